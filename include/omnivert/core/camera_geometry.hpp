@@ -1,0 +1,39 @@
+#pragma once
+// The image-side geometry of a catadioptric camera with a vertical mirror axis, as read from
+// cam0/sensor.yaml: image size, mirror centre, valid annulus R_min..R_max (Sec. 2) and the
+// sign that turns an image angle into a camera bearing (NOTES Sec. 1).
+//
+// Conventions (NOTES Sec. 1): pixel (u right, v down); image angle a = atan2(v - cy, u - cx);
+// camera bearing beta = bearing_sign * a, wrapped to (-pi, pi].
+
+#include <optional>
+#include <string>
+
+#include <Eigen/Core>
+
+namespace omnivert {
+
+struct CameraGeometry {
+  int width = 0;
+  int height = 0;
+  // Mirror centre in pixels; absent: estimated on every frame.
+  std::optional<Eigen::Vector2d> center;
+  // Valid annulus in pixels; absent: estimated from the mirror rim.
+  std::optional<double> r_min;
+  std::optional<double> r_max;
+  // +1: beta = a; -1: beta = -a (mirror-flipped image).
+  int bearing_sign = 1;
+
+  // Camera bearing of an image angle (NOTES Sec. 1).
+  double bearing_of_image_angle(double a) const;
+  // Image angle of a camera bearing (inverse of the above).
+  double image_angle_of_bearing(double beta) const;
+};
+
+// Reads the fields above from a sensor.yaml. Fields other than these are ignored (the
+// simulator adds its intrinsics). Throws InputError naming the file, the line and the field
+// for: a missing file, YAML that does not parse, a missing or non-numeric resolution,
+// negative or non-numeric values, r_min >= r_max, bearing_sign other than +-1.
+CameraGeometry load_camera_geometry(const std::string& path);
+
+}  // namespace omnivert
