@@ -1,0 +1,24 @@
+#pragma once
+// Subcommands of the omnivert tool. Each add_*_command declares its options on the app and
+// sets a callback that does the work through the library.
+//
+// Exit codes, for every subcommand:
+//   0 success; 1 the work failed (a message says why); 2 bad input or usage (file, line,
+//   problem); 3 the result is not determined (calibrate: unobservable trajectory).
+
+#include <CLI/CLI.hpp>
+
+namespace omnivert::cli {
+
+inline constexpr int kExitFailure = 1;
+inline constexpr int kExitBadInput = 2;
+inline constexpr int kExitUndetermined = 3;
+
+// Thrown by a command's callback to end with a given code after printing `what()`.
+struct CommandExit {
+  int code;
+};
+
+void add_extract_command(CLI::App& app);
+
+}  // namespace omnivert::cli

@@ -1,0 +1,39 @@
+// omnivert: vertical lines in omnidirectional images, from pixels to camera-odometry
+// calibration. See README.md and `omnivert <command> --help`.
+
+#include <cstdio>
+#include <exception>
+
+#include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
+
+#include "commands.hpp"
+#include "omnivert/core/error.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"omnivert: vertical lines in omnidirectional images (extraction, description, "
+               "tracking, camera-odometry self-calibration)"};
+  app.require_subcommand(1);
+  bool verbose = false;
+  app.add_flag("-v,--verbose", verbose, "More log output");
+  app.set_version_flag("--version", "omnivert 0.1.0");
+
+  omnivert::cli::add_extract_command(app);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : omnivert::cli::kExitBadInput;
+  } catch (const omnivert::InputError& e) {
+    std::fprintf(stderr, "omnivert: error: %s\n", e.what());
+    return omnivert::cli::kExitBadInput;
+  } catch (const omnivert::cli::CommandExit& e) {
+    return e.code;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "omnivert: error: %s\n", e.what());
+    return omnivert::cli::kExitFailure;
+  }
+  (void)verbose;
+  return 0;
+}
