@@ -19,6 +19,6 @@ struct CommandExit {
   int code;
 };
 
-void add_extract_command(CLI::App& app);
+
 
 }  // namespace omnivert::cli

@@ -18,7 +18,6 @@ int main(int argc, char** argv) {
   app.add_flag("-v,--verbose", verbose, "More log output");
   app.set_version_flag("--version", "omnivert 0.1.0");
 
-  omnivert::cli::add_extract_command(app);
 
   try {
     app.parse(argc, argv);
