@@ -19,6 +19,7 @@ struct CommandExit {
   int code;
 };
 
-
+void add_extract_command(CLI::App& app);
+void add_pattern_command(CLI::App& app);
 
 }  // namespace omnivert::cli

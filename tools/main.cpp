@@ -18,6 +18,9 @@ int main(int argc, char** argv) {
   app.add_flag("-v,--verbose", verbose, "More log output");
   app.set_version_flag("--version", "omnivert 0.1.0");
 
+  omnivert::cli::add_extract_command(app);
+  omnivert::cli::add_pattern_command(app);
+
 
   try {
     app.parse(argc, argv);
