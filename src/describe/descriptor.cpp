@@ -55,8 +55,11 @@ void DescriptorExtractor::prepare(const cv::Mat& gray, const MirrorCircle& circl
   const cv::Mat src = gray(roi_);
   if (options_.smoothing == DescriptorSmoothing::kGaussianBlur) {
     // Sec. 3.1, read as a blur of the image with sigma_G before the gradients.
-    cv::GaussianBlur(src, blurred_, cv::Size(), options_.sigma_fraction * ra, 0, cv::BORDER_REPLICATE);
-    blurred_.convertTo(blurred_, CV_32F);
+    // In floating point: a blur of sigma ~10 px rounded back to 8 bits leaves a staircase
+    // whose gradients point along the pixel grid (measured: 0.31 mean descriptor change
+    // under a 17 degree rotation, against 0.00 at 90 degrees).
+    src.convertTo(blurred_, CV_32F);
+    cv::GaussianBlur(blurred_, blurred_, cv::Size(), options_.sigma_fraction * ra, 0, cv::BORDER_REPLICATE);
     cv::Sobel(blurred_, gx_, CV_32F, 1, 0, 3);
     cv::Sobel(blurred_, gy_, CV_32F, 0, 1, 3);
   } else {

@@ -261,43 +261,53 @@ std::optional<MirrorCircle> MirrorCenterDetector::estimate(const cv::Mat& gray,
     c = accumulator_peak(acc, 2.0);
   }
 
-  // Rim: the radius with the best coverage of darker-outward radial edges.
+  // Rim: radii with a good coverage of darker-outward radial edges, best first; the first
+  // that fits to sub-pixel precision is the rim (a mirror holder can add rings that lie
+  // mostly outside the image).
   const int rmax_search = static_cast<int>(std::hypot(small.cols, small.rows) / 2);
   const auto outer = radial_edge_coverage(gx, gy, c, rmax_search, thr, -1);
-  double rim = 0;
+  std::vector<std::pair<double, int>> rims;  // (coverage, radius in the small image)
+  int r_lo = static_cast<int>(0.15 * std::min(small.cols, small.rows)), r_hi = rmax_search;
   if (geometry.r_max) {
     // Rim just outside the given r_max: look in the next 15%.
-    double best = 0;
-    for (int r = static_cast<int>(*geometry.r_max * scale); r <= rmax_search &&
-                                                             r <= *geometry.r_max * scale * 1.15 + 3;
-         ++r)
-      if (outer[r] > best) best = outer[r], rim = r;
-    if (best < 0.3) rim = *geometry.r_max * scale / (1.0 - options_.rim_margin_fraction);
-  } else {
-    const int r_lo = static_cast<int>(0.15 * std::min(small.cols, small.rows));
-    double best = 0;
-    for (int r = r_lo; r <= rmax_search; ++r)
-      if (outer[r] > best) best = outer[r], rim = r;
-    if (best < 0.3) {
+    r_lo = static_cast<int>(*geometry.r_max * scale);
+    r_hi = std::min(rmax_search, static_cast<int>(*geometry.r_max * scale * 1.15 + 3));
+  }
+  for (int r = std::max(r_lo, 2); r < r_hi; ++r) {
+    if (outer[r] >= 0.3 && outer[r] >= outer[r - 1] && outer[r] > outer[r + 1])
+      rims.emplace_back(outer[r], r);
+  }
+  std::sort(rims.rbegin(), rims.rend());
+  Eigen::Vector2d center = c / scale;
+  double rim_radius = 0;
+  bool refined = false;
+  for (std::size_t i = 0; i < rims.size() && i < 6 && !refined; ++i) {
+    center = c / scale;
+    rim_radius = rims[i].second / scale;
+    refined = refine(gray, center, rim_radius);
+  }
+  if (!refined) {
+    if (!geometry.r_max) {
       set_why(why,
-              "no mirror rim found (no circle of darker-outward edges around the centre); give "
-              "r_max in sensor.yaml");
+              rims.empty() ? "no mirror rim found (no circle of darker-outward edges around the "
+                             "centre); give center, r_min and r_max in sensor.yaml"
+                           : "the mirror rim was found but could not be fitted to sub-pixel "
+                             "precision; give center, r_min and r_max in sensor.yaml");
       return std::nullopt;
     }
+    if (!geometry.center) {
+      set_why(why, "the mirror rim could not be fitted; give center in sensor.yaml");
+      return std::nullopt;
+    }
+    center = *geometry.center;
+    rim_radius = 0;  // no rim: the centre stays where sensor.yaml puts it
   }
-
-  Eigen::Vector2d center = c / scale;
-  double rim_radius = rim / scale;
-  const bool refined = refine(gray, center, rim_radius);
-  if (!refined && !geometry.center) {
-    set_why(why, "the mirror rim was found but could not be fitted to sub-pixel precision");
-    return std::nullopt;
-  }
-  if (geometry.center) center = refined ? center : *geometry.center;
+  if (geometry.center && !refined) center = *geometry.center;
+  const double rim = rim_radius * scale;
 
   MirrorCircle circle;
   circle.center = center;
-  circle.rim_radius = refined ? rim_radius : 0.0;
+  circle.rim_radius = rim_radius;
   circle.r_max = geometry.r_max ? *geometry.r_max : rim_radius * (1.0 - options_.rim_margin_fraction);
   if (geometry.r_min) {
     circle.r_min = *geometry.r_min;

@@ -110,13 +110,22 @@ RadialPattern draw_radial_pattern(const RadialPatternOptions& o) {
     }
   }
 
+  // Rotation of the scene: evaluate the unrotated scene at angle - rotation.
+  const double rot = o.rotation_rad;
+  const double cr = std::cos(rot), sr = std::sin(rot);
+  for (Blob& b : blobs) {
+    const double bx = b.x - cx, by = b.y - cy;
+    b.x = cx + cr * bx - sr * by;
+    b.y = cy + sr * bx + cr * by;
+  }
+  for (auto& e : out.edges) e.image_angle = wrap_angle(e.image_angle + rot);
   const double r_disc = o.r_min / 1.1;
   auto value = [&](double x, double y) {
     const double dx = x - cx, dy = y - cy;
     const double r = std::sqrt(dx * dx + dy * dy);
     if (r > o.rim_radius) return 12.0;
     if (r < r_disc) return 25.0;
-    const double a = wrap_positive(std::atan2(dy, dx));
+    const double a = wrap_positive(std::atan2(dy, dx) - rot);
     for (const Patch& p : patches)
       if (a >= p.a0 && a < p.a1 && r >= p.r0 && r < p.r1) return p.level;
     return level[sector_of(a)];
@@ -127,7 +136,7 @@ RadialPattern draw_radial_pattern(const RadialPatternOptions& o) {
     const double r = std::sqrt(dx * dx + dy * dy);
     if (r > o.rim_radius) return -1;
     if (r < r_disc) return -2;
-    const double a = wrap_positive(std::atan2(dy, dx));
+    const double a = wrap_positive(std::atan2(dy, dx) - rot);
     for (std::size_t i = 0; i < patches.size(); ++i) {
       const Patch& p = patches[i];
       if (a >= p.a0 && a < p.a1 && r >= p.r0 && r < p.r1) return 1000 + static_cast<int>(i);
@@ -178,6 +187,7 @@ RadialPattern draw_radial_pattern(const RadialPatternOptions& o) {
       }
     }
   }
+  if (o.noise_seed != 0) rng.seed(o.noise_seed);
   std::normal_distribution<double> N(0.0, o.noise_sigma);
   out.image.create(o.height, o.width, CV_8U);
   for (int v = 0; v < o.height; ++v) {

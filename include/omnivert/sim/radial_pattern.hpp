@@ -31,6 +31,11 @@ struct RadialPatternOptions {
   double min_separation_deg = 4.0;  // between any two edges
   double noise_sigma = 3.0;         // Gaussian image noise, grey levels
   bool texture = true;              // low-contrast blobs so descriptors differ between lines
+  // The same scene rotated about the mirror centre: every image angle + rotation (the image
+  // noise is drawn afresh, as a rotated camera would see it).
+  double rotation_rad = 0.0;
+  // Seed of the image noise (0: follow `seed`).
+  std::uint64_t noise_seed = 0;
   std::uint64_t seed = 1;
 };
 
