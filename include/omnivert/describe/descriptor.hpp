@@ -44,6 +44,12 @@ struct DescriptorOptions {
   DescriptorNormalization normalization = DescriptorNormalization::kPerPair;
   double clip = 0.1;             // Sec. 3.3
   double sigma_fraction = 1.0 / 3.0;  // sigma_G = sigma_fraction * r_a (Sec. 3.1)
+  // Gradients of log(log_offset + I) instead of I (an extension of Sec. 3.3): a gain g and gamma y
+  // map log I to const + y log I, so after the blur and unit normalisation the descriptor is
+  // unchanged by both (up to noise and saturation). Applies to the blur reading.
+  bool log_intensity = true;
+  // Offset in log(offset + I): keeps near-black pixels (noise, interpolation) from dominating.
+  double log_offset = 2.0;
 
   bool IsValid(std::string* why) const;
   // Descriptor length: areas x 2 halves x bins.
