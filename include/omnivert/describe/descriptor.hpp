@@ -51,6 +51,10 @@ struct DescriptorOptions {
   // Offset in log(offset + I): keeps near-black pixels (noise, interpolation) from dominating.
   double log_offset = 2.0;
 
+  // Blur reading: gradients are sampled every floor(sigma_G / this) pixels (>= 1); the
+  // blurred image holds nothing finer. A large value forces full resolution.
+  double min_samples_per_sigma = 5.0;
+
   bool IsValid(std::string* why) const;
   // Descriptor length: areas x 2 halves x bins.
   int size() const { return areas * 2 * bins; }
@@ -84,8 +88,12 @@ class DescriptorExtractor {
   void normalize(float* row) const;
 
   DescriptorOptions options_;
-  cv::Rect roi_;   // region of the gradient images in the frame
-  cv::Mat gx_, gy_, blurred_;
+  cv::Rect roi_;   // region of the frame the gradient images cover
+  int step_ = 1;   // one gradient sample every step_ pixels (blur reading)
+  cv::Mat full_, blurred_, gx_, gy_;
+  cv::Mat log_lut_;  // grey level -> log(offset + I) (or I)
+  double log_lut_offset_ = -1;
+  bool log_lut_log_ = false;
 };
 
 }  // namespace omnivert
