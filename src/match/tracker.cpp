@@ -99,26 +99,26 @@ void Tracker::add_frame(const FrameFeatures& frame,
       }
       const std::int64_t id = ok ? slot.track_ids[static_cast<std::size_t>(r.best)] : -1;
       if (ok && options_.mutual) {
-        if (track_claimed(id)) {
+        // Reverse direction first (so that the reason does not depend on the order in which
+        // lines are processed): the nearest line of the new frame to B_best must be A_i.
+        // Computed for the accepted candidate only (n dot products), ties to lowest index.
+        const auto b = slot.descriptors.row(r.best);
+        int nearest = -1;
+        float nearest_sq = std::numeric_limits<float>::infinity();
+        for (int a = 0; a < n; ++a) {
+          const float sq = (frame.descriptors.row(a) - b).squaredNorm();
+          if (sq < nearest_sq) {
+            nearest_sq = sq;
+            nearest = a;
+          }
+        }
+        if (nearest != i) {
+          ++stats_.rejected_mutual;
+          ok = false;
+        } else if (track_claimed(id)) {
+          // One line per track and frame: taken by a line matched in a more recent frame.
           ++stats_.rejected_claimed;
           ok = false;
-        } else {
-          // Reverse direction: the nearest line of the new frame to B_best must be A_i.
-          // Computed for the accepted candidate only (n dot products), ties to lowest index.
-          const auto b = slot.descriptors.row(r.best);
-          int nearest = -1;
-          float nearest_sq = std::numeric_limits<float>::infinity();
-          for (int a = 0; a < n; ++a) {
-            const float sq = (frame.descriptors.row(a) - b).squaredNorm();
-            if (sq < nearest_sq) {
-              nearest_sq = sq;
-              nearest = a;
-            }
-          }
-          if (nearest != i) {
-            ++stats_.rejected_mutual;
-            ok = false;
-          }
         }
       }
       if (ok && options_.gate.enabled &&
