@@ -122,7 +122,8 @@ TrackingEvaluation evaluate_tracking(const std::vector<TrackRow>& tracks,
   for (std::int64_t k = 0; k < num_intervals; ++k) {
     auto& c = ev.intervals[static_cast<std::size_t>(k)];
     c.first_frame = k * options.interval;
-    c.end_frame = std::min<std::int64_t>((k + 1) * options.interval, std::max<std::int64_t>(num_frames, 1));
+    c.end_frame =
+        std::min<std::int64_t>((k + 1) * options.interval, std::max<std::int64_t>(num_frames, 1));
   }
   auto bucket = [&](std::int64_t frame) -> TrackingCounts& {
     const std::int64_t k = std::clamp<std::int64_t>(frame / options.interval, 0, num_intervals - 1);
@@ -202,7 +203,7 @@ std::string format_tracking_table(const TrackingEvaluation& ev, const std::strin
   char buf[256];
   std::snprintf(buf,
                 sizeof(buf),
-                "%-16s %9s %10s %9s %11s %11s\n",
+                "%-16s %9s %10s %10s %11s %12s\n",
                 "Frame interval",
                 "Matches",
                 "Correct %",
@@ -213,7 +214,7 @@ std::string format_tracking_table(const TrackingEvaluation& ev, const std::strin
   auto row = [&](const std::string& label, const TrackingCounts& c) {
     std::snprintf(buf,
                   sizeof(buf),
-                  "%-16s %9lld %10.2f %9.2f %11.2f %11.2f\n",
+                  "%-16s %9lld %10.2f %10.2f %11.2f %12.2f\n",
                   label.c_str(),
                   static_cast<long long>(c.matches),
                   c.percent_correct(),

@@ -50,8 +50,7 @@ MatchVerdict apply_match_tests(const MatchOptions& options,
     return MatchVerdict::kFailedTest2;
   }
   // Sec. 4.3, eq. (10); second_distance is +inf for a single candidate (vacuous test).
-  if (options.use_test3 && num_candidates >= 2 &&
-      !(min_distance <= options.f3 * second_distance)) {
+  if (options.use_test3 && num_candidates >= 2 && !(min_distance <= options.f3 * second_distance)) {
     return MatchVerdict::kFailedTest3;
   }
   return MatchVerdict::kAccepted;
@@ -122,8 +121,7 @@ void Matcher::match(const ConstDescriptors& query,
   const DistanceView d = compute_distances(query, candidates);
   results->resize(static_cast<std::size_t>(query.rows()));
   for (Eigen::Index i = 0; i < query.rows(); ++i) {
-    (*results)[static_cast<std::size_t>(i)] =
-        cols_ == 0 ? MatchResult{} : evaluate_row(d.row(i));
+    (*results)[static_cast<std::size_t>(i)] = cols_ == 0 ? MatchResult{} : evaluate_row(d.row(i));
   }
 }
 
@@ -148,9 +146,8 @@ std::vector<MatchResult> match_brute_force(const MatchOptions& options,
     }
     MatchResult& r = out[static_cast<std::size_t>(i)];
     if (nb == 0) continue;
-    std::stable_sort(row.begin(), row.end(), [](const auto& a, const auto& b) {
-      return a.first < b.first;
-    });
+    std::stable_sort(
+        row.begin(), row.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
     r.best = row[0].second;
     r.min_distance = static_cast<float>(row[0].first);
     const double second = nb >= 2 ? row[1].first : std::numeric_limits<double>::infinity();

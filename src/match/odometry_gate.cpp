@@ -59,8 +59,8 @@ BearingGate make_bearing_gate(const OdometryGateOptions& options,
     return g;
   }
   const double parallax = std::asin(s / options.min_feature_distance);
-  const double slip = options.slip_fraction * (after.wheel_travel - before.wheel_travel) /
-                      options.wheel_base;
+  const double slip =
+      options.slip_fraction * (after.wheel_travel - before.wheel_travel) / options.wheel_base;
   g.max_deviation = parallax + slip + options.bearing_tolerance;
   g.informative = g.max_deviation < kPi;
   if (!g.informative) g.max_deviation = kPi;

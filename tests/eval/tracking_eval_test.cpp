@@ -48,11 +48,16 @@ Case hand_built() {
     c.truth.push_back(gt(f, 200, 0.5, f == 4 ? 50.0 : 90.0));  // short in frame 4
   }
   c.tracks = {
-      det(0, 0, 0.005),        det(1, 0, 0.005, 0), det(2, 0, 0.005, 1),
-      det(3, 0, 0.51, 2),                                           // false match A -> B
-      det(0, 1, 0.5),          det(1, 1, 0.5, 0),   det(2, 1, 0.5, 1),
-      det(4, 2, 0.005),                                             // false new entry
-      det(1, 3, 2.0),          det(2, 3, 2.0, 1),                   // clutter
+      det(0, 0, 0.005),
+      det(1, 0, 0.005, 0),
+      det(2, 0, 0.005, 1),
+      det(3, 0, 0.51, 2),  // false match A -> B
+      det(0, 1, 0.5),
+      det(1, 1, 0.5, 0),
+      det(2, 1, 0.5, 1),
+      det(4, 2, 0.005),  // false new entry
+      det(1, 3, 2.0),
+      det(2, 3, 2.0, 1),  // clutter
   };
   return c;
 }
@@ -149,7 +154,7 @@ TEST(TrackingEval, LinksFollowMatchedFrame) {
   std::vector<TrackRow> tracks = {det(0, 7, 0.0), det(1, 7, 1.0, 0), det(2, 7, 0.0, 0)};
   TrackingEvaluation ev = evaluate_tracking(tracks, truth, options());
   EXPECT_EQ(ev.total.matches, 2);
-  EXPECT_EQ(ev.total.correct, 1);  // 2 -> 0
+  EXPECT_EQ(ev.total.correct, 1);        // 2 -> 0
   EXPECT_EQ(ev.total.false_matches, 1);  // 1 -> 0
   for (auto& r : tracks) r.matched_frame = -1;
   ev = evaluate_tracking(tracks, truth, options());

@@ -332,9 +332,8 @@ TEST(BearingGate, PureRotationAndTranslationBounds) {
   o.bearing_tolerance = 0.01;
   o.slip_fraction = 0.05;
   g = make_bearing_gate(o, a, b);
-  EXPECT_NEAR(g.max_deviation,
-              std::asin(2 * 0.2 * std::sin(0.1) / 0.5) + 0.05 * 0.08 / 0.4 + 0.01,
-              1e-12);
+  EXPECT_NEAR(
+      g.max_deviation, std::asin(2 * 0.2 * std::sin(0.1) / 0.5) + 0.05 * 0.08 / 0.4 + 0.01, 1e-12);
 }
 
 // Soundness: for random extrinsics (rho <= rho_max), random drives and random static lines at
@@ -377,8 +376,8 @@ TEST(BearingGate, TrueBearingChangesAlwaysAdmitted) {
       after.add(inc, o.wheel_base);
       // Differential drive, integrated in sub-steps (exact arcs in the limit).
       for (int k = 0; k < 20; ++k) {
-        const double dr = 0.5 * (inc.d_right + inc.d_left) / 20, dt =
-            (inc.d_right - inc.d_left) / o.wheel_base / 20;
+        const double dr = 0.5 * (inc.d_right + inc.d_left) / 20,
+                     dt = (inc.d_right - inc.d_left) / o.wheel_base / 20;
         x += dr * std::cos(th + dt / 2);
         y += dr * std::sin(th + dt / 2);
         th += dt;
@@ -393,8 +392,8 @@ TEST(BearingGate, TrueBearingChangesAlwaysAdmitted) {
                                   << angle_diff(b1, b0 + g.predicted_change) << " bound "
                                   << g.max_deviation;
     informative += g.informative;
-    if (g.informative && std::abs(angle_diff(b1, b0 + g.predicted_change)) >
-                             0.5 * g.max_deviation) {
+    if (g.informative &&
+        std::abs(angle_diff(b1, b0 + g.predicted_change)) > 0.5 * g.max_deviation) {
       ++tight;
     }
   }

@@ -1,4 +1,5 @@
 #include "omnivert/match/tracks_io.hpp"
+#include "omnivert/match/tracks_plot.hpp"
 
 #include <cstdlib>
 #include <fstream>
@@ -16,10 +17,10 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path temp_dir() {
-  const fs::path d = fs::temp_directory_path() /
-                     ("omnivert_tracks_io_" + std::to_string(::testing::UnitTest::GetInstance()
-                                                                 ->random_seed()) +
-                      "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  const fs::path d =
+      fs::temp_directory_path() /
+      ("omnivert_tracks_io_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+       "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
   fs::create_directories(d);
   return d;
 }

@@ -96,8 +96,7 @@ class Matcher {
   // Fills `distances` (query.rows() x candidates.rows()) with eq. (6) distances. Both inputs
   // must have the same number of columns (asserted). The returned view stays valid until
   // the next call.
-  DistanceView compute_distances(const ConstDescriptors& query,
-                                           const ConstDescriptors& candidates);
+  DistanceView compute_distances(const ConstDescriptors& query, const ConstDescriptors& candidates);
 
   // For every query row, the nearest candidate and the verdict of tests 1-3. `results` is
   // resized to query.rows().
@@ -109,9 +108,7 @@ class Matcher {
   MatchResult evaluate_row(const Eigen::Ref<const Eigen::RowVectorXf>& row) const;
 
   // The distance matrix of the last compute_distances/match call.
-  DistanceView last_distances() const {
-    return DistanceView(distances_, 0, 0, rows_, cols_);
-  }
+  DistanceView last_distances() const { return DistanceView(distances_, 0, 0, rows_, cols_); }
 
  private:
   MatchOptions options_;

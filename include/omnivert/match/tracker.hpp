@@ -36,10 +36,10 @@
 namespace omnivert {
 
 struct TrackerOptions {
-  MatchOptions match;          // tests 1-3 (Sec. 4)
-  int look_back = 20;          // frames searched back for an unmatched line (Sec. 9.1)
-  bool mutual = false;         // one-to-one, mutual nearest neighbours
-  OdometryGateOptions gate;    // bearing-change gate from wheel travel (off by default)
+  MatchOptions match;        // tests 1-3 (Sec. 4)
+  int look_back = 20;        // frames searched back for an unmatched line (Sec. 9.1)
+  bool mutual = false;       // one-to-one, mutual nearest neighbours
+  OdometryGateOptions gate;  // bearing-change gate from wheel travel (off by default)
 
   bool IsValid(std::string* error) const;
 };
@@ -59,7 +59,7 @@ struct TrackAssignment {
 struct TrackerStats {
   std::int64_t frames = 0;
   std::int64_t lines = 0;
-  std::int64_t matched_previous = 0;  // matched in frame t-1
+  std::int64_t matched_previous = 0;   // matched in frame t-1
   std::int64_t matched_look_back = 0;  // matched in frames t-2 .. t-look_back
   std::int64_t new_tracks = 0;
   // Rejections of a best candidate, over all look-back attempts (one line can count several

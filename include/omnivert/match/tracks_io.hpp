@@ -1,6 +1,6 @@
 #pragma once
-// tracks.csv: the tracker's output, one row per reported line per frame, and the paper's
-// Fig. 22 (bearing against frame number) drawn from it.
+// tracks.csv: the tracker's output, one row per reported line per frame (drawn as the paper's
+// Fig. 22 by tracks_plot.hpp).
 //
 // Columns (header line first; only the first four are required when reading):
 //   frame          0-based image index in the dataset (cam0/data.csv order)
@@ -15,8 +15,6 @@
 #include <filesystem>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "omnivert/describe/frame_features.hpp"
 #include "omnivert/match/tracker.hpp"
@@ -52,24 +50,5 @@ void write_tracks_csv(const std::filesystem::path& path, const std::vector<Track
 // Throws InputError(file, line, problem) for a missing file, a missing required column, a
 // malformed or non-finite number, a negative frame or track id.
 std::vector<TrackRow> read_tracks_csv(const std::filesystem::path& path);
-
-struct TrackPlotOptions {
-  int width = 1600;   // pixels
-  int height = 900;   // pixels
-  bool draw_ids = true;
-  std::string title = "Vertical-line tracks";
-};
-
-// The paper's Fig. 22: bearing (degrees, -180..180, y axis) against frame number (x axis);
-// each detection a small circle, each track a polyline in its own colour (broken where it
-// crosses +-180 degrees, each piece drawn to the border), its id written where it starts.
-// Returns an 8-bit BGR image.
-cv::Mat draw_tracks(const std::vector<TrackRow>& rows, const TrackPlotOptions& options = {});
-
-// draw_tracks, then PNG; written under a temporary name and renamed. Throws InputError when
-// the file cannot be written.
-void write_tracks_png(const std::filesystem::path& path,
-                      const std::vector<TrackRow>& rows,
-                      const TrackPlotOptions& options = {});
 
 }  // namespace omnivert
