@@ -68,14 +68,19 @@ void Tracker::add_frame(const FrameFeatures& frame,
     const auto candidates = slot.descriptors.topRows(slot.num_lines);
     // Query rows: the lines still unmatched (all of them for k = 1).
     const int nq = static_cast<int>(unmatched_.size());
-    if (query_.rows() < nq || query_.cols() != frame.descriptors.cols()) {
-      query_.resize(std::max<Eigen::Index>(query_.rows(), nq), frame.descriptors.cols());
+    // All lines still in play (always so for k = 1): match the frame's own matrix, no copy.
+    const bool all_rows = nq == n;
+    if (all_rows) {
+      matcher_.match(frame.descriptors, candidates, &results_);
+    } else {
+      if (query_.rows() < nq || query_.cols() != frame.descriptors.cols()) {
+        query_.resize(std::max<Eigen::Index>(query_.rows(), nq), frame.descriptors.cols());
+      }
+      for (int q = 0; q < nq; ++q) {
+        query_.row(q) = frame.descriptors.row(unmatched_[static_cast<std::size_t>(q)]);
+      }
+      matcher_.match(query_.topRows(nq), candidates, &results_);
     }
-    for (int q = 0; q < nq; ++q) {
-      query_.row(q) = frame.descriptors.row(unmatched_[static_cast<std::size_t>(q)]);
-    }
-    matcher_.match(query_.topRows(nq), candidates, &results_);
-
     const BearingGate gate = options_.gate.enabled
                                  ? make_bearing_gate(options_.gate, slot.odometry, odometry_)
                                  : BearingGate{};
@@ -102,14 +107,21 @@ void Tracker::add_frame(const FrameFeatures& frame,
         // Reverse direction first (so that the reason does not depend on the order in which
         // lines are processed): the nearest line of the new frame to B_best must be A_i.
         // Computed for the accepted candidate only (n dot products), ties to lowest index.
-        const auto b = slot.descriptors.row(r.best);
         int nearest = -1;
-        float nearest_sq = std::numeric_limits<float>::infinity();
-        for (int a = 0; a < n; ++a) {
-          const float sq = (frame.descriptors.row(a) - b).squaredNorm();
-          if (sq < nearest_sq) {
-            nearest_sq = sq;
-            nearest = a;
+        if (all_rows) {
+          // The whole column of distances to B_best is at hand (row q is line q).
+          Eigen::Index idx = 0;
+          matcher_.last_distances().col(r.best).minCoeff(&idx);
+          nearest = static_cast<int>(idx);
+        } else {
+          const auto b = slot.descriptors.row(r.best);
+          float nearest_sq = std::numeric_limits<float>::infinity();
+          for (int a = 0; a < n; ++a) {
+            const float sq = (frame.descriptors.row(a) - b).squaredNorm();
+            if (sq < nearest_sq) {
+              nearest_sq = sq;
+              nearest = a;
+            }
           }
         }
         if (nearest != i) {
