@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 #include <map>
 #include <unordered_map>
 
@@ -65,6 +66,9 @@ TrackingEvaluation evaluate_tracking(const std::vector<TrackRow>& tracks,
   // Rule 1: associate each detection to the nearest true bearing within the tolerance.
   const std::size_t n = tracks.size();
   std::vector<std::int64_t> assoc(n, -1);
+  // Every world line within the tolerance (sorted ids): more than one when true lines are
+  // closer than the tolerance (crossings, lines far ahead), where the nearest is noise.
+  std::vector<std::vector<std::int64_t>> within(n);
   std::vector<char> gt_detected(ground_truth.size(), 0);
   double sq_sum = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
@@ -74,11 +78,15 @@ TrackingEvaluation evaluate_tracking(const std::vector<TrackRow>& tracks,
     std::size_t best_k = ground_truth.size();
     for (std::size_t k : it->second) {
       const double d = std::abs(angle_diff(tracks[i].bearing, ground_truth[k].bearing));
+      if (d <= options.association_tolerance) within[i].push_back(ground_truth[k].line_id);
       if (d <= best) {
         best = d;
         best_k = k;
       }
     }
+    std::sort(within[i].begin(), within[i].end());
+    within[i].erase(std::unique(within[i].begin(), within[i].end()), within[i].end());
+    if (within[i].size() > 1) ++ev.ambiguous_detections;
     if (best_k == ground_truth.size()) continue;
     assoc[i] = ground_truth[best_k].line_id;
     gt_detected[best_k] = 1;
@@ -130,6 +138,9 @@ TrackingEvaluation evaluate_tracking(const std::vector<TrackRow>& tracks,
     return ev.intervals[static_cast<std::size_t>(k)];
   };
 
+  // Rule 3: identity sets propagated along the links of each track.
+  std::vector<std::vector<std::int64_t>> identity(n);
+  std::vector<std::int64_t> common;
   for (auto& [id, dets] : by_track) {
     std::stable_sort(dets.begin(), dets.end(), [&](std::size_t a, std::size_t b) {
       return tracks[a].frame < tracks[b].frame;
@@ -140,6 +151,7 @@ TrackingEvaluation evaluate_tracking(const std::vector<TrackRow>& tracks,
       const TrackRow& d = tracks[i];
       if (k > 0 && tracks[dets[k - 1]].frame == d.frame) ++ev.duplicate_ids;
       if (d.frame == start_frame) {
+        identity[i] = within[i];
         // Rule 2: the first detection(s) of a track id are new entries. Rule 4.
         TrackingCounts& c = bucket(d.frame);
         ++c.new_entries;
@@ -183,12 +195,23 @@ TrackingEvaluation evaluate_tracking(const std::vector<TrackRow>& tracks,
       // Rule 3.
       TrackingCounts& c = bucket(d.frame);
       ++c.matches;
-      if (assoc[i] < 0 || assoc[pred] < 0) {
+      if (within[i].empty() || identity[pred].empty()) {
         ++c.unverified;
-      } else if (assoc[i] == assoc[pred]) {
+        identity[i] = within[i];
+        continue;
+      }
+      common.clear();
+      std::set_intersection(identity[pred].begin(),
+                            identity[pred].end(),
+                            within[i].begin(),
+                            within[i].end(),
+                            std::back_inserter(common));
+      if (!common.empty()) {
         ++c.correct;
+        identity[i] = common;
       } else {
         ++c.false_matches;
+        identity[i] = within[i];
       }
     }
   }
@@ -236,11 +259,12 @@ std::string format_tracking_table(const TrackingEvaluation& ev, const std::strin
   s += buf;
   std::snprintf(buf,
                 sizeof(buf),
-                "Detections: %lld, associated within tolerance: %lld (%.1f%%), duplicate ids "
-                "in a frame: %lld\n",
+                "Detections: %lld, associated within tolerance: %lld (%.1f%%), ambiguous "
+                "(several true lines within tolerance): %lld, duplicate ids in a frame: %lld\n",
                 static_cast<long long>(ev.detections),
                 static_cast<long long>(ev.associated_detections),
                 ev.detections > 0 ? 100.0 * ev.associated_detections / ev.detections : 0.0,
+                static_cast<long long>(ev.ambiguous_detections),
                 static_cast<long long>(ev.duplicate_ids));
   s += buf;
   std::snprintf(buf,

@@ -172,6 +172,35 @@ TEST(TrackingEval, DoubleClaimCountsAsFalseMatch) {
   EXPECT_EQ(ev.total.false_matches, 1);
 }
 
+// Two lines cross (within 1 degree of each other in frame 2) and the tracks swap there:
+// one false match per track, where the lines separate; no false match while they are
+// indistinguishable, and none for tracks that follow their line through the crossing.
+TEST(TrackingEval, SwapAtCrossingCountsOnceAndAmbiguityIsNotAnError) {
+  const double a_deg[] = {-2, -1, 0, 1, 2}, b_deg[] = {2, 1, 0.05, -1, -2};
+  std::vector<GroundTruthLine> truth;
+  for (int f = 0; f < 5; ++f) {
+    truth.push_back(gt(f, 1, deg2rad(a_deg[f])));
+    truth.push_back(gt(f, 2, deg2rad(b_deg[f])));
+  }
+  std::vector<TrackRow> swap, follow;
+  for (int f = 0; f < 5; ++f) {
+    const std::int64_t m = f > 0 ? f - 1 : -1;
+    // Swapping tracks: up to frame 2 on their own line, then on the other one.
+    swap.push_back(det(f, 0, deg2rad(f <= 2 ? a_deg[f] : b_deg[f]), m));
+    swap.push_back(det(f, 1, deg2rad(f <= 2 ? b_deg[f] : a_deg[f]), m));
+    follow.push_back(det(f, 0, deg2rad(a_deg[f]), m));
+    follow.push_back(det(f, 1, deg2rad(b_deg[f]), m));
+  }
+  TrackingEvaluation ev = evaluate_tracking(swap, truth, options());
+  EXPECT_EQ(ev.ambiguous_detections, 2);
+  EXPECT_EQ(ev.total.matches, 8);
+  EXPECT_EQ(ev.total.false_matches, 2);
+  EXPECT_EQ(ev.total.correct, 6);
+  ev = evaluate_tracking(follow, truth, options());
+  EXPECT_EQ(ev.total.false_matches, 0);
+  EXPECT_EQ(ev.total.correct, 8);
+}
+
 TEST(TrackingEval, EmptyInputs) {
   const TrackingEvaluation ev = evaluate_tracking({}, {}, options());
   EXPECT_EQ(ev.total.matches, 0);

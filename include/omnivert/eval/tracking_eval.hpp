@@ -10,9 +10,16 @@
 //     that track in `matched_frame` when the row says so (nearest bearing if the track has
 //     several there), otherwise the track's latest detection in an earlier frame. The first
 //     detection of a track id is a new entry, not a match.
-//  3. A link is correct when both ends are associated to the same world line, a false match
-//     when they are associated to two different world lines, and unverified when either end
-//     is unassociated.
+//  3. A link joins two detections of different world lines (a false match) when no single
+//     world line explains both. Each detection has the set of world lines within the
+//     tolerance (usually one; several where true lines are closer than 1 degree: crossings,
+//     lines far ahead). Along each track an identity set is carried: a new entry starts with
+//     its set; a link is correct when the predecessor's identity set meets the detection's
+//     set (the identity becomes the intersection), a false match when they are disjoint (the
+//     identity restarts from the detection's set), and unverified when either set is empty
+//     (an unassociated end). Without ambiguity this is exactly "both ends associated to the
+//     same / different world lines"; with it, two tracks swapping at a crossing count one
+//     false match each, at the link where their lines separate.
 //  4. A new entry is a false new entry when its world line was detected (some detection
 //     associated to it) in one of the previous `look_back` frames (20).
 //  5. Rates are fractions of (matches + false new entries): correct + false matches + false
@@ -83,8 +90,9 @@ struct TrackingEvaluation {
   TrackingCounts total;
   std::int64_t detections = 0;
   std::int64_t associated_detections = 0;
-  std::int64_t duplicate_ids = 0;  // detections sharing a track id with another in one frame
-  std::int64_t long_lines = 0;     // ground-truth rows of long lines
+  std::int64_t ambiguous_detections = 0;  // several true lines within the tolerance
+  std::int64_t duplicate_ids = 0;         // detections sharing a track id with another in one frame
+  std::int64_t long_lines = 0;            // ground-truth rows of long lines
   std::int64_t long_lines_detected = 0;
   double long_line_recall() const {
     return long_lines > 0 ? static_cast<double>(long_lines_detected) / long_lines : 0.0;
