@@ -65,10 +65,14 @@ Matcher::DistanceView Matcher::compute_distances(const ConstDescriptors& query,
   cols_ = candidates.rows();
   // Grow the work space only when a larger problem arrives (no allocation in steady state).
   if (distances_.rows() < rows_ || distances_.cols() < cols_) {
-    distances_.resize(std::max(distances_.rows(), rows_), std::max(distances_.cols(), cols_));
+    // Generous steps (at least 64, then doubling) so that growth stops after a few frames.
+    auto grow = [](Eigen::Index have, Eigen::Index need) {
+      return have >= need ? have : std::max<Eigen::Index>({need, 2 * have, 64});
+    };
+    distances_.resize(grow(distances_.rows(), rows_), grow(distances_.cols(), cols_));
   }
-  if (query_norms_.size() < rows_) query_norms_.resize(rows_);
-  if (candidate_norms_.size() < cols_) candidate_norms_.resize(cols_);
+  if (query_norms_.size() < rows_) query_norms_.resize(distances_.rows());
+  if (candidate_norms_.size() < cols_) candidate_norms_.resize(distances_.cols());
   if (rows_ == 0 || cols_ == 0) return last_distances();
 
   // Eq. (6) as |a - b|^2 = |a|^2 + |b|^2 - 2 a.b: one matrix product for all pairs.

@@ -1,11 +1,23 @@
 #include "omnivert/match/tracker.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cassert>
 #include <limits>
 #include <sstream>
 
 namespace omnivert {
+namespace {
+
+// Capacity for a frame of n lines: at least 64 (frames have 20-40 lines), else the next power
+// of two, so that buffers reach their final size after a few frames and then stay.
+Eigen::Index line_capacity(Eigen::Index n) {
+  return std::max<Eigen::Index>(64,
+                                static_cast<Eigen::Index>(std::bit_ceil(
+                                    static_cast<std::size_t>(std::max<Eigen::Index>(n, 1)))));
+}
+
+}  // namespace
 
 bool TrackerOptions::IsValid(std::string* error) const {
   if (!match.IsValid(error)) return false;
@@ -58,6 +70,12 @@ void Tracker::add_frame(const FrameFeatures& frame,
   }
   out->assign(static_cast<std::size_t>(n), TrackAssignment{});
   claimed_.clear();
+  if (static_cast<Eigen::Index>(unmatched_.capacity()) < n) {
+    const auto cap = static_cast<std::size_t>(line_capacity(n));
+    unmatched_.reserve(cap);
+    still_unmatched_.reserve(cap);
+    claimed_.reserve(cap);
+  }
   unmatched_.resize(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) unmatched_[static_cast<std::size_t>(i)] = i;
 
@@ -74,7 +92,8 @@ void Tracker::add_frame(const FrameFeatures& frame,
       matcher_.match(frame.descriptors, candidates, &results_);
     } else {
       if (query_.rows() < nq || query_.cols() != frame.descriptors.cols()) {
-        query_.resize(std::max<Eigen::Index>(query_.rows(), nq), frame.descriptors.cols());
+        query_.resize(line_capacity(std::max<Eigen::Index>(query_.rows(), nq)),
+                      frame.descriptors.cols());
       }
       for (int q = 0; q < nq; ++q) {
         query_.row(q) = frame.descriptors.row(unmatched_[static_cast<std::size_t>(q)]);
@@ -175,7 +194,10 @@ void Tracker::store_frame(const FrameFeatures& frame, const std::vector<TrackAss
   const int n = static_cast<int>(frame.lines.size());
   const Eigen::Index cols = frame.descriptors.cols();
   if (slot.descriptors.rows() < n || slot.descriptors.cols() != cols) {
-    slot.descriptors.resize(std::max<Eigen::Index>(slot.descriptors.rows(), n), cols);
+    slot.descriptors.resize(line_capacity(std::max<Eigen::Index>(slot.descriptors.rows(), n)),
+                            cols);
+    slot.bearings.reserve(static_cast<std::size_t>(slot.descriptors.rows()));
+    slot.track_ids.reserve(static_cast<std::size_t>(slot.descriptors.rows()));
   }
   if (n > 0) slot.descriptors.topRows(n) = frame.descriptors;
   slot.bearings.resize(static_cast<std::size_t>(n));
