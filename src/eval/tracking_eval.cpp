@@ -8,6 +8,8 @@
 #include <map>
 #include <unordered_map>
 
+#include "omnivert/core/error.hpp"
+
 namespace omnivert {
 
 bool TrackingEvalOptions::IsValid(std::string* error) const {
@@ -47,8 +49,7 @@ TrackingEvaluation evaluate_tracking(const std::vector<TrackRow>& tracks,
                                      const std::vector<GroundTruthLine>& ground_truth,
                                      const TrackingEvalOptions& options) {
   std::string error;
-  (void)error;
-  assert(options.IsValid(&error));
+  if (!options.IsValid(&error)) throw InputError("evaluation options: " + error);
   TrackingEvaluation ev;
 
   std::int64_t num_frames = options.num_frames;

@@ -6,6 +6,8 @@
 #include <limits>
 #include <sstream>
 
+#include "omnivert/core/error.hpp"
+
 namespace omnivert {
 namespace {
 
@@ -39,9 +41,9 @@ std::string TrackerStats::BriefReport() const {
 }
 
 Tracker::Tracker(TrackerOptions options) : options_(options), matcher_(options.match) {
+  // Options usually come from the user (flags, config): report, do not crash.
   std::string error;
-  (void)error;
-  assert(options_.IsValid(&error));
+  if (!options_.IsValid(&error)) throw InputError("tracker options: " + error);
   ring_.resize(static_cast<std::size_t>(options_.look_back));
 }
 

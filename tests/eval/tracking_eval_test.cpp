@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "omnivert/core/error.hpp"
+
 namespace omnivert {
 namespace {
 
@@ -208,6 +210,16 @@ TEST(TrackingEval, EmptyInputs) {
   EXPECT_EQ(ev.long_line_recall(), 0.0);
   EXPECT_FALSE(std::isnan(ev.bearing_rms));
   EXPECT_NE(format_tracking_table(ev).find("Total"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace omnivert
+
+namespace omnivert {
+namespace {
+
+TEST(TrackingEval, InvalidOptionsThrowInputError) {
+  EXPECT_THROW(evaluate_tracking({}, {}, TrackingEvalOptions{}), InputError);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "omnivert/core/angles.hpp"
+#include "omnivert/core/error.hpp"
 
 namespace omnivert {
 namespace {
@@ -440,6 +441,26 @@ TEST(Tracker, OdometryGateRejectsImpossibleBearingJump) {
     } else {
       EXPECT_EQ(out1[2].track_id, out0[2].track_id);
     }
+  }
+}
+
+}  // namespace
+}  // namespace omnivert
+
+namespace omnivert {
+namespace {
+
+TEST(Tracker, InvalidOptionsThrowInputError) {
+  TrackerOptions o;
+  o.look_back = 0;
+  EXPECT_THROW(Tracker{o}, InputError);
+  o = {};
+  o.gate.enabled = true;  // no wheel base
+  try {
+    Tracker t(o);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("wheel base"), std::string::npos);
   }
 }
 

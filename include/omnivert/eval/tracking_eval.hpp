@@ -100,8 +100,8 @@ struct TrackingEvaluation {
   double bearing_rms = 0.0;  // radians, over associated detections
 };
 
-// Evaluates `tracks` against `ground_truth`. Options must be valid (asserted; check with
-// IsValid and report the error to the user).
+// Evaluates `tracks` against `ground_truth`. Throws InputError with the reason when the
+// options are not valid (e.g. the annulus is missing).
 TrackingEvaluation evaluate_tracking(const std::vector<TrackRow>& tracks,
                                      const std::vector<GroundTruthLine>& ground_truth,
                                      const TrackingEvalOptions& options);

@@ -75,7 +75,7 @@ struct TrackerStats {
 
 class Tracker {
  public:
-  // Options must be valid (check with TrackerOptions::IsValid; asserted).
+  // Throws InputError with the reason when the options are not valid (TrackerOptions::IsValid).
   explicit Tracker(TrackerOptions options);
 
   // Processes the next frame. `since_previous` is the wheel travel from the previous frame
