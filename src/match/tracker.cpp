@@ -30,6 +30,18 @@ bool TrackerOptions::IsValid(std::string* error) const {
   return gate.IsValid(error);
 }
 
+TrackerOptions paper_tracker_options() { return TrackerOptions{}; }
+
+TrackerOptions recommended_tracker_options(double wheel_base) {
+  TrackerOptions o;
+  o.mutual = true;
+  if (wheel_base > 0.0) {
+    o.gate.enabled = true;
+    o.gate.wheel_base = wheel_base;
+  }
+  return o;
+}
+
 std::string TrackerStats::BriefReport() const {
   std::ostringstream s;
   s << frames << " frames, " << lines << " lines: " << matched_previous

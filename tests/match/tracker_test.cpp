@@ -450,6 +450,25 @@ TEST(Tracker, OdometryGateRejectsImpossibleBearingJump) {
 namespace omnivert {
 namespace {
 
+TEST(TrackerOptions, PaperAndRecommended) {
+  const TrackerOptions p = paper_tracker_options();
+  EXPECT_EQ(p.look_back, 20);
+  EXPECT_DOUBLE_EQ(p.match.f1, 1.05);
+  EXPECT_DOUBLE_EQ(p.match.f2, 0.75);
+  EXPECT_DOUBLE_EQ(p.match.f3, 0.8);
+  EXPECT_FALSE(p.mutual);
+  EXPECT_FALSE(p.gate.enabled);
+  std::string error;
+  const TrackerOptions r = recommended_tracker_options(0.45);
+  EXPECT_TRUE(r.IsValid(&error)) << error;
+  EXPECT_TRUE(r.mutual);
+  EXPECT_TRUE(r.gate.enabled);
+  EXPECT_DOUBLE_EQ(r.gate.wheel_base, 0.45);
+  const TrackerOptions no_odometry = recommended_tracker_options(0.0);
+  EXPECT_TRUE(no_odometry.IsValid(&error));
+  EXPECT_FALSE(no_odometry.gate.enabled);
+}
+
 TEST(Tracker, InvalidOptionsThrowInputError) {
   TrackerOptions o;
   o.look_back = 0;
