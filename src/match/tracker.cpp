@@ -5,6 +5,7 @@
 #include <cassert>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
 
 #include "omnivert/core/error.hpp"
 
@@ -78,7 +79,17 @@ void Tracker::add_frame(const FrameFeatures& frame,
                         const WheelIncrement& since_previous,
                         std::vector<TrackAssignment>* out) {
   const int n = static_cast<int>(frame.lines.size());
-  assert(frame.descriptors.rows() == n);
+  // Contract: one descriptor row per line, one width for the whole run.
+  if (frame.descriptors.rows() != n) {
+    throw std::invalid_argument("Tracker::add_frame: " + std::to_string(n) + " lines but " +
+                                std::to_string(frame.descriptors.rows()) + " descriptor rows");
+  }
+  if (n > 0 && descriptor_width_ > 0 && frame.descriptors.cols() != descriptor_width_) {
+    throw std::invalid_argument("Tracker::add_frame: descriptor width changed from " +
+                                std::to_string(descriptor_width_) + " to " +
+                                std::to_string(frame.descriptors.cols()));
+  }
+  if (n > 0) descriptor_width_ = frame.descriptors.cols();
   if (frame_count_ > 0 && options_.gate.enabled) {
     odometry_.add(since_previous, options_.gate.wheel_base);
   }

@@ -5,6 +5,7 @@
 #include <map>
 #include <random>
 #include <set>
+#include <stdexcept>
 
 #include <gtest/gtest.h>
 
@@ -467,6 +468,19 @@ TEST(TrackerOptions, PaperAndRecommended) {
   const TrackerOptions no_odometry = recommended_tracker_options(0.0);
   EXPECT_TRUE(no_odometry.IsValid(&error));
   EXPECT_FALSE(no_odometry.gate.enabled);
+}
+
+TEST(Tracker, BrokenFrameContractThrows) {
+  Tracker t{TrackerOptions{}};
+  std::vector<TrackAssignment> out;
+  FrameFeatures f;
+  f.lines.resize(3);
+  f.descriptors = DescriptorMatrix::Zero(2, 192);
+  EXPECT_THROW(t.add_frame(f, &out), std::invalid_argument);
+  f.descriptors = DescriptorMatrix::Zero(3, 192);
+  t.add_frame(f, &out);
+  f.descriptors = DescriptorMatrix::Zero(3, 96);
+  EXPECT_THROW(t.add_frame(f, &out), std::invalid_argument);
 }
 
 TEST(Tracker, InvalidOptionsThrowInputError) {

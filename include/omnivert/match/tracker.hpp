@@ -88,7 +88,8 @@ class Tracker {
   // Processes the next frame. `since_previous` is the wheel travel from the previous frame
   // to this one (ignored for the first frame and when the gate is off). A frame that could
   // not be read should still be passed, with no lines, so that frame counts and odometry
-  // stay right. `out` is resized to the number of lines, in line order.
+  // stay right. `out` is resized to the number of lines, in line order. Throws
+  // std::invalid_argument when the descriptors do not have one row per line or change width.
   void add_frame(const FrameFeatures& frame,
                  const WheelIncrement& since_previous,
                  std::vector<TrackAssignment>* out);
@@ -120,6 +121,7 @@ class Tracker {
   std::int64_t frame_count_ = 0;
   std::int64_t next_track_id_ = 0;
   OdometryAccumulator odometry_;
+  Eigen::Index descriptor_width_ = 0;
   TrackerStats stats_;
   // Per-frame work space.
   std::vector<int> unmatched_;
