@@ -128,18 +128,30 @@ cv::Mat draw_tracks(const std::vector<TrackRow>& rows, const TrackPlotOptions& o
     });
     const cv::Scalar c = track_colour(id);
     for (std::size_t k = 1; k < dets.size(); ++k) {
-      // Predecessor: the detection it was matched to when known, else the previous one.
+      // Predecessor (as in evaluate_tracking): among the track's detections in the frame it
+      // was matched to (else its latest earlier frame), the nearest in bearing.
       const TrackRow* b = dets[k];
-      const TrackRow* a = dets[k - 1];
-      if (b->matched_frame >= 0) {
+      std::int64_t pred_frame = -1;
+      for (std::size_t m = k; m-- > 0;) {
+        if (dets[m]->frame == b->matched_frame) pred_frame = b->matched_frame;
+      }
+      if (pred_frame < 0) {
         for (std::size_t m = k; m-- > 0;) {
-          if (dets[m]->frame == b->matched_frame) {
-            a = dets[m];
+          if (dets[m]->frame < b->frame) {
+            pred_frame = dets[m]->frame;
             break;
           }
         }
       }
-      if (a->frame == b->frame) continue;
+      if (pred_frame < 0) continue;
+      const TrackRow* a = nullptr;
+      for (std::size_t m = k; m-- > 0;) {
+        if (dets[m]->frame != pred_frame) continue;
+        if (!a || std::abs(angle_diff(dets[m]->bearing, b->bearing)) <
+                      std::abs(angle_diff(a->bearing, b->bearing))) {
+          a = dets[m];
+        }
+      }
       const double d = angle_diff(b->bearing, a->bearing);  // the short way round
       const double xa = px(static_cast<double>(a->frame)) + ox;
       const double xb = px(static_cast<double>(b->frame)) + ox;
