@@ -307,6 +307,12 @@ TEST(Tracker, MutualTrackClaimedOnceAcrossLookBack) {
   for (const auto& a : out) EXPECT_TRUE(ids.insert(a.track_id).second) << "duplicate id";
 }
 
+TEST(BearingGate, IncrementFromCumulativeTravel) {
+  const WheelIncrement inc = increment_between(1.0, 2.0, 1.25, 2.5);
+  EXPECT_DOUBLE_EQ(inc.d_left, 0.25);
+  EXPECT_DOUBLE_EQ(inc.d_right, 0.5);
+}
+
 TEST(BearingGate, PureRotationAndTranslationBounds) {
   OdometryGateOptions o;
   o.enabled = true;

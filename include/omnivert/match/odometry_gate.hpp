@@ -33,6 +33,15 @@ struct WheelIncrement {
   double d_left = 0.0;
 };
 
+// The increment between two frames from the cumulative wheel travel at their timestamps (as
+// the dataset reader gives it, wheel0/data.csv: `left [m], right [m]`, cumulative).
+inline WheelIncrement increment_between(double left_before,
+                                        double right_before,
+                                        double left_after,
+                                        double right_after) {
+  return WheelIncrement{right_after - right_before, left_after - left_before};
+}
+
 struct OdometryGateOptions {
   bool enabled = false;
   double wheel_base = 0.0;            // e, metres (required when enabled)
