@@ -71,7 +71,9 @@ bool Tracker::track_claimed(std::int64_t id) const {
 }
 
 void Tracker::add_frame(const FrameFeatures& frame, std::vector<TrackAssignment>* out) {
-  assert(!options_.gate.enabled && "the odometry gate needs wheel increments");
+  if (options_.gate.enabled) {
+    throw std::invalid_argument("Tracker::add_frame: the odometry gate needs wheel increments");
+  }
   add_frame(frame, WheelIncrement{}, out);
 }
 

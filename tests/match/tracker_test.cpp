@@ -487,6 +487,10 @@ TEST(Tracker, BrokenFrameContractThrows) {
   t.add_frame(f, &out);
   f.descriptors = DescriptorMatrix::Zero(3, 96);
   EXPECT_THROW(t.add_frame(f, &out), std::invalid_argument);
+  Tracker gated{recommended_tracker_options(0.5)};
+  f.descriptors = DescriptorMatrix::Zero(3, 192);
+  EXPECT_THROW(gated.add_frame(f, &out), std::invalid_argument);  // no wheel increment
+  gated.add_frame(f, WheelIncrement{}, &out);
 }
 
 TEST(Tracker, InvalidOptionsThrowInputError) {

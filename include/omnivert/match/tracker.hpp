@@ -93,7 +93,7 @@ class Tracker {
   void add_frame(const FrameFeatures& frame,
                  const WheelIncrement& since_previous,
                  std::vector<TrackAssignment>* out);
-  // Same, without odometry (the gate must be off).
+  // Same, without odometry (the gate must be off; std::invalid_argument otherwise).
   void add_frame(const FrameFeatures& frame, std::vector<TrackAssignment>* out);
 
   const TrackerOptions& options() const { return options_; }
