@@ -10,7 +10,7 @@
 #include <system_error>
 #include <unordered_map>
 
-#include "atomic_write.hpp"
+#include "omnivert/core/image_io.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
 
@@ -103,7 +103,7 @@ void write_tracks_csv(const fs::path& path, const std::vector<TrackRow>& rows) {
                                 r.distance);
     out.append(buf, static_cast<std::size_t>(n));
   }
-  detail::write_atomically(path, out);
+  write_text_atomic(path.string(), out);
 }
 
 std::vector<TrackRow> read_tracks_csv(const fs::path& path) {

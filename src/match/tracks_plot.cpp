@@ -8,7 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "atomic_write.hpp"
+#include "omnivert/core/image_io.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
 
@@ -197,10 +197,7 @@ cv::Mat draw_tracks(const std::vector<TrackRow>& rows, const TrackPlotOptions& o
 void write_tracks_png(const fs::path& path,
                       const std::vector<TrackRow>& rows,
                       const TrackPlotOptions& options) {
-  const cv::Mat img = draw_tracks(rows, options);
-  std::vector<uchar> buf;
-  if (!cv::imencode(".png", img, buf)) throw InputError(path.string(), 0, "PNG encoding failed");
-  detail::write_atomically(path, std::string(buf.begin(), buf.end()));
+  write_image_atomic(path.string(), draw_tracks(rows, options));
 }
 
 }  // namespace omnivert
