@@ -19,6 +19,7 @@ struct CommandExit {
   int code;
 };
 
-
+// omnivert simulate: render a dataset with ground truth (tools/cmd_simulate.cpp).
+void add_simulate_command(CLI::App& app);
 
 }  // namespace omnivert::cli

@@ -17,7 +17,7 @@ int main(int argc, char** argv) {
   bool verbose = false;
   app.add_flag("-v,--verbose", verbose, "More log output");
   app.set_version_flag("--version", "omnivert 0.1.0");
-
+  omnivert::cli::add_simulate_command(app);
 
   try {
     app.parse(argc, argv);
