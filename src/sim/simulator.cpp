@@ -75,9 +75,10 @@ void write_dataset(const World& world,
   // timestamp falls between two wheel samples), then every 1/rate.
   const std::int64_t frame_step_ns = std::llround(1e9 / cfg.frame_rate);
   const std::int64_t first_offset_ns = 10'000'000;
+  // The last frame is at or after the end of the motion, so that it shows the final pose.
   int n_frames = static_cast<int>(
-                     std::floor((t_motion * 1e9 - static_cast<double>(first_offset_ns)) /
-                                static_cast<double>(frame_step_ns))) +
+                     std::ceil((t_motion * 1e9 - static_cast<double>(first_offset_ns)) /
+                               static_cast<double>(frame_step_ns))) +
                  1;
   n_frames = std::max(n_frames, 1);
   if (cfg.max_frames > 0) n_frames = std::min(n_frames, cfg.max_frames);
