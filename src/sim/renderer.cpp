@@ -118,8 +118,7 @@ cv::Mat1f Renderer::render(const CameraPose& pose) const {
   return img;
 }
 
-void Renderer::render(const CameraPose& pose, cv::Mat1f& image) const {
-  FrameState f;
+void Renderer::setup_walls(const CameraPose& pose, FrameState& f) const {
   f.cx = pose.x;
   f.cy = pose.y;
   f.hc = pose.height;
@@ -138,6 +137,12 @@ void Renderer::render(const CameraPose& pose, cv::Mat1f& image) const {
     f.uy[i] = w.to.y() - w.from.y();
     f.len[i] = w.length();
   }
+}
+
+void Renderer::render(const CameraPose& pose, cv::Mat1f& image) const {
+  FrameState f;
+  setup_walls(pose, f);
+  const std::size_t nw = world_.walls.size();
   // Edge azimuths: the only places where the walls met by a ray, or a wall's texture,
   // change discontinuously.
   f.disc.reserve(edges_.size() + 2);
@@ -181,8 +186,6 @@ void Renderer::render(const CameraPose& pose, cv::Mat1f& image) const {
   background_.copyTo(image);
   float* out = image.ptr<float>();
   const double cyaw = std::cos(pose.yaw), syaw = std::sin(pose.yaw);
-  const double s = camera_.bearing_sign;
-  (void)s;
   for (std::size_t k = 0; k < px_index_.size(); ++k) {
     const double halfw = px_halfw_[k];
     const double az = pose.yaw + px_beta_[k];
@@ -226,11 +229,22 @@ float Renderer::shade(const FrameState& f,
                       double tan_el,
                       double dtan,
                       double halfw) const {
+  const int* hits = f.hits.data();
+  return shade_hits(f, hits + f.hit_offset[static_cast<std::size_t>(interval)],
+                    hits + f.hit_offset[static_cast<std::size_t>(interval) + 1], dx, dy, tan_el, dtan, halfw);
+}
+
+float Renderer::shade_hits(const FrameState& f,
+                           const int* h0,
+                           const int* h1,
+                           double dx,
+                           double dy,
+                           double tan_el,
+                           double dtan,
+                           double halfw) const {
   double acc = 0.0, remaining = 1.0;
-  const int h0 = f.hit_offset[static_cast<std::size_t>(interval)];
-  const int h1 = f.hit_offset[static_cast<std::size_t>(interval) + 1];
-  for (int h = h0; h < h1 && remaining > 1e-4; ++h) {
-    const int w = f.hits[static_cast<std::size_t>(h)];
+  for (const int* h = h0; h < h1 && remaining > 1e-4; ++h) {
+    const int w = *h;
     const double den = cross(dx, dy, f.ux[w], f.uy[w]);
     if (std::abs(den) < 1e-14) continue;
     const double t = cross(f.qx[w], f.qy[w], f.ux[w], f.uy[w]) / den;
@@ -241,7 +255,10 @@ float Renderer::shade(const FrameState& f,
     const double cov =
         coverage(z, dz, std::max(wall.z0, 0.0), std::min(wall_top_[static_cast<std::size_t>(w)], world_.height));
     if (cov <= 0.0) continue;
-    acc += remaining * cov * wall_texture(w, sigma * f.len[w], z, dz);
+    // Footprint along the wall: the tangential footprint t * 2 halfw, stretched by the
+    // incidence (|den| / len is the sine of the angle between ray and wall).
+    const double ds = std::min(t * 2.0 * halfw * f.len[w] / std::abs(den), 1.0);
+    acc += remaining * cov * wall_texture(w, sigma * f.len[w], z, ds, dz);
     remaining *= 1.0 - cov;
   }
   if (remaining > 1e-4) {
@@ -260,7 +277,7 @@ float Renderer::shade(const FrameState& f,
   return static_cast<float>(acc);
 }
 
-float Renderer::wall_texture(int wi, double s, double z, double dz) const {
+float Renderer::wall_texture(int wi, double s, double z, double ds, double dz) const {
   const Wall& w = world_.walls[static_cast<std::size_t>(wi)];
   double v = w.intensity;
   for (const Strip& st : w.strips) {
@@ -282,9 +299,11 @@ float Renderer::wall_texture(int wi, double s, double z, double dz) const {
         break;
       }
       case Pattern::kWave: {
-        const double q = deg2rad(p.angle_deg);
-        pv += p.amplitude *
-              std::sin(kTwoPi * ((s - p.s0) * std::cos(q) + (z - p.z0) * std::sin(q)) / p.period);
+        // Box-filtered over the footprint: the sine's amplitude times sinc(width / period).
+        const double q = deg2rad(p.angle_deg), cq = std::cos(q), sq = std::sin(q);
+        const double x = kPi * std::hypot(ds * cq, dz * sq) / p.period;
+        const double att = x < 1e-6 ? 1.0 : std::sin(x) / x;
+        pv += att * p.amplitude * std::sin(kTwoPi * ((s - p.s0) * cq + (z - p.z0) * sq) / p.period);
         break;
       }
       case Pattern::kFlat:
@@ -326,6 +345,42 @@ float Renderer::plane_texture(const Plane& p, double x, double y, double footpri
   if (wy > 0) v += (1 - wx) * wy * tile(ix, iy + sy);
   if (wx > 0 && wy > 0) v += wx * wy * tile(ix + sx, iy + sy);
   return static_cast<float>(v);
+}
+
+void Renderer::render_reference(const CameraPose& pose, int samples, cv::Mat1f& image) const {
+  FrameState f;
+  setup_walls(pose, f);
+  background_.copyTo(image);
+  float* out = image.ptr<float>();
+  std::vector<std::pair<double, int>> tmp;
+  std::vector<int> hits;
+  for (std::size_t k = 0; k < px_index_.size(); ++k) {
+    const double halfw = px_halfw_[k];
+    const double az0 = pose.yaw + px_beta_[k] - halfw;
+    double value = 0.0;
+    for (int q = 0; q < samples; ++q) {
+      const double az = az0 + (q + 0.5) * (2.0 * halfw / samples);
+      const double dx = std::cos(az), dy = std::sin(az);
+      // Every wall, nearest first.
+      tmp.clear();
+      for (std::size_t w = 0; w < world_.walls.size(); ++w) {
+        const double den = cross(dx, dy, f.ux[w], f.uy[w]);
+        if (std::abs(den) < 1e-14) continue;
+        const double t = cross(f.qx[w], f.qy[w], f.ux[w], f.uy[w]) / den;
+        const double sigma = cross(f.qx[w], f.qy[w], dx, dy) / den;
+        if (t > 1e-9 && sigma >= 0.0 && sigma <= 1.0) tmp.emplace_back(t, static_cast<int>(w));
+      }
+      std::sort(tmp.begin(), tmp.end());
+      hits.clear();
+      for (const auto& h : tmp) hits.push_back(h.second);
+      // Texture filters use the sub-sample's own footprint.
+      value += shade_hits(f, hits.data(), hits.data() + hits.size(), dx, dy, px_tan_[k], px_dtan_[k],
+                          halfw / samples);
+    }
+    const int idx = px_index_[k];
+    const float w = px_weight_[k];
+    out[idx] = w * static_cast<float>(value / samples) + (1.0f - w) * out[idx];
+  }
 }
 
 std::vector<VisibleLine> Renderer::visible_lines(const CameraPose& pose, double min_length_px) const {

@@ -48,6 +48,11 @@ class Renderer {
   void render(const CameraPose& pose, cv::Mat1f& image) const;
   cv::Mat1f render(const CameraPose& pose) const;
 
+  // The plain reference for tests and benchmarks: every pixel casts `samples` rays spread
+  // over its azimuthal footprint against every wall (no edge intervals, no analytic
+  // coverage). Same textures. Slow.
+  void render_reference(const CameraPose& pose, int samples, cv::Mat1f& image) const;
+
   // The vertical edges visible from `pose`, occlusion by nearer walls considered, each with
   // the part of it inside the valid annulus; only edges with at least `min_length_px`
   // visible radial pixels.
@@ -70,7 +75,16 @@ class Renderer {
               double tan_el,
               double dtan,
               double halfw) const;
-  float wall_texture(int wall, double s, double z, double dz) const;
+  float shade_hits(const FrameState& f,
+                   const int* hits_begin,
+                   const int* hits_end,
+                   double dx,
+                   double dy,
+                   double tan_el,
+                   double dtan,
+                   double halfw) const;
+  void setup_walls(const CameraPose& pose, FrameState& f) const;
+  float wall_texture(int wall, double s, double z, double ds, double dz) const;
   float plane_texture(const Plane& p, double x, double y, double footprint, bool ceiling) const;
 
   CatadioptricCamera camera_;
