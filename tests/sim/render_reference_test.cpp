@@ -2,6 +2,7 @@
 // reference (every pixel casts 32 rays over its footprint against every wall), on frames of
 // each preset world: occlusion, partial-height walls and textures must agree.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -42,6 +43,45 @@ TEST(RenderReference, FastRendererMatchesPlainRayCasting) {
     const int pixels = cam.width * cam.height;
     EXPECT_LT(mean, 0.15) << name;
     EXPECT_LT(big, pixels / 1000) << name;
+  }
+}
+
+float bilinear(const cv::Mat1f& m, double x, double y) {
+  const int u = static_cast<int>(std::floor(x)), v = static_cast<int>(std::floor(y));
+  const double fx = x - u, fy = y - v;
+  return static_cast<float>((1 - fy) * ((1 - fx) * m(v, u) + fx * m(v, u + 1)) +
+                            fy * ((1 - fx) * m(v + 1, u) + fx * m(v + 1, u + 1)));
+}
+
+// Every ground-truth line is an edge the image shows: along its visible extent, the median
+// intensity step across it (3 px apart) is at least 5 grey levels for nearly all lines.
+// (Lines hidden by occlusion but listed, or listed at a wrong place, would fail this.)
+TEST(GroundTruthLines, EveryListedLineShowsAsAnEdge) {
+  const CatadioptricCamera cam;
+  for (const std::string name : {"corridor", "office", "hall"}) {
+    const World w = world_preset(name);
+    const Renderer r(cam, w);
+    const auto motion = load_trajectory("paper").pieces(w.start);
+    int total = 0, weak = 0;
+    for (double t : {0.0, 10.0, 20.0, 25.0}) {
+      const CameraPose pose = camera_pose(pose_at(motion, t), Extrinsics{}, 0.9);
+      const cv::Mat1f img = r.render(pose);
+      for (const VisibleLine& l : r.visible_lines(pose)) {
+        std::vector<double> steps;
+        const double ca = std::cos(l.bearing), sa = std::sin(l.bearing);
+        for (double rr = l.r_inner + 2; rr <= l.r_outer - 2; rr += 1.0) {
+          const double x = cam.cx + rr * ca, y = cam.cy + rr * sa;
+          steps.push_back(std::abs(bilinear(img, x - 1.5 * sa, y + 1.5 * ca) - bilinear(img, x + 1.5 * sa, y - 1.5 * ca)));
+        }
+        if (steps.empty()) continue;
+        std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
+        ++total;
+        if (steps[steps.size() / 2] < 5.0) ++weak;
+      }
+    }
+    std::printf("%s: %d ground-truth lines in 4 frames, %d without a visible step\n", name.c_str(), total, weak);
+    EXPECT_GT(total, 200) << name;
+    EXPECT_LT(weak, total * 3 / 100) << name;
   }
 }
 
