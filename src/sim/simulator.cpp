@@ -61,6 +61,37 @@ std::string fmt(const char* format, double v) {
   return buf;
 }
 
+}  // namespace
+
+std::string free_space_violation(const World& world,
+                                 const std::vector<MotionPiece>& motion,
+                                 double t_end,
+                                 double clearance) {
+  for (double t = 0.0; t <= t_end + 1e-9; t += 0.02) {
+    const Pose2 p = pose_at(motion, t);
+    for (std::size_t i = 0; i < world.walls.size(); ++i) {
+      const Wall& w = world.walls[i];
+      if (distance_to_segment(p.head<2>(), w.from, w.to) < clearance) {
+        char where[200];
+        std::snprintf(where,
+                      sizeof where,
+                      "at t = %.2f s the robot (x = %.2f, y = %.2f) comes within %.2f m of wall %zu "
+                      "of world '%s'",
+                      t,
+                      p.x(),
+                      p.y(),
+                      clearance,
+                      i + 1,
+                      world.name.c_str());
+        return where;
+      }
+    }
+  }
+  return {};
+}
+
+namespace {
+
 void write_dataset(const World& world,
                    const Trajectory& trajectory,
                    const SimConfig& cfg,
@@ -88,26 +119,9 @@ void write_dataset(const World& world,
   const double t_last = frame_time(n_frames - 1);
 
   // The robot must stay in the free space of the world.
-  for (double t = 0.0; t <= t_last + 1e-9; t += 0.02) {
-    const Pose2 p = pose_at(motion, t);
-    for (std::size_t i = 0; i < world.walls.size(); ++i) {
-      const Wall& w = world.walls[i];
-      if (distance_to_segment(p.head<2>(), w.from, w.to) < cfg.min_clearance) {
-        char where[160];
-        std::snprintf(where,
-                      sizeof where,
-                      "at t = %.2f s the robot (x = %.2f, y = %.2f) comes within %.2f m of wall %zu "
-                      "of world '%s'",
-                      t,
-                      p.x(),
-                      p.y(),
-                      cfg.min_clearance,
-                      i + 1,
-                      world.name.c_str());
-        throw InputError("trajectory '" + trajectory.name + "' leaves the free space: " + where +
-                         "; give the trajectory a 'start' or choose another world");
-      }
-    }
+  if (const std::string p = free_space_violation(world, motion, t_last, cfg.min_clearance); !p.empty()) {
+    throw InputError("trajectory '" + trajectory.name + "' leaves the free space: " + p +
+                     "; give the trajectory a 'start' or choose another world");
   }
 
   fs::create_directories(dir / "cam0" / "data");

@@ -121,6 +121,16 @@ TEST_F(SimulatorTest, WheelTravelIntegratesToTheGroundTruthPoses) {
   }
 }
 
+TEST(Presets, EveryTrajectoryPresetFitsEveryWorldPreset) {
+  for (const std::string& wn : world_presets()) {
+    const World w = world_preset(wn);
+    for (const std::string& tn : trajectory_presets()) {
+      const auto motion = load_trajectory(tn).pieces(w.start);
+      EXPECT_EQ(free_space_violation(w, motion, duration(motion), 0.25), "") << wn << " " << tn;
+    }
+  }
+}
+
 TEST_F(SimulatorTest, SameSeedSameDataDifferentSeedDifferentNoise) {
   SimConfig cfg;
   cfg.max_frames = 3;

@@ -48,6 +48,13 @@ struct SimConfig {
 // The camera pose for a robot pose (NOTES Sec. 1).
 CameraPose camera_pose(const Pose2& robot, const Extrinsics& x, double camera_height);
 
+// Empty if the robot centre keeps `clearance` from every wall over [0, t_end] (sampled every
+// 20 ms); else where and which wall it comes too close to.
+std::string free_space_violation(const World& world,
+                                 const std::vector<MotionPiece>& motion,
+                                 double t_end,
+                                 double clearance);
+
 struct SimSummary {
   int frames = 0;
   int wheel_samples = 0;
