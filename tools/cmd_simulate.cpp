@@ -19,6 +19,8 @@ void add_simulate_command(CLI::App& app) {
     bool force = false;
     sim::SimConfig cfg;
     std::string wheel_unit = "meters";
+    std::vector<double> center;
+    std::vector<double> ticks_per_meter;
   };
   auto opt = std::make_shared<Options>();
   sim::SimConfig& c = opt->cfg;
@@ -36,11 +38,8 @@ void add_simulate_command(CLI::App& app) {
   // Camera and mounting.
   cmd->add_option("--width", c.camera.width, "Image width [px]")->capture_default_str();
   cmd->add_option("--height", c.camera.height, "Image height [px]")->capture_default_str();
-  cmd->add_option("--center", [&c](const CLI::results_t& r) {
-      c.camera.cx = std::stod(r[0]);
-      c.camera.cy = std::stod(r[1]);
-      return true;
-    }, "Mirror centre cx cy [px]")->expected(2);
+  cmd->add_option("--center", opt->center, "Mirror centre cx cy [px] (default 321.37 238.81)")
+      ->expected(2);
   cmd->add_option("--xi", c.camera.xi, "Unified model mirror parameter xi")->capture_default_str();
   cmd->add_option("--gamma", c.camera.gamma, "Unified model focal length gamma [px]")->capture_default_str();
   cmd->add_option("--r-min", c.camera.r_min, "Valid annulus inner radius [px]")->capture_default_str();
@@ -64,11 +63,10 @@ void add_simulate_command(CLI::App& app) {
                   "True wheel base = nominal * (1 + this)");
   cmd->add_option("--wheel-unit", opt->wheel_unit, "meters or ticks")
       ->check(CLI::IsMember({"meters", "ticks"}))->capture_default_str();
-  cmd->add_option("--ticks-per-meter", [&c](const CLI::results_t& r) {
-      c.wheel.ticks_per_meter_left = std::stod(r[0]);
-      c.wheel.ticks_per_meter_right = std::stod(r.size() > 1 ? r[1] : r[0]);
-      return true;
-    }, "Ticks per meter (left [right])")->expected(1, 2);
+  cmd->add_option("--ticks-per-meter", opt->ticks_per_meter,
+                  "Ticks per meter, left [right] (default 20000)")
+      ->expected(1, 2)
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--counter-bits", c.wheel.counter_bits, "Tick counters wrap at 2^bits (0: never)")
       ->check(CLI::Range(0, 62));
   // Image sensor.
@@ -82,7 +80,16 @@ void add_simulate_command(CLI::App& app) {
       ->capture_default_str()->check(CLI::NonNegativeNumber);
 
   cmd->callback([opt]() {
-    opt->cfg.wheel.ticks = opt->wheel_unit == "ticks";
+    sim::SimConfig& cfg = opt->cfg;
+    cfg.wheel.ticks = opt->wheel_unit == "ticks";
+    if (opt->center.size() == 2) {
+      cfg.camera.cx = opt->center[0];
+      cfg.camera.cy = opt->center[1];
+    }
+    if (!opt->ticks_per_meter.empty()) {
+      cfg.wheel.ticks_per_meter_left = opt->ticks_per_meter.front();
+      cfg.wheel.ticks_per_meter_right = opt->ticks_per_meter.back();
+    }
     const sim::World world = sim::load_world(opt->world);
     const sim::Trajectory trajectory = sim::load_trajectory(opt->trajectory);
     std::unique_ptr<Progress> progress;
