@@ -7,9 +7,9 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include <yaml-cpp/yaml.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <yaml-cpp/yaml.h>
 
 #include "omnivert/core/error.hpp"
 #include "omnivert/core/yaml_fields.hpp"
@@ -64,7 +64,8 @@ std::vector<CsvRow> read_csv(const std::string& path,
     std::size_t start = 0;
     while (true) {
       const auto comma = t.find(',', start);
-      row.fields.push_back(trim(t.substr(start, comma == std::string::npos ? std::string::npos : comma - start)));
+      row.fields.push_back(
+          trim(t.substr(start, comma == std::string::npos ? std::string::npos : comma - start)));
       if (comma == std::string::npos) break;
       start = comma + 1;
     }
@@ -76,7 +77,8 @@ std::vector<CsvRow> read_csv(const std::string& path,
     }
     rows.push_back(std::move(row));
   }
-  if (!header_seen) throw InputError(path, 0, "file is empty (expected a '#' header line: " + what + ")");
+  if (!header_seen)
+    throw InputError(path, 0, "file is empty (expected a '#' header line: " + what + ")");
   return rows;
 }
 
@@ -85,14 +87,16 @@ std::int64_t parse_timestamp(const std::string& s, const std::string& path, int 
   const char* end = s.data() + s.size();
   const auto r = std::from_chars(s.data(), end, v);
   if (s.empty() || r.ec != std::errc() || r.ptr != end || v < 0) {
-    throw InputError(path,
-                     line,
-                     "cannot parse timestamp '" + s + "' (expected a non-negative integer in ns)");
+    throw InputError(
+        path, line, "cannot parse timestamp '" + s + "' (expected a non-negative integer in ns)");
   }
   return v;
 }
 
-double parse_double(const std::string& s, const std::string& column, const std::string& path, int line) {
+double parse_double(const std::string& s,
+                    const std::string& column,
+                    const std::string& path,
+                    int line) {
   double v = 0;
   const char* end = s.data() + s.size();
   const auto r = std::from_chars(s.data(), end, v);
@@ -113,7 +117,8 @@ int parse_int(const std::string& s, const std::string& column, const std::string
 }
 
 // Timestamps must strictly increase.
-void check_increasing(std::int64_t prev, int prev_line, std::int64_t t, const std::string& path, int line) {
+void check_increasing(
+    std::int64_t prev, int prev_line, std::int64_t t, const std::string& path, int line) {
   if (t == prev) {
     throw InputError(path,
                      line,
@@ -128,7 +133,9 @@ void check_increasing(std::int64_t prev, int prev_line, std::int64_t t, const st
   }
 }
 
-std::string rel(const std::string& root, const std::string& sub) { return (fs::path(root) / sub).string(); }
+std::string rel(const std::string& root, const std::string& sub) {
+  return (fs::path(root) / sub).string();
+}
 
 cv::Mat1b read_checked_image(const std::string& path, const CameraGeometry& cam) {
   const cv::Mat raw = cv::imread(path, cv::IMREAD_UNCHANGED);
@@ -144,8 +151,8 @@ cv::Mat1b read_checked_image(const std::string& path, const CameraGeometry& cam)
     throw InputError(path,
                      0,
                      "image is " + std::to_string(raw.cols) + "x" + std::to_string(raw.rows) +
-                         " pixels but cam0/sensor.yaml gives resolution " + std::to_string(cam.width) +
-                         "x" + std::to_string(cam.height));
+                         " pixels but cam0/sensor.yaml gives resolution " +
+                         std::to_string(cam.width) + "x" + std::to_string(cam.height));
   }
   cv::Mat1b grey;
   if (raw.channels() == 1) {
@@ -155,7 +162,8 @@ cv::Mat1b read_checked_image(const std::string& path, const CameraGeometry& cam)
   } else if (raw.channels() == 4) {
     cv::cvtColor(raw, grey, cv::COLOR_BGRA2GRAY);
   } else {
-    throw InputError(path, 0, "image has " + std::to_string(raw.channels()) + " channels; expected grey");
+    throw InputError(
+        path, 0, "image has " + std::to_string(raw.channels()) + " channels; expected grey");
   }
   return grey;
 }
@@ -165,7 +173,8 @@ WheelSensor load_wheel_sensor(const std::string& path) {
   WheelSensor s;
   s.wheel_base = yaml::required_number(root, "wheel_base", path, true);
   if (!(s.wheel_base > 0)) {
-    throw InputError(path, yaml::line_of(root["wheel_base"]), "field 'wheel_base' must be positive");
+    throw InputError(
+        path, yaml::line_of(root["wheel_base"]), "field 'wheel_base' must be positive");
   }
   const std::string unit = yaml::optional_string(root, "unit", path).value_or("meters");
   if (unit == "meters") {
@@ -173,21 +182,29 @@ WheelSensor load_wheel_sensor(const std::string& path) {
   } else if (unit == "ticks") {
     s.unit = WheelUnit::kTicks;
   } else {
-    throw InputError(path, yaml::line_of(root["unit"]), "field 'unit' must be meters or ticks, got '" + unit + "'");
+    throw InputError(path,
+                     yaml::line_of(root["unit"]),
+                     "field 'unit' must be meters or ticks, got '" + unit + "'");
   }
   if (s.unit == WheelUnit::kTicks) {
     for (const char* key : {"ticks_per_meter_left", "ticks_per_meter_right"}) {
       const double v = yaml::required_number(root, key, path, true);
-      if (!(v > 0)) throw InputError(path, yaml::line_of(root[key]), std::string("field '") + key + "' must be positive");
-      (std::string(key) == "ticks_per_meter_left" ? s.ticks_per_meter_left : s.ticks_per_meter_right) = v;
+      if (!(v > 0))
+        throw InputError(
+            path, yaml::line_of(root[key]), std::string("field '") + key + "' must be positive");
+      (std::string(key) == "ticks_per_meter_left" ? s.ticks_per_meter_left
+                                                  : s.ticks_per_meter_right) = v;
     }
   }
   if (const auto bits = yaml::optional_number(root, "counter_bits", path, true)) {
     if (*bits != std::floor(*bits) || *bits < 2 || *bits > 63) {
-      throw InputError(path, yaml::line_of(root["counter_bits"]), "field 'counter_bits' must be a whole number in 2..63");
+      throw InputError(path,
+                       yaml::line_of(root["counter_bits"]),
+                       "field 'counter_bits' must be a whole number in 2..63");
     }
     if (s.unit != WheelUnit::kTicks) {
-      throw InputError(path, yaml::line_of(root["counter_bits"]), "field 'counter_bits' needs 'unit: ticks'");
+      throw InputError(
+          path, yaml::line_of(root["counter_bits"]), "field 'counter_bits' needs 'unit: ticks'");
     }
     s.counter_bits = static_cast<int>(*bits);
   }
@@ -195,7 +212,9 @@ WheelSensor load_wheel_sensor(const std::string& path) {
   return s;
 }
 
-std::vector<WheelRecord> load_wheel_data(const std::string& path, const WheelSensor& s, double max_speed) {
+std::vector<WheelRecord> load_wheel_data(const std::string& path,
+                                         const WheelSensor& s,
+                                         double max_speed) {
   std::string header;
   const auto rows = read_csv(path, 3, "timestamp [ns], left, right", &header);
   const bool header_ticks = header.find("[ticks]") != std::string::npos;
@@ -218,10 +237,12 @@ std::vector<WheelRecord> load_wheel_data(const std::string& path, const WheelSen
     WheelRecord rec;
     rec.line = r.line;
     rec.timestamp_ns = parse_timestamp(r.fields[0], path, r.line);
-    if (i > 0) check_increasing(out.back().timestamp_ns, out.back().line, rec.timestamp_ns, path, r.line);
+    if (i > 0)
+      check_increasing(out.back().timestamp_ns, out.back().line, rec.timestamp_ns, path, r.line);
     double meters[2];
     for (int w = 0; w < 2; ++w) {
-      const double raw = parse_double(r.fields[1 + w], std::string(names[w]) + " wheel value", path, r.line);
+      const double raw =
+          parse_double(r.fields[1 + w], std::string(names[w]) + " wheel value", path, r.line);
       if (i == 0) {
         unwrapped[w] = raw;
         first[w] = raw;
@@ -242,8 +263,15 @@ std::vector<WheelRecord> load_wheel_data(const std::string& path, const WheelSen
             hint = "; check counter_bits and ticks_per_meter in wheel0/sensor.yaml";
           }
           char buf[200];
-          std::snprintf(buf, sizeof buf, "%s wheel jumps by %.4g m in %.4g s (%.3g m/s, more than the plausible %.3g m/s)",
-                        names[w], dm, dt, std::abs(dm) / std::max(dt, 1e-12), max_speed);
+          std::snprintf(
+              buf,
+              sizeof buf,
+              "%s wheel jumps by %.4g m in %.4g s (%.3g m/s, more than the plausible %.3g m/s)",
+              names[w],
+              dm,
+              dt,
+              std::abs(dm) / std::max(dt, 1e-12),
+              max_speed);
           throw InputError(path, r.line, buf + hint);
         }
       }
@@ -275,7 +303,8 @@ GroundTruth load_ground_truth(const std::string& dir, const std::vector<ImageRec
     for (const CsvRow& r : read_csv(poses, 4, "timestamp [ns], x [m], y [m], theta [rad]")) {
       PoseRecord p;
       p.timestamp_ns = parse_timestamp(r.fields[0], poses, r.line);
-      if (!gt.poses.empty()) check_increasing(gt.poses.back().timestamp_ns, prev_line, p.timestamp_ns, poses, r.line);
+      if (!gt.poses.empty())
+        check_increasing(gt.poses.back().timestamp_ns, prev_line, p.timestamp_ns, poses, r.line);
       p.x = parse_double(r.fields[1], "x", poses, r.line);
       p.y = parse_double(r.fields[2], "y", poses, r.line);
       p.theta = parse_double(r.fields[3], "theta", poses, r.line);
@@ -286,7 +315,10 @@ GroundTruth load_ground_truth(const std::string& dir, const std::vector<ImageRec
   const std::string lines = rel(dir, "lines.csv");
   if (fs::exists(lines, ec)) {
     gt.has_lines = true;
-    for (const CsvRow& r : read_csv(lines, 6, "timestamp [ns], frame, line_id, bearing [rad], r_inner [px], r_outer [px]")) {
+    for (const CsvRow& r :
+         read_csv(lines,
+                  6,
+                  "timestamp [ns], frame, line_id, bearing [rad], r_inner [px], r_outer [px]")) {
       LineRecord l;
       l.timestamp_ns = parse_timestamp(r.fields[0], lines, r.line);
       l.frame = parse_int(r.fields[1], "frame", lines, r.line);
@@ -295,12 +327,16 @@ GroundTruth load_ground_truth(const std::string& dir, const std::vector<ImageRec
       l.r_inner = parse_double(r.fields[4], "r_inner", lines, r.line);
       l.r_outer = parse_double(r.fields[5], "r_outer", lines, r.line);
       if (l.frame < 0 || static_cast<std::size_t>(l.frame) >= images.size()) {
-        throw InputError(lines, r.line, "frame " + std::to_string(l.frame) + " is not an image index (0.." +
-                                            std::to_string(static_cast<long>(images.size()) - 1) + ")");
+        throw InputError(lines,
+                         r.line,
+                         "frame " + std::to_string(l.frame) + " is not an image index (0.." +
+                             std::to_string(static_cast<long>(images.size()) - 1) + ")");
       }
       if (images[static_cast<std::size_t>(l.frame)].timestamp_ns != l.timestamp_ns) {
-        throw InputError(lines, r.line, "timestamp " + std::to_string(l.timestamp_ns) + " is not that of frame " +
-                                            std::to_string(l.frame) + " in cam0/data.csv");
+        throw InputError(lines,
+                         r.line,
+                         "timestamp " + std::to_string(l.timestamp_ns) + " is not that of frame " +
+                             std::to_string(l.frame) + " in cam0/data.csv");
       }
       if (!gt.lines.empty() && l.frame < gt.lines.back().frame) {
         throw InputError(lines, r.line, "frames must not decrease");
@@ -326,7 +362,9 @@ Dataset Dataset::load(const std::string& dir, const LoadOptions& options) {
     ImageRecord im;
     im.line = r.line;
     im.timestamp_ns = parse_timestamp(r.fields[0], cam_csv, r.line);
-    if (!d.images_.empty()) check_increasing(d.images_.back().timestamp_ns, d.images_.back().line, im.timestamp_ns, cam_csv, r.line);
+    if (!d.images_.empty())
+      check_increasing(
+          d.images_.back().timestamp_ns, d.images_.back().line, im.timestamp_ns, cam_csv, r.line);
     im.filename = r.fields[1];
     if (im.filename.empty()) throw InputError(cam_csv, r.line, "empty file name");
     im.path = rel(dir, "cam0/data/" + im.filename);
@@ -353,13 +391,15 @@ Dataset Dataset::load(const std::string& dir, const LoadOptions& options) {
       if (im.timestamp_ns < w0 || im.timestamp_ns > w1) {
         throw InputError(wheel_csv,
                          0,
-                         "wheel data (timestamps " + std::to_string(w0) + " to " + std::to_string(w1) +
-                             ") does not cover the image at line " + std::to_string(im.line) +
-                             " of cam0/data.csv (timestamp " + std::to_string(im.timestamp_ns) + ")");
+                         "wheel data (timestamps " + std::to_string(w0) + " to " +
+                             std::to_string(w1) + ") does not cover the image at line " +
+                             std::to_string(im.line) + " of cam0/data.csv (timestamp " +
+                             std::to_string(im.timestamp_ns) + ")");
       }
     }
     d.travel_at_images_.reserve(d.images_.size());
-    for (const ImageRecord& im : d.images_) d.travel_at_images_.push_back(d.travel_at(im.timestamp_ns));
+    for (const ImageRecord& im : d.images_)
+      d.travel_at_images_.push_back(d.travel_at(im.timestamp_ns));
   }
 
   // Ground truth.
@@ -377,14 +417,17 @@ WheelTravel Dataset::travel_at(std::int64_t t) const {
   if (wheel_.empty() || t < wheel_.front().timestamp_ns || t > wheel_.back().timestamp_ns) {
     throw std::out_of_range("timestamp outside the wheel data");
   }
-  auto it = std::lower_bound(wheel_.begin(), wheel_.end(), t, [](const WheelRecord& w, std::int64_t v) {
-    return w.timestamp_ns < v;
-  });
+  auto it =
+      std::lower_bound(wheel_.begin(), wheel_.end(), t, [](const WheelRecord& w, std::int64_t v) {
+        return w.timestamp_ns < v;
+      });
   if (it->timestamp_ns == t) return it->travel;
   const WheelRecord& b = *it;
   const WheelRecord& a = *(it - 1);
-  const double f = static_cast<double>(t - a.timestamp_ns) / static_cast<double>(b.timestamp_ns - a.timestamp_ns);
-  return {a.travel.left + f * (b.travel.left - a.travel.left), a.travel.right + f * (b.travel.right - a.travel.right)};
+  const double f = static_cast<double>(t - a.timestamp_ns) /
+                   static_cast<double>(b.timestamp_ns - a.timestamp_ns);
+  return {a.travel.left + f * (b.travel.left - a.travel.left),
+          a.travel.right + f * (b.travel.right - a.travel.right)};
 }
 
 }  // namespace omnivert::dataset

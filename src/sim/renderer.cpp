@@ -10,9 +10,9 @@ namespace omnivert::sim {
 
 namespace {
 
-constexpr int kBins = 4096;           // azimuth bins of the interval look-up
-constexpr float kRimValue = 6.0f;     // outside the mirror: dark (the rim a circle detector finds)
-constexpr float kSelfValue = 32.0f;   // the camera's own reflection inside r_min
+constexpr int kBins = 4096;          // azimuth bins of the interval look-up
+constexpr float kRimValue = 6.0f;    // outside the mirror: dark (the rim a circle detector finds)
+constexpr float kSelfValue = 32.0f;  // the camera's own reflection inside r_min
 
 // Fraction of [c - w/2, c + w/2] inside [lo, hi] (box filter of a step pair).
 inline double coverage(double c, double w, double lo, double hi) {
@@ -46,11 +46,11 @@ inline double cross(double ax, double ay, double bx, double by) { return ax * by
 
 struct Renderer::FrameState {
   double cx = 0, cy = 0, hc = 0, yaw = 0;
-  int m = 0;                  // number of intervals (= number of distinct edge azimuths)
-  std::vector<double> disc;   // sorted edge azimuths in [0, 2 pi), disc[m] = disc[0] + 2 pi
-  std::vector<int> bin_start; // interval containing the start of each azimuth bin
+  int m = 0;                   // number of intervals (= number of distinct edge azimuths)
+  std::vector<double> disc;    // sorted edge azimuths in [0, 2 pi), disc[m] = disc[0] + 2 pi
+  std::vector<int> bin_start;  // interval containing the start of each azimuth bin
   std::vector<int> hit_offset;
-  std::vector<int> hits;      // walls met by the rays of each interval, nearest first
+  std::vector<int> hits;                    // walls met by the rays of each interval, nearest first
   std::vector<double> qx, qy, ux, uy, len;  // per wall: from - C, to - from, length
 
   // Azimuth of the global edge index j (periodic continuation).
@@ -168,7 +168,8 @@ void Renderer::render(const CameraPose& pose, cv::Mat1f& image) const {
   std::vector<std::pair<double, int>> tmp;
   for (int i = 0; i < f.m; ++i) {
     f.hit_offset.push_back(static_cast<int>(f.hits.size()));
-    const double az = 0.5 * (f.disc[static_cast<std::size_t>(i)] + f.disc[static_cast<std::size_t>(i) + 1]);
+    const double az =
+        0.5 * (f.disc[static_cast<std::size_t>(i)] + f.disc[static_cast<std::size_t>(i) + 1]);
     const double dx = std::cos(az), dy = std::sin(az);
     tmp.clear();
     for (std::size_t w = 0; w < nw; ++w) {
@@ -196,8 +197,13 @@ void Renderer::render(const CameraPose& pose, cv::Mat1f& image) const {
     if (next >= a1) {
       // No vertical edge inside the footprint: one sample at the pixel centre.
       const double c = px_cos_[k], sn = px_sin_[k];
-      value = shade(f, f.interval_of(j0), cyaw * c - syaw * sn, syaw * c + cyaw * sn,
-                    px_tan_[k], px_dtan_[k], halfw);
+      value = shade(f,
+                    f.interval_of(j0),
+                    cyaw * c - syaw * sn,
+                    syaw * c + cyaw * sn,
+                    px_tan_[k],
+                    px_dtan_[k],
+                    halfw);
     } else {
       // Split the footprint at the edges it contains; one sample per piece, weighted by
       // its azimuthal length (exact coverage for the vertical discontinuities).
@@ -208,8 +214,13 @@ void Renderer::render(const CameraPose& pose, cv::Mat1f& image) const {
         const double hi = std::min(f.disc_at(j + 1), a1);
         if (hi > lo) {
           const double mid = 0.5 * (lo + hi);
-          value += (hi - lo) * shade(f, f.interval_of(j), std::cos(mid), std::sin(mid),
-                                     px_tan_[k], px_dtan_[k], halfw);
+          value += (hi - lo) * shade(f,
+                                     f.interval_of(j),
+                                     std::cos(mid),
+                                     std::sin(mid),
+                                     px_tan_[k],
+                                     px_dtan_[k],
+                                     halfw);
         }
         lo = hi;
         ++j;
@@ -230,8 +241,14 @@ float Renderer::shade(const FrameState& f,
                       double dtan,
                       double halfw) const {
   const int* hits = f.hits.data();
-  return shade_hits(f, hits + f.hit_offset[static_cast<std::size_t>(interval)],
-                    hits + f.hit_offset[static_cast<std::size_t>(interval) + 1], dx, dy, tan_el, dtan, halfw);
+  return shade_hits(f,
+                    hits + f.hit_offset[static_cast<std::size_t>(interval)],
+                    hits + f.hit_offset[static_cast<std::size_t>(interval) + 1],
+                    dx,
+                    dy,
+                    tan_el,
+                    dtan,
+                    halfw);
 }
 
 float Renderer::shade_hits(const FrameState& f,
@@ -252,8 +269,10 @@ float Renderer::shade_hits(const FrameState& f,
     const double sigma = std::clamp(cross(f.qx[w], f.qy[w], dx, dy) / den, 0.0, 1.0);
     const double z = f.hc + t * tan_el, dz = t * dtan;
     const Wall& wall = world_.walls[static_cast<std::size_t>(w)];
-    const double cov =
-        coverage(z, dz, std::max(wall.z0, 0.0), std::min(wall_top_[static_cast<std::size_t>(w)], world_.height));
+    const double cov = coverage(z,
+                                dz,
+                                std::max(wall.z0, 0.0),
+                                std::min(wall_top_[static_cast<std::size_t>(w)], world_.height));
     if (cov <= 0.0) continue;
     // Footprint along the wall: the tangential footprint t * 2 halfw, stretched by the
     // incidence (|den| / len is the sine of the angle between ray and wall).
@@ -268,7 +287,8 @@ float Renderer::shade_hits(const FrameState& f,
       acc += remaining * plane_texture(world_.floor, f.cx + t * dx, f.cy + t * dy, fp, false);
     } else if (tan_el > 1e-9) {
       const double t = (world_.height - f.hc) / tan_el;
-      const double fp = std::max(t * 2.0 * halfw, (world_.height - f.hc) / (tan_el * tan_el) * dtan);
+      const double fp =
+          std::max(t * 2.0 * halfw, (world_.height - f.hc) / (tan_el * tan_el) * dtan);
       acc += remaining * plane_texture(world_.ceiling, f.cx + t * dx, f.cy + t * dy, fp, true);
     } else {
       acc += remaining * 0.5 * (world_.floor.intensity + world_.ceiling.intensity);
@@ -292,9 +312,9 @@ float Renderer::wall_texture(int wi, double s, double z, double ds, double dz) c
     switch (p.pattern) {
       case Pattern::kStripes: {
         const double x = (z - p.z0) / p.period, dx = dz / p.period;
-        const double sq = dx > 1e-6
-                              ? 2.0 * (square_integral(x + 0.5 * dx) - square_integral(x - 0.5 * dx)) / dx
-                              : (x - std::floor(x) < 0.5 ? 1.0 : -1.0);
+        const double sq =
+            dx > 1e-6 ? 2.0 * (square_integral(x + 0.5 * dx) - square_integral(x - 0.5 * dx)) / dx
+                      : (x - std::floor(x) < 0.5 ? 1.0 : -1.0);
         pv += p.amplitude * sq;
         break;
       }
@@ -316,7 +336,8 @@ float Renderer::wall_texture(int wi, double s, double z, double ds, double dz) c
   return static_cast<float>(v);
 }
 
-float Renderer::plane_texture(const Plane& p, double x, double y, double footprint, bool ceiling) const {
+float Renderer::plane_texture(
+    const Plane& p, double x, double y, double footprint, bool ceiling) const {
   // Tiles with their own grey level; the footprint blends neighbouring tiles near a joint.
   const double gx = x / p.tile, gy = y / p.tile;
   const double fx = gx - std::floor(gx), fy = gy - std::floor(gy);
@@ -374,7 +395,13 @@ void Renderer::render_reference(const CameraPose& pose, int samples, cv::Mat1f& 
       hits.clear();
       for (const auto& h : tmp) hits.push_back(h.second);
       // Texture filters use the sub-sample's own footprint.
-      value += shade_hits(f, hits.data(), hits.data() + hits.size(), dx, dy, px_tan_[k], px_dtan_[k],
+      value += shade_hits(f,
+                          hits.data(),
+                          hits.data() + hits.size(),
+                          dx,
+                          dy,
+                          px_tan_[k],
+                          px_dtan_[k],
                           halfw / samples);
     }
     const int idx = px_index_[k];
@@ -383,7 +410,8 @@ void Renderer::render_reference(const CameraPose& pose, int samples, cv::Mat1f& 
   }
 }
 
-std::vector<VisibleLine> Renderer::visible_lines(const CameraPose& pose, double min_length_px) const {
+std::vector<VisibleLine> Renderer::visible_lines(const CameraPose& pose,
+                                                 double min_length_px) const {
   std::vector<VisibleLine> out;
   const double el_min = camera_.elevation_of_radius(camera_.r_min);
   const double el_max = camera_.elevation_of_radius(camera_.r_max);

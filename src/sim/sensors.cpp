@@ -34,8 +34,10 @@ WheelSamples simulate_wheels(const std::vector<MotionPiece>& motion,
     prev = now;
     // Eq. (31): reported increment = true increment (with the wheel's scale error) plus
     // N(0, K |d|).
-    left += d.x() * (1.0 + c.radius_error_left) + std::sqrt(c.odometry_k * std::abs(d.x())) * n01(rng);
-    right += d.y() * (1.0 + c.radius_error_right) + std::sqrt(c.odometry_k * std::abs(d.y())) * n01(rng);
+    left +=
+        d.x() * (1.0 + c.radius_error_left) + std::sqrt(c.odometry_k * std::abs(d.x())) * n01(rng);
+    right +=
+        d.y() * (1.0 + c.radius_error_right) + std::sqrt(c.odometry_k * std::abs(d.y())) * n01(rng);
     w.t.push_back(t);
     w.true_left.push_back(now.x());
     w.true_right.push_back(now.y());

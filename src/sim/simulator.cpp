@@ -30,7 +30,9 @@ CameraPose camera_pose(const Pose2& robot, const Extrinsics& x, double camera_he
 
 namespace {
 
-double distance_to_segment(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+double distance_to_segment(const Eigen::Vector2d& p,
+                           const Eigen::Vector2d& a,
+                           const Eigen::Vector2d& b) {
   const Eigen::Vector2d u = b - a;
   const double t = std::clamp((p - a).dot(u) / u.squaredNorm(), 0.0, 1.0);
   return (a + t * u - p).norm();
@@ -73,16 +75,17 @@ std::string free_space_violation(const World& world,
       const Wall& w = world.walls[i];
       if (distance_to_segment(p.head<2>(), w.from, w.to) < clearance) {
         char where[200];
-        std::snprintf(where,
-                      sizeof where,
-                      "at t = %.2f s the robot (x = %.2f, y = %.2f) comes within %.2f m of wall %zu "
-                      "of world '%s'",
-                      t,
-                      p.x(),
-                      p.y(),
-                      clearance,
-                      i + 1,
-                      world.name.c_str());
+        std::snprintf(
+            where,
+            sizeof where,
+            "at t = %.2f s the robot (x = %.2f, y = %.2f) comes within %.2f m of wall %zu "
+            "of world '%s'",
+            t,
+            p.x(),
+            p.y(),
+            clearance,
+            i + 1,
+            world.name.c_str());
         return where;
       }
     }
@@ -107,10 +110,10 @@ void write_dataset(const World& world,
   const std::int64_t frame_step_ns = std::llround(1e9 / cfg.frame_rate);
   const std::int64_t first_offset_ns = 10'000'000;
   // The last frame is at or after the end of the motion, so that it shows the final pose.
-  int n_frames = static_cast<int>(
-                     std::ceil((t_motion * 1e9 - static_cast<double>(first_offset_ns)) /
-                               static_cast<double>(frame_step_ns))) +
-                 1;
+  int n_frames =
+      static_cast<int>(std::ceil((t_motion * 1e9 - static_cast<double>(first_offset_ns)) /
+                                 static_cast<double>(frame_step_ns))) +
+      1;
   n_frames = std::max(n_frames, 1);
   if (cfg.max_frames > 0) n_frames = std::min(n_frames, cfg.max_frames);
   auto frame_time = [&](int k) {
@@ -119,7 +122,8 @@ void write_dataset(const World& world,
   const double t_last = frame_time(n_frames - 1);
 
   // The robot must stay in the free space of the world.
-  if (const std::string p = free_space_violation(world, motion, t_last, cfg.min_clearance); !p.empty()) {
+  if (const std::string p = free_space_violation(world, motion, t_last, cfg.min_clearance);
+      !p.empty()) {
     throw InputError("trajectory '" + trajectory.name + "' leaves the free space: " + p +
                      "; give the trajectory a 'start' or choose another world");
   }
@@ -136,8 +140,9 @@ void write_dataset(const World& world,
     FILE* f = open_or_throw(dir / "wheel0" / "data.csv");
     FileCloser closer{f};
     const WheelConfig& wc = cfg.wheel;
-    std::fprintf(f, wc.ticks ? "#timestamp [ns],left [ticks],right [ticks]\n"
-                             : "#timestamp [ns],left [m],right [m]\n");
+    std::fprintf(f,
+                 wc.ticks ? "#timestamp [ns],left [ticks],right [ticks]\n"
+                          : "#timestamp [ns],left [m],right [m]\n");
     for (std::size_t i = 0; i < wheels.t.size(); ++i) {
       const std::int64_t ts = t0 + std::llround(wheels.t[i] * 1e9);
       if (wc.ticks) {
@@ -176,6 +181,8 @@ void write_dataset(const World& world,
     y += "r_min: " + fmt("%.9g", c.r_min) + "\n";
     y += "r_max: " + fmt("%.9g", c.r_max) + "\n";
     y += "bearing_sign: " + std::to_string(c.bearing_sign) + "\n";
+    y += "rim_radius: " + fmt("%.9g", c.rim_radius()) +
+         "   # dark beyond: the mirror's outer boundary\n";
     y += "xi: " + fmt("%.9g", c.xi) + "\n";
     y += "gamma: " + fmt("%.9g", c.gamma) + "\n";
     y += "rate_hz: " + fmt("%.9g", cfg.frame_rate) + "\n";
@@ -190,8 +197,9 @@ void write_dataset(const World& world,
     y += "rho: " + fmt("%.12g", x.rho) + "   # [m]\n";
     y += "psi: " + fmt("%.12g", x.psi) + "   # [rad]\n";
     y += "# the same as T_base_cam = [Rz(yaw) | (x, y, z)]\n";
-    y += "T_base_cam: {x: " + fmt("%.12g", tx) + ", y: " + fmt("%.12g", ty) + ", z: " +
-         fmt("%.12g", cfg.camera_height) + ", yaw: " + fmt("%.12g", wrap_angle(x.phi + x.psi)) + "}\n";
+    y += "T_base_cam: {x: " + fmt("%.12g", tx) + ", y: " + fmt("%.12g", ty) +
+         ", z: " + fmt("%.12g", cfg.camera_height) +
+         ", yaw: " + fmt("%.12g", wrap_angle(x.phi + x.psi)) + "}\n";
     write_text(dir / "ground_truth" / "extrinsics.yaml", y);
   }
   save_world(world, (dir / "ground_truth" / "world.yaml").string());
@@ -260,7 +268,8 @@ void write_dataset(const World& world,
       throw std::runtime_error("cannot write image " + (dir / "cam0" / "data" / name).string());
     }
     std::fprintf(fcam, "%" PRId64 ",%s\n", ts, name.c_str());
-    std::fprintf(fpose, "%" PRId64 ",%.9f,%.9f,%.9f\n", ts, robot.x(), robot.y(), wrap_angle(robot.z()));
+    std::fprintf(
+        fpose, "%" PRId64 ",%.9f,%.9f,%.9f\n", ts, robot.x(), robot.y(), wrap_angle(robot.z()));
     for (const VisibleLine& l : renderer.visible_lines(cam, cfg.min_line_px)) {
       std::fprintf(flines,
                    "%" PRId64 ",%d,%d,%.9f,%.3f,%.3f\n",
@@ -291,7 +300,8 @@ SimSummary simulate(const World& world,
                     const std::function<void(int, int)>& progress) {
   const auto t_start = std::chrono::steady_clock::now();
   if (const std::string p = cfg.camera.validate(); !p.empty()) throw InputError("camera: " + p);
-  if (const std::string p = world.validate(); !p.empty()) throw InputError("world '" + world.name + "': " + p);
+  if (const std::string p = world.validate(); !p.empty())
+    throw InputError("world '" + world.name + "': " + p);
   if (const std::string p = trajectory.validate(); !p.empty()) {
     throw InputError("trajectory '" + trajectory.name + "': " + p);
   }
@@ -300,7 +310,8 @@ SimSummary simulate(const World& world,
   if (!(cfg.wheel.wheel_base > 0) || !(cfg.wheel.true_wheel_base() > 0)) {
     throw InputError("the wheel base must be positive");
   }
-  if (cfg.wheel.ticks && (!(cfg.wheel.ticks_per_meter_left > 0) || !(cfg.wheel.ticks_per_meter_right > 0))) {
+  if (cfg.wheel.ticks &&
+      (!(cfg.wheel.ticks_per_meter_left > 0) || !(cfg.wheel.ticks_per_meter_right > 0))) {
     throw InputError("ticks per meter must be positive");
   }
   if (cfg.wheel.counter_bits < 0 || cfg.wheel.counter_bits > 62) {

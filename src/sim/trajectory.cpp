@@ -18,12 +18,14 @@ Pose2 advance(const Pose2& p, double v, double omega, double dt) {
   const double th = p.z();
   const double dth = omega * dt;
   if (std::abs(dth) < 1e-9) {
-    return {p.x() + v * dt * std::cos(th + 0.5 * dth), p.y() + v * dt * std::sin(th + 0.5 * dth),
+    return {p.x() + v * dt * std::cos(th + 0.5 * dth),
+            p.y() + v * dt * std::sin(th + 0.5 * dth),
             th + dth};
   }
   const double r = v / omega;
   return {p.x() + r * (std::sin(th + dth) - std::sin(th)),
-          p.y() - r * (std::cos(th + dth) - std::cos(th)), th + dth};
+          p.y() - r * (std::cos(th + dth) - std::cos(th)),
+          th + dth};
 }
 
 Segment straight(double d) {
@@ -157,7 +159,8 @@ Trajectory parse(const std::string& file) {
                .value_or(std::filesystem::path(file).stem().string());
   t.speed = yaml::optional_number(root, "speed", file, true).value_or(t.speed);
   t.turn_rate = yaml::optional_number(root, "turn_rate", file, true).value_or(t.turn_rate);
-  if (!(t.speed > 0)) throw InputError(file, yaml::line_of(root["speed"]), "field 'speed' must be positive");
+  if (!(t.speed > 0))
+    throw InputError(file, yaml::line_of(root["speed"]), "field 'speed' must be positive");
   if (!(t.turn_rate > 0)) {
     throw InputError(file, yaml::line_of(root["turn_rate"]), "field 'turn_rate' must be positive");
   }
@@ -167,11 +170,13 @@ Trajectory parse(const std::string& file) {
   }
   const YAML::Node segs = root["segments"];
   if (!segs) throw InputError(file, 0, "missing required field 'segments' (a list)");
-  if (!segs.IsSequence()) throw InputError(file, yaml::line_of(segs), "field 'segments' must be a list");
+  if (!segs.IsSequence())
+    throw InputError(file, yaml::line_of(segs), "field 'segments' must be a list");
   int repeat = 1;
   if (const auto r = yaml::optional_number(root, "repeat", file, true)) {
     if (*r < 1 || *r != std::floor(*r)) {
-      throw InputError(file, yaml::line_of(root["repeat"]), "field 'repeat' must be a whole number >= 1");
+      throw InputError(
+          file, yaml::line_of(root["repeat"]), "field 'repeat' must be a whole number >= 1");
     }
     repeat = static_cast<int>(*r);
   }

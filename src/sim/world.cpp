@@ -6,8 +6,8 @@
 #include <fstream>
 #include <random>
 
-#include <opencv2/imgproc.hpp>
 #include <yaml-cpp/yaml.h>
+#include <opencv2/imgproc.hpp>
 
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
@@ -30,8 +30,8 @@ void World::add_box(const Eigen::Vector2d& center,
   const Eigen::Vector2d ex(std::cos(yaw), std::sin(yaw));
   const Eigen::Vector2d ey(-ex.y(), ex.x());
   const Eigen::Vector2d hx = 0.5 * size.x() * ex, hy = 0.5 * size.y() * ey;
-  const Eigen::Vector2d c[4] = {center - hx - hy, center + hx - hy, center + hx + hy,
-                                center - hx + hy};
+  const Eigen::Vector2d c[4] = {
+      center - hx - hy, center + hx - hy, center + hx + hy, center - hx + hy};
   // Faces lit differently, so that each corner of the box is an edge of some contrast.
   const double shade[4] = {1.0, 0.82, 0.93, 0.74};
   for (int i = 0; i < 4; ++i) {
@@ -501,7 +501,8 @@ World parse_world(const std::string& file) {
       throw InputError(file, line, "field 'texture_scale' must be positive");
     }
     if (const YAML::Node strips = n["strips"]) {
-      if (!strips.IsSequence()) throw InputError(file, yaml::line_of(strips), "'strips' must be a list");
+      if (!strips.IsSequence())
+        throw InputError(file, yaml::line_of(strips), "'strips' must be a list");
       for (const YAML::Node& sn : strips) {
         Strip s;
         const auto at = range_field(sn, "at", file, {}, true);
@@ -512,7 +513,8 @@ World parse_world(const std::string& file) {
       }
     }
     if (const YAML::Node panels = n["panels"]) {
-      if (!panels.IsSequence()) throw InputError(file, yaml::line_of(panels), "'panels' must be a list");
+      if (!panels.IsSequence())
+        throw InputError(file, yaml::line_of(panels), "'panels' must be a list");
       for (const YAML::Node& pn : panels) {
         Panel p;
         const auto at = range_field(pn, "at", file, {}, true);
@@ -526,7 +528,8 @@ World parse_world(const std::string& file) {
           p.pattern = parse_pattern(*pat, file, yaml::line_of(pn["pattern"]));
         }
         p.period = yaml::optional_number(pn, "period", file, true).value_or(p.period);
-        if (!(p.period > 0)) throw InputError(file, yaml::line_of(pn), "field 'period' must be positive");
+        if (!(p.period > 0))
+          throw InputError(file, yaml::line_of(pn), "field 'period' must be positive");
         p.angle_deg = yaml::optional_number(pn, "angle_deg", file).value_or(p.angle_deg);
         p.amplitude = yaml::optional_number(pn, "amplitude", file, true).value_or(p.amplitude);
         w.panels.push_back(p);
@@ -565,7 +568,8 @@ World world_preset(const std::string& name) {
   if (name == "corridor") return make_corridor();
   if (name == "office") return make_office();
   if (name == "hall") return make_hall();
-  throw InputError("unknown world '" + name + "' (presets: corridor, office, hall; or a YAML file)");
+  throw InputError("unknown world '" + name +
+                   "' (presets: corridor, office, hall; or a YAML file)");
 }
 
 World load_world(const std::string& name_or_file) {
@@ -574,9 +578,8 @@ World load_world(const std::string& name_or_file) {
   }
   std::error_code ec;
   if (!std::filesystem::exists(name_or_file, ec)) {
-    throw InputError(name_or_file,
-                     0,
-                     "no such world file, and not a preset (corridor, office, hall)");
+    throw InputError(
+        name_or_file, 0, "no such world file, and not a preset (corridor, office, hall)");
   }
   return parse_world(name_or_file);
 }
@@ -590,7 +593,8 @@ void save_world(const World& world, const std::string& path) {
   out << YAML::Key << "seed" << YAML::Value << world.seed;
   out << YAML::Key << "start" << YAML::Value << YAML::Flow << YAML::BeginSeq << world.start.x()
       << world.start.y() << world.start.z() << YAML::EndSeq;
-  for (const auto& [key, p] : {std::pair{"floor", world.floor}, std::pair{"ceiling", world.ceiling}}) {
+  for (const auto& [key, p] :
+       {std::pair{"floor", world.floor}, std::pair{"ceiling", world.ceiling}}) {
     out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginMap;
     out << YAML::Key << "intensity" << YAML::Value << p.intensity;
     out << YAML::Key << "contrast" << YAML::Value << p.contrast;
@@ -604,8 +608,8 @@ void save_world(const World& world, const std::string& path) {
     out << YAML::Key << "to" << YAML::Value << YAML::Flow << YAML::BeginSeq << w.to.x() << w.to.y()
         << YAML::EndSeq;
     if (w.z1 >= 0 || w.z0 > 0) {
-      out << YAML::Key << "z" << YAML::Value << YAML::Flow << YAML::BeginSeq << w.z0
-          << world.top(w) << YAML::EndSeq;
+      out << YAML::Key << "z" << YAML::Value << YAML::Flow << YAML::BeginSeq << w.z0 << world.top(w)
+          << YAML::EndSeq;
     }
     out << YAML::Key << "intensity" << YAML::Value << w.intensity;
     out << YAML::Key << "texture" << YAML::Value << w.texture;

@@ -27,10 +27,12 @@ class DatasetTest : public ::testing::Test {
     fs::remove_all(root);
     fs::create_directories(root / "cam0" / "data");
     fs::create_directories(root / "wheel0");
-    write("cam0/sensor.yaml", "resolution: [64, 48]\ncenter: [32.5, 24.5]\nr_min: 5\nr_max: 20\nbearing_sign: 1\n");
+    write("cam0/sensor.yaml",
+          "resolution: [64, 48]\ncenter: [32.5, 24.5]\nr_min: 5\nr_max: 20\nbearing_sign: 1\n");
     write("cam0/data.csv",
           "#timestamp [ns],filename\n1000000000,a.png\n2000000000,b.png\n3000000000,c.png\n");
-    for (const char* f : {"a.png", "b.png", "c.png"}) image(std::string("cam0/data/") + f, 64, 48, CV_8UC1);
+    for (const char* f : {"a.png", "b.png", "c.png"})
+      image(std::string("cam0/data/") + f, 64, 48, CV_8UC1);
     write("wheel0/sensor.yaml", "wheel_base: 0.4\nunit: meters\nodometry_k: 1.0e-5\n");
     write("wheel0/data.csv",
           "#timestamp [ns],left [m],right [m]\n"
@@ -96,25 +98,30 @@ TEST_F(DatasetTest, MissingImageFile) {
 
 TEST_F(DatasetTest, UnparsableTimestamp) {
   write("cam0/data.csv", "#timestamp [ns],filename\n1000000000,a.png\n2000x00000,b.png\n");
-  EXPECT_EQ(error(), p("cam0/data.csv") +
-                         ":3: cannot parse timestamp '2000x00000' (expected a non-negative integer in ns)");
+  EXPECT_EQ(error(),
+            p("cam0/data.csv") +
+                ":3: cannot parse timestamp '2000x00000' (expected a non-negative integer in ns)");
 }
 
 TEST_F(DatasetTest, WrongNumberOfColumns) {
   write("cam0/data.csv", "#timestamp [ns],filename\n1000000000,a.png,extra\n");
-  EXPECT_EQ(error(), p("cam0/data.csv") +
-                         ":2: expected 2 comma-separated columns (timestamp [ns], filename), got 3");
+  EXPECT_EQ(error(),
+            p("cam0/data.csv") +
+                ":2: expected 2 comma-separated columns (timestamp [ns], filename), got 3");
 }
 
 TEST_F(DatasetTest, MissingHeader) {
   write("cam0/data.csv", "1000000000,a.png\n");
-  EXPECT_EQ(error(), p("cam0/data.csv") +
-                         ":1: expected a header line starting with '#' (timestamp [ns], filename)");
+  EXPECT_EQ(error(),
+            p("cam0/data.csv") +
+                ":1: expected a header line starting with '#' (timestamp [ns], filename)");
 }
 
 TEST_F(DatasetTest, UnparsableWheelValue) {
-  write("wheel0/data.csv", "#timestamp [ns],left [m],right [m]\n500000000,1.0,2.0\n1000000000,1.1,nan\n");
-  EXPECT_EQ(error(), p("wheel0/data.csv") + ":3: cannot parse right wheel value 'nan' as a finite number");
+  write("wheel0/data.csv",
+        "#timestamp [ns],left [m],right [m]\n500000000,1.0,2.0\n1000000000,1.1,nan\n");
+  EXPECT_EQ(error(),
+            p("wheel0/data.csv") + ":3: cannot parse right wheel value 'nan' as a finite number");
 }
 
 TEST_F(DatasetTest, DuplicateImageTimestamp) {
@@ -124,20 +131,26 @@ TEST_F(DatasetTest, DuplicateImageTimestamp) {
 
 TEST_F(DatasetTest, DecreasingWheelTimestamp) {
   write("wheel0/data.csv",
-        "#timestamp [ns],left [m],right [m]\n500000000,1.0,2.0\n\n1500000000,1.1,2.0\n1000000000,1.2,2.0\n");
-  EXPECT_EQ(error(), p("wheel0/data.csv") +
-                         ":5: timestamp 1000000000 is earlier than 1500000000 on line 4: timestamps must increase");
+        "#timestamp [ns],left [m],right "
+        "[m]\n500000000,1.0,2.0\n\n1500000000,1.1,2.0\n1000000000,1.2,2.0\n");
+  EXPECT_EQ(error(),
+            p("wheel0/data.csv") +
+                ":5: timestamp 1000000000 is earlier than 1500000000 on line 4: timestamps must "
+                "increase");
 }
 
 TEST_F(DatasetTest, ImageOfTheWrongSize) {
   image("cam0/data/a.png", 32, 24, CV_8UC1);
-  EXPECT_EQ(error(), p("cam0/data/a.png") + ": image is 32x24 pixels but cam0/sensor.yaml gives resolution 64x48");
+  EXPECT_EQ(
+      error(),
+      p("cam0/data/a.png") + ": image is 32x24 pixels but cam0/sensor.yaml gives resolution 64x48");
 }
 
 TEST_F(DatasetTest, ImageOfTheWrongDepth) {
   image("cam0/data/a.png", 64, 48, CV_16UC1);
-  EXPECT_EQ(error(), p("cam0/data/a.png") +
-                         ": image is 16 bits deep; expected 8-bit grey (convert it, e.g. to 8-bit PNG)");
+  EXPECT_EQ(error(),
+            p("cam0/data/a.png") +
+                ": image is 16 bits deep; expected 8-bit grey (convert it, e.g. to 8-bit PNG)");
 }
 
 TEST_F(DatasetTest, BadImageLaterInTheSequenceIsFoundWhenRead) {
@@ -148,11 +161,14 @@ TEST_F(DatasetTest, BadImageLaterInTheSequenceIsFoundWhenRead) {
     FAIL();
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()),
-              p("cam0/data/c.png") + ": image is 64x40 pixels but cam0/sensor.yaml gives resolution 64x48");
+              p("cam0/data/c.png") +
+                  ": image is 64x40 pixels but cam0/sensor.yaml gives resolution 64x48");
   }
   LoadOptions all;
   all.check_all_images = true;
-  EXPECT_EQ(error(all), p("cam0/data/c.png") + ": image is 64x40 pixels but cam0/sensor.yaml gives resolution 64x48");
+  EXPECT_EQ(
+      error(all),
+      p("cam0/data/c.png") + ": image is 64x40 pixels but cam0/sensor.yaml gives resolution 64x48");
 }
 
 TEST_F(DatasetTest, ColourImageIsConvertedToGrey) {
@@ -162,10 +178,12 @@ TEST_F(DatasetTest, ColourImageIsConvertedToGrey) {
 }
 
 TEST_F(DatasetTest, WheelDataNotCoveringTheImages) {
-  write("wheel0/data.csv", "#timestamp [ns],left [m],right [m]\n500000000,1.0,2.0\n2500000000,1.1,2.0\n");
-  EXPECT_EQ(error(), p("wheel0/data.csv") +
-                         ": wheel data (timestamps 500000000 to 2500000000) does not cover the image at "
-                         "line 4 of cam0/data.csv (timestamp 3000000000)");
+  write("wheel0/data.csv",
+        "#timestamp [ns],left [m],right [m]\n500000000,1.0,2.0\n2500000000,1.1,2.0\n");
+  EXPECT_EQ(error(),
+            p("wheel0/data.csv") +
+                ": wheel data (timestamps 500000000 to 2500000000) does not cover the image at "
+                "line 4 of cam0/data.csv (timestamp 3000000000)");
 }
 
 TEST_F(DatasetTest, WheelsAreOptionalOnlyWhenAllowed) {
@@ -181,7 +199,8 @@ TEST_F(DatasetTest, WheelSensorFields) {
   write("wheel0/sensor.yaml", "unit: meters\n");
   EXPECT_EQ(error(), p("wheel0/sensor.yaml") + ": missing required field 'wheel_base'");
   write("wheel0/sensor.yaml", "wheel_base: 0.4\nunit: furlongs\n");
-  EXPECT_EQ(error(), p("wheel0/sensor.yaml") + ":2: field 'unit' must be meters or ticks, got 'furlongs'");
+  EXPECT_EQ(error(),
+            p("wheel0/sensor.yaml") + ":2: field 'unit' must be meters or ticks, got 'furlongs'");
   write("wheel0/sensor.yaml", "wheel_base: 0.4\nunit: ticks\nticks_per_meter_left: 100\n");
   EXPECT_EQ(error(), p("wheel0/sensor.yaml") + ": missing required field 'ticks_per_meter_right'");
   write("wheel0/sensor.yaml", "wheel_base: 0.4\nunit: meters\ncounter_bits: 16\n");
@@ -189,8 +208,10 @@ TEST_F(DatasetTest, WheelSensorFields) {
 }
 
 TEST_F(DatasetTest, HeaderUnitMustMatchTheSensorUnit) {
-  write("wheel0/sensor.yaml", "wheel_base: 0.4\nunit: ticks\nticks_per_meter_left: 1000\nticks_per_meter_right: 1000\n");
-  EXPECT_EQ(error(), p("wheel0/data.csv") + ":1: header says [m] but wheel0/sensor.yaml says 'unit: ticks'");
+  write("wheel0/sensor.yaml",
+        "wheel_base: 0.4\nunit: ticks\nticks_per_meter_left: 1000\nticks_per_meter_right: 1000\n");
+  EXPECT_EQ(error(),
+            p("wheel0/data.csv") + ":1: header says [m] but wheel0/sensor.yaml says 'unit: ticks'");
 }
 
 class TicksTest : public DatasetTest {
@@ -204,8 +225,10 @@ class TicksTest : public DatasetTest {
           "2500000000,88,154\n3000000000,188,254\n3500000000,32,98\n");
   }
   void sensor(const std::string& extra) {
-    write("wheel0/sensor.yaml",
-          "wheel_base: 0.4\nunit: ticks\nticks_per_meter_left: 1000\nticks_per_meter_right: 1000\n" + extra);
+    write(
+        "wheel0/sensor.yaml",
+        "wheel_base: 0.4\nunit: ticks\nticks_per_meter_left: 1000\nticks_per_meter_right: 1000\n" +
+            extra);
   }
 };
 
@@ -221,9 +244,10 @@ TEST_F(TicksTest, WrappedCounterWithoutCounterBitsIsAnImplausibleJump) {
   sensor("");
   LoadOptions o;
   o.max_wheel_speed = 0.3;
-  EXPECT_EQ(error(o), p("wheel0/data.csv") +
-                         ":3: left wheel jumps by -0.156 m in 0.5 s (0.312 m/s, more than the plausible 0.3 "
-                         "m/s); if the tick counter wraps, give counter_bits in wheel0/sensor.yaml");
+  EXPECT_EQ(error(o),
+            p("wheel0/data.csv") +
+                ":3: left wheel jumps by -0.156 m in 0.5 s (0.312 m/s, more than the plausible 0.3 "
+                "m/s); if the tick counter wraps, give counter_bits in wheel0/sensor.yaml");
 }
 
 TEST_F(TicksTest, ImplausibleJumpAfterUnwrapping) {
@@ -235,9 +259,10 @@ TEST_F(TicksTest, ImplausibleJumpAfterUnwrapping) {
     FAIL();
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()),
-              p("wheel0/data.csv") + ":3: left wheel jumps by -0.156 m in 0.5 s (0.312 m/s, more than the "
-                                     "plausible 0.3 m/s); check counter_bits and ticks_per_meter in "
-                                     "wheel0/sensor.yaml");
+              p("wheel0/data.csv") +
+                  ":3: left wheel jumps by -0.156 m in 0.5 s (0.312 m/s, more than the "
+                  "plausible 0.3 m/s); check counter_bits and ticks_per_meter in "
+                  "wheel0/sensor.yaml");
   }
 }
 
@@ -245,7 +270,8 @@ TEST_F(DatasetTest, GroundTruthIsReadAndChecked) {
   fs::create_directories(root / "ground_truth");
   write("ground_truth/extrinsics.yaml", "phi: -0.34\nrho: 0.23\npsi: 0.33\n");
   write("ground_truth/poses.csv",
-        "#timestamp [ns],x [m],y [m],theta [rad]\n1000000000,0,0,0\n2000000000,0.1,0,0\n3000000000,0.2,0,0.1\n");
+        "#timestamp [ns],x [m],y [m],theta "
+        "[rad]\n1000000000,0,0,0\n2000000000,0.1,0,0\n3000000000,0.2,0,0.1\n");
   write("ground_truth/lines.csv",
         "#timestamp [ns],frame,line_id,bearing [rad],r_inner [px],r_outer [px]\n"
         "1000000000,0,4,0.5,6,19\n2000000000,1,4,0.6,6,19\n");
@@ -261,11 +287,15 @@ TEST_F(DatasetTest, GroundTruthIsReadAndChecked) {
     EXPECT_DOUBLE_EQ(gt.lines[1].bearing, 0.6);
   }
   write("ground_truth/lines.csv",
-        "#timestamp [ns],frame,line_id,bearing [rad],r_inner [px],r_outer [px]\n1000000000,7,4,0.5,6,19\n");
+        "#timestamp [ns],frame,line_id,bearing [rad],r_inner [px],r_outer "
+        "[px]\n1000000000,7,4,0.5,6,19\n");
   EXPECT_EQ(error(), p("ground_truth/lines.csv") + ":2: frame 7 is not an image index (0..2)");
   write("ground_truth/lines.csv",
-        "#timestamp [ns],frame,line_id,bearing [rad],r_inner [px],r_outer [px]\n1000000001,0,4,0.5,6,19\n");
-  EXPECT_EQ(error(), p("ground_truth/lines.csv") + ":2: timestamp 1000000001 is not that of frame 0 in cam0/data.csv");
+        "#timestamp [ns],frame,line_id,bearing [rad],r_inner [px],r_outer "
+        "[px]\n1000000001,0,4,0.5,6,19\n");
+  EXPECT_EQ(error(),
+            p("ground_truth/lines.csv") +
+                ":2: timestamp 1000000001 is not that of frame 0 in cam0/data.csv");
   write("ground_truth/extrinsics.yaml", "phi: -0.34\nrho: 0.23\n");
   EXPECT_EQ(error(), p("ground_truth/extrinsics.yaml") + ": missing required field 'psi'");
 }

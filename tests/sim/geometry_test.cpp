@@ -43,7 +43,10 @@ TEST(CameraModel, ProjectionFollowsTheBearingConvention) {
       const double r = cam.radius_of_elevation(el);
       EXPECT_NEAR(px.x(), cam.cx + r * std::cos(beta), 1e-9);
       EXPECT_NEAR(px.y(), cam.cy + sign * r * std::sin(beta), 1e-9);
-      EXPECT_NEAR(cam.geometry().bearing_of_image_angle(std::atan2(px.y() - cam.cy, px.x() - cam.cx)), beta, 1e-12);
+      EXPECT_NEAR(
+          cam.geometry().bearing_of_image_angle(std::atan2(px.y() - cam.cy, px.x() - cam.cx)),
+          beta,
+          1e-12);
     }
   }
   CatadioptricCamera cam;
@@ -114,10 +117,11 @@ using TrajectoryFile = TempDir;
 using WorldFile = TempDir;
 
 TEST_F(TrajectoryFile, ReadsSegmentsAndRepeat) {
-  const std::string f = write("t.yaml",
-                              "speed: 0.2\nturn_rate: 0.5\nstart: [1, 2, 0]\nrepeat: 2\nsegments:\n"
-                              "  - straight: 1.0\n  - turn_deg: 90\n  - arc: {length: 0.5, angle_deg: 30}\n"
-                              "  - wait: 2\n");
+  const std::string f =
+      write("t.yaml",
+            "speed: 0.2\nturn_rate: 0.5\nstart: [1, 2, 0]\nrepeat: 2\nsegments:\n"
+            "  - straight: 1.0\n  - turn_deg: 90\n  - arc: {length: 0.5, angle_deg: 30}\n"
+            "  - wait: 2\n");
   const Trajectory t = load_trajectory(f);
   ASSERT_EQ(t.segments.size(), 8u);
   EXPECT_TRUE(t.has_start);
@@ -132,7 +136,8 @@ TEST_F(TrajectoryFile, BadSegmentNamesFileAndLine) {
     load_trajectory(f);
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_EQ(std::string(e.what()), f + ":3: unknown segment 'jump' (expected straight, turn_deg, arc or wait)");
+    EXPECT_EQ(std::string(e.what()),
+              f + ":3: unknown segment 'jump' (expected straight, turn_deg, arc or wait)");
   }
   EXPECT_THROW(load_trajectory("nonsense"), InputError);
 }
@@ -172,14 +177,16 @@ TEST_F(WorldFile, UserWorldWithBoxesAndPartialHeightEdges) {
 }
 
 TEST_F(WorldFile, BadValuesNameFileAndLine) {
-  const std::string f = write("bad.yaml",
-                              "walls:\n  - from: [0, 0]\n    to: [1, 0]\n    panels:\n"
-                              "      - {at: [0.2, 0.5], z: [0, 1], intensity: 3, pattern: zebra}\n");
+  const std::string f =
+      write("bad.yaml",
+            "walls:\n  - from: [0, 0]\n    to: [1, 0]\n    panels:\n"
+            "      - {at: [0.2, 0.5], z: [0, 1], intensity: 3, pattern: zebra}\n");
   try {
     load_world(f);
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_EQ(std::string(e.what()), f + ":5: unknown pattern 'zebra' (expected flat, stripes or wave)");
+    EXPECT_EQ(std::string(e.what()),
+              f + ":5: unknown pattern 'zebra' (expected flat, stripes or wave)");
   }
   const std::string g = write("bad2.yaml", "walls:\n  - from: [0, 0]\n");
   try {

@@ -14,8 +14,8 @@
 #include <cmath>
 #include <cstdio>
 
-#include <Eigen/Dense>
 #include <gtest/gtest.h>
+#include <Eigen/Dense>
 
 #include "omnivert/core/angles.hpp"
 #include "omnivert/sim/renderer.hpp"
@@ -48,7 +48,8 @@ World edge_world(double edge_y) {
 }
 
 // Predicted camera bearing of the world vertical line at (xf, yf) (NOTES Sec. 1).
-double predicted_bearing(double xr, double yr, double th, double phi, double rho, double psi, double xf, double yf) {
+double predicted_bearing(
+    double xr, double yr, double th, double phi, double rho, double psi, double xf, double yf) {
   const double xc = xr + rho * std::cos(th + phi);
   const double yc = yr + rho * std::sin(th + phi);
   return wrap_angle(std::atan2(yf - yc, xf - xc) - (th + phi + psi));
@@ -56,8 +57,14 @@ double predicted_bearing(double xr, double yr, double th, double phi, double rho
 
 // Image angle of the edge, fitted to the intensities of pixels in the ring r0..r1 within
 // +-window of the approximate angle a_guess (the window only selects the region).
-double fit_edge_angle(const cv::Mat1f& img, double cx, double cy, double a_guess, double r0, double r1,
-                      double window, int* used = nullptr) {
+double fit_edge_angle(const cv::Mat1f& img,
+                      double cx,
+                      double cy,
+                      double a_guess,
+                      double r0,
+                      double r1,
+                      double window,
+                      int* used = nullptr) {
   // Intensity levels on either side, from the region itself.
   double lo = 1e9, hi = -1e9;
   std::vector<Eigen::Vector3d> px;  // x, y, intensity
@@ -108,10 +115,12 @@ TEST(RenderBearing, VerticalEdgeAtPredictedBearingWithinFiveHundredthsOfADegree)
         // Radii where the wall (not floor or ceiling) is seen at the edge.
         const double d = std::hypot(2.0 - pose.x, edge_y - pose.y);
         const double r0 = std::max(cam.radius_of_elevation(std::atan2(0.15 - 0.9, d)), cam.r_min);
-        const double r1 = std::min(cam.radius_of_elevation(std::atan2(2.4 - 0.9, d)), cam.r_max - 2);
+        const double r1 =
+            std::min(cam.radius_of_elevation(std::atan2(2.4 - 0.9, d)), cam.r_max - 2);
         ASSERT_GT(r1 - r0, 40.0);
         int used = 0;
-        const double a = fit_edge_angle(img, cam.cx, cam.cy, sign * beta, r0, r1, deg2rad(3.0), &used);
+        const double a =
+            fit_edge_angle(img, cam.cx, cam.cy, sign * beta, r0, r1, deg2rad(3.0), &used);
         ASSERT_GT(used, 30);
         const double measured_beta = wrap_angle(sign * a);
         const double err = rad2deg(std::abs(angle_diff(measured_beta, beta)));
@@ -215,7 +224,9 @@ TEST(RenderBearing, OcclusionRemovesHiddenEdges) {
   Renderer renderer(cam, w);
   auto has_edge = [&](const CameraPose& p) {
     for (const auto& l : renderer.visible_lines(p)) {
-      if (renderer.edges()[static_cast<std::size_t>(l.line_id)].p.isApprox(Eigen::Vector2d(2.0, 0.0))) return true;
+      if (renderer.edges()[static_cast<std::size_t>(l.line_id)].p.isApprox(
+              Eigen::Vector2d(2.0, 0.0)))
+        return true;
     }
     return false;
   };

@@ -26,7 +26,8 @@ TEST(RenderReference, FastRendererMatchesPlainRayCasting) {
   for (const std::string name : {"corridor", "office", "hall"}) {
     const World w = world_preset(name);
     Renderer r(cam, w);
-    const CameraPose pose = camera_pose({w.start.x() + 1.3, w.start.y() + 0.4, 0.6}, Extrinsics{}, 0.9);
+    const CameraPose pose =
+        camera_pose({w.start.x() + 1.3, w.start.y() + 0.4, 0.6}, Extrinsics{}, 0.9);
     cv::Mat1f fast, ref;
     r.render(pose, fast);
     r.render_reference(pose, 32, ref);
@@ -36,7 +37,11 @@ TEST(RenderReference, FastRendererMatchesPlainRayCasting) {
     cv::minMaxLoc(diff, nullptr, &worst);
     // Pixels that differ by more than 1/32 of a full contrast step (supersampling quantisation).
     const int big = cv::countNonZero(diff > 8.0);
-    std::printf("%s: fast vs reference: mean |diff| %.4f, max %.2f, %d pixels > 8\n", name.c_str(), mean, worst, big);
+    std::printf("%s: fast vs reference: mean |diff| %.4f, max %.2f, %d pixels > 8\n",
+                name.c_str(),
+                mean,
+                worst,
+                big);
     // Differences come from the reference's 1/32 coverage steps and the texture filters'
     // approximations; a visibility error (wrong wall, wrong order, missed edge) would
     // change whole regions.
@@ -71,7 +76,8 @@ TEST(GroundTruthLines, EveryListedLineShowsAsAnEdge) {
         const double ca = std::cos(l.bearing), sa = std::sin(l.bearing);
         for (double rr = l.r_inner + 2; rr <= l.r_outer - 2; rr += 1.0) {
           const double x = cam.cx + rr * ca, y = cam.cy + rr * sa;
-          steps.push_back(std::abs(bilinear(img, x - 1.5 * sa, y + 1.5 * ca) - bilinear(img, x + 1.5 * sa, y - 1.5 * ca)));
+          steps.push_back(std::abs(bilinear(img, x - 1.5 * sa, y + 1.5 * ca) -
+                                   bilinear(img, x + 1.5 * sa, y - 1.5 * ca)));
         }
         if (steps.empty()) continue;
         std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
@@ -79,7 +85,10 @@ TEST(GroundTruthLines, EveryListedLineShowsAsAnEdge) {
         if (steps[steps.size() / 2] < 5.0) ++weak;
       }
     }
-    std::printf("%s: %d ground-truth lines in 4 frames, %d without a visible step\n", name.c_str(), total, weak);
+    std::printf("%s: %d ground-truth lines in 4 frames, %d without a visible step\n",
+                name.c_str(),
+                total,
+                weak);
     EXPECT_GT(total, 200) << name;
     EXPECT_LT(weak, total * 3 / 100) << name;
   }

@@ -45,7 +45,10 @@ TEST(WheelNoise, IncrementVarianceIsKTimesDistance) {
     }
   }
   const double mean = sum / n, var = sum2 / n - mean * mean;
-  std::printf("wheel increments: n = %ld, variance / (K|d|) = %.4f, mean %.2e\n", n, var / c.odometry_k, mean);
+  std::printf("wheel increments: n = %ld, variance / (K|d|) = %.4f, mean %.2e\n",
+              n,
+              var / c.odometry_k,
+              mean);
   ASSERT_GT(n, 20000);
   // Relative standard error of a variance estimate is sqrt(2/n) (< 1% here): 5% is > 5 sigma.
   EXPECT_NEAR(var / c.odometry_k, 1.0, 0.05);

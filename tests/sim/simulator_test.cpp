@@ -90,7 +90,10 @@ TEST_F(SimulatorTest, WheelTravelIntegratesToTheGroundTruthPoses) {
     max_pos = std::max(max_pos, std::hypot(x - gt.poses[i].x, y - gt.poses[i].y));
     max_th = std::max(max_th, std::abs(angle_diff(th, gt.poses[i].theta)));
   }
-  std::printf("odometry vs ground truth over %zu frames: max %.2e m, %.2e rad\n", d.size(), max_pos, max_th);
+  std::printf("odometry vs ground truth over %zu frames: max %.2e m, %.2e rad\n",
+              d.size(),
+              max_pos,
+              max_th);
   EXPECT_LT(max_pos, 1e-4);
   EXPECT_LT(max_th, 1e-5);
   EXPECT_NEAR(std::abs(gt.poses.back().theta), kPi, 1e-6);  // the paper's 180 degree turn
@@ -112,7 +115,8 @@ TEST_F(SimulatorTest, WheelTravelIntegratesToTheGroundTruthPoses) {
   const auto& X = *gt.extrinsics;
   for (const auto& l : gt.lines) {
     const auto& p = gt.poses[static_cast<std::size_t>(l.frame)];
-    const double xc = p.x + X.rho * std::cos(p.theta + X.phi), yc = p.y + X.rho * std::sin(p.theta + X.phi);
+    const double xc = p.x + X.rho * std::cos(p.theta + X.phi),
+                 yc = p.y + X.rho * std::sin(p.theta + X.phi);
     const Eigen::Vector2d f = edges.at(l.line_id);
     const double beta = std::atan2(f.y() - yc, f.x() - xc) - (p.theta + X.phi + X.psi);
     ASSERT_NEAR(angle_diff(l.bearing, beta), 0.0, 1e-6);
@@ -145,25 +149,29 @@ TEST_F(SimulatorTest, SameSeedSameDataDifferentSeedDifferentNoise) {
   EXPECT_EQ(slurp(dir / "a" / "wheel0" / "data.csv"), slurp(dir / "b" / "wheel0" / "data.csv"));
   EXPECT_NE(slurp(dir / "a" / img), slurp(dir / "c" / img));
   EXPECT_NE(slurp(dir / "a" / "wheel0" / "data.csv"), slurp(dir / "c" / "wheel0" / "data.csv"));
-  EXPECT_EQ(slurp(dir / "a" / "ground_truth" / "lines.csv"), slurp(dir / "c" / "ground_truth" / "lines.csv"));
+  EXPECT_EQ(slurp(dir / "a" / "ground_truth" / "lines.csv"),
+            slurp(dir / "c" / "ground_truth" / "lines.csv"));
 }
 
 TEST_F(SimulatorTest, FailedRunLeavesNoDatasetAndExistingOutputIsKept) {
   SimConfig cfg;
   Trajectory t;
   t.name = "into-the-wall";
-  t.segments = {{Segment::Kind::kStraight, 0.5, 0, 0}, {Segment::Kind::kTurn, 0, kPi / 2, 0},
+  t.segments = {{Segment::Kind::kStraight, 0.5, 0, 0},
+                {Segment::Kind::kTurn, 0, kPi / 2, 0},
                 {Segment::Kind::kStraight, 3.0, 0, 0}};
   const std::string out = (dir / "bad").string();
   try {
     simulate(world_preset("corridor"), t, cfg, out);
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("trajectory 'into-the-wall' leaves the free space"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("trajectory 'into-the-wall' leaves the free space"),
+              std::string::npos)
         << e.what();
   }
   EXPECT_FALSE(fs::exists(out));
-  for (const auto& entry : fs::directory_iterator(dir)) ADD_FAILURE() << "left behind: " << entry.path();
+  for (const auto& entry : fs::directory_iterator(dir))
+    ADD_FAILURE() << "left behind: " << entry.path();
 
   cfg.max_frames = 1;
   const std::string ok = (dir / "ok").string();
@@ -199,7 +207,8 @@ TEST_F(SimulatorTest, WrappingTickCountersReadBackAsMeters) {
   // 40 frames at 3.8 cm: about 1.5 m, several wraps of the 12-bit counters.
   const auto& last = d.wheel().back().travel;
   EXPECT_GT(last.left, 1.4);
-  const double expected = (d.wheel().back().timestamp_ns - d.wheel().front().timestamp_ns) * 1e-9 * 0.114;
+  const double expected =
+      (d.wheel().back().timestamp_ns - d.wheel().front().timestamp_ns) * 1e-9 * 0.114;
   EXPECT_NEAR(last.left, expected, 1.0 / 20000 + 1e-9);
   EXPECT_NEAR(last.right, expected, 1.0 / 19000 + 1e-9);
 }

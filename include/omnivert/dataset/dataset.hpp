@@ -46,7 +46,7 @@ struct WheelSensor {
   WheelUnit unit = WheelUnit::kMeters;
   double ticks_per_meter_left = 0;
   double ticks_per_meter_right = 0;
-  int counter_bits = 0;  // 0: counters do not wrap
+  int counter_bits = 0;              // 0: counters do not wrap
   std::optional<double> odometry_k;  // Chong-Kleeman K [m], eq. (31)
 };
 

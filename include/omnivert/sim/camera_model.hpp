@@ -50,6 +50,11 @@ struct CatadioptricCamera {
   // model's domain (el >= asin(xi)).
   bool project(const Eigen::Vector3d& p_cam, Eigen::Vector2d& px) const;
 
+  // Radius of the mirror's outer boundary as drawn: the world inside, dark outside.
+  double rim_radius() const { return r_max + 3.0; }
+  // Radius of the camera's own (dark) reflection.
+  double self_radius() const { return r_min - 3.0; }
+
   // The pipeline's view of this camera (what cam0/sensor.yaml holds).
   CameraGeometry geometry() const;
   // Checks the parameters; returns an empty string or what is wrong.

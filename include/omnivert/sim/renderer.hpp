@@ -33,11 +33,11 @@ struct CameraPose {
 
 // One world vertical line in one image (ground_truth/lines.csv).
 struct VisibleLine {
-  int line_id = 0;       // VerticalEdge::id
-  double bearing = 0;    // camera bearing beta [rad], (-pi, pi] (eq. 16-17)
-  double r_inner = 0;    // radial extent of its visible part inside r_min..r_max [px]
+  int line_id = 0;     // VerticalEdge::id
+  double bearing = 0;  // camera bearing beta [rad], (-pi, pi] (eq. 16-17)
+  double r_inner = 0;  // radial extent of its visible part inside r_min..r_max [px]
   double r_outer = 0;
-  double distance = 0;   // horizontal distance from the camera centre [m]
+  double distance = 0;  // horizontal distance from the camera centre [m]
 };
 
 class Renderer {
@@ -63,8 +63,8 @@ class Renderer {
   const World& world() const { return world_; }
 
   // Radii between which the world is drawn; inside: the camera's reflection, outside: rim.
-  double world_r_in() const { return camera_.r_min - 3.0; }
-  double world_r_out() const { return camera_.r_max + 3.0; }
+  double world_r_in() const { return camera_.self_radius(); }
+  double world_r_out() const { return camera_.rim_radius(); }
 
  private:
   struct FrameState;

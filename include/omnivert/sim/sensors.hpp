@@ -36,9 +36,9 @@ struct WheelConfig {
 
 // Cumulative wheel travel sampled at the wheel rate.
 struct WheelSamples {
-  std::vector<double> t;                  // [s] from the start of the motion
+  std::vector<double> t;                      // [s] from the start of the motion
   std::vector<double> true_left, true_right;  // true cumulative travel [m]
-  std::vector<double> left, right;        // reported cumulative travel [m] (noise, errors)
+  std::vector<double> left, right;            // reported cumulative travel [m] (noise, errors)
 };
 
 // True cumulative travel (left, right) [m] of the wheels at time t for wheel base e:
@@ -56,10 +56,10 @@ WheelSamples simulate_wheels(const std::vector<MotionPiece>& motion,
 std::int64_t to_ticks(double meters, double ticks_per_meter, int counter_bits);
 
 struct ImageSensor {
-  double noise_sigma = 2.0;   // additive Gaussian noise [grey levels]
-  double gain_flicker = 0.03; // per-frame gain ~ N(1, gain_flicker)
-  double exposure = 1.0;      // mean gain; > 1 saturates bright walls and windows
-  double blur_sigma = 0.0;    // Gaussian optical blur [px]; 0: none
+  double noise_sigma = 2.0;    // additive Gaussian noise [grey levels]
+  double gain_flicker = 0.03;  // per-frame gain ~ N(1, gain_flicker)
+  double exposure = 1.0;       // mean gain; > 1 saturates bright walls and windows
+  double blur_sigma = 0.0;     // Gaussian optical blur [px]; 0: none
 };
 
 // Turns a noise-free rendering into the 8-bit image the camera delivers: gain (exposure and

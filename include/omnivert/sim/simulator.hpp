@@ -33,9 +33,9 @@ struct Extrinsics {
 
 struct SimConfig {
   std::uint64_t seed = 1;
-  int max_frames = 0;          // 0: the whole trajectory
-  double frame_rate = 3.0;     // [Hz], Sec. 9
-  double camera_height = 0.9;  // camera centre above the floor [m]
+  int max_frames = 0;                                 // 0: the whole trajectory
+  double frame_rate = 3.0;                            // [Hz], Sec. 9
+  double camera_height = 0.9;                         // camera centre above the floor [m]
   std::int64_t start_ns = 1'600'000'000'000'000'000;  // timestamp of the motion's start
   CatadioptricCamera camera;
   Extrinsics extrinsics;
@@ -58,9 +58,9 @@ std::string free_space_violation(const World& world,
 struct SimSummary {
   int frames = 0;
   int wheel_samples = 0;
-  double distance = 0;        // robot centre path length [m]
-  double mean_lines = 0;      // visible ground-truth lines per frame
-  double seconds = 0;         // wall-clock time
+  double distance = 0;    // robot centre path length [m]
+  double mean_lines = 0;  // visible ground-truth lines per frame
+  double seconds = 0;     // wall-clock time
 };
 
 // Simulates and writes the dataset to out_dir. Throws InputError when out_dir exists (and

@@ -38,9 +38,9 @@ struct MotionPiece {
 
 struct Trajectory {
   std::string name = "trajectory";
-  double speed = 0.114;     // [m/s] on straights and arcs (0.114: 3.8 cm per frame at 3 Hz)
-  double turn_rate = 0.3;   // [rad/s] on turns in place
-  bool has_start = false;   // start given by the trajectory (else the world's start pose)
+  double speed = 0.114;    // [m/s] on straights and arcs (0.114: 3.8 cm per frame at 3 Hz)
+  double turn_rate = 0.3;  // [rad/s] on turns in place
+  bool has_start = false;  // start given by the trajectory (else the world's start pose)
   Pose2 start = Pose2::Zero();
   std::vector<Segment> segments;
 

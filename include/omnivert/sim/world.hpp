@@ -70,7 +70,7 @@ struct VerticalEdge {
 
 struct World {
   std::string name = "world";
-  double height = 2.6;  // ceiling height [m]
+  double height = 2.6;     // ceiling height [m]
   std::uint64_t seed = 1;  // seed of the wall noise textures
   Plane floor{90, 25, 0.5};
   Plane ceiling{210, 12, 0.6};
