@@ -317,7 +317,10 @@ SimSummary simulate(const World& world,
   if (cfg.wheel.counter_bits < 0 || cfg.wheel.counter_bits > 62) {
     throw InputError("counter_bits must be in 0..62");
   }
-  if (!(cfg.camera_height > 0)) throw InputError("camera height must be positive");
+  if (!(cfg.camera_height > 0) || !(cfg.camera_height < world.height)) {
+    throw InputError("the camera height must lie between the floor and the ceiling of world '" +
+                     world.name + "' (0 to " + std::to_string(world.height) + " m)");
+  }
 
   const fs::path out = fs::path(out_dir);
   std::error_code ec;

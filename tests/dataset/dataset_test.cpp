@@ -171,6 +171,19 @@ TEST_F(DatasetTest, BadImageLaterInTheSequenceIsFoundWhenRead) {
       p("cam0/data/c.png") + ": image is 64x40 pixels but cam0/sensor.yaml gives resolution 64x48");
 }
 
+TEST_F(DatasetTest, FileThatIsNotAnImage) {
+  write("cam0/data/a.png", "not a png");
+  EXPECT_EQ(error(), p("cam0/data/a.png") + ": cannot be read as an image");
+}
+
+TEST_F(DatasetTest, WindowsLineEndingsAndSpacesAreAccepted) {
+  write("cam0/data.csv", "#timestamp [ns],filename\r\n1000000000, a.png\r\n2000000000 ,b.png\r\n\r\n");
+  const Dataset d = Dataset::load(root.string());
+  ASSERT_EQ(d.size(), 2u);
+  EXPECT_EQ(d.images()[0].filename, "a.png");
+  EXPECT_EQ(d.images()[1].timestamp_ns, 2000000000);
+}
+
 TEST_F(DatasetTest, ColourImageIsConvertedToGrey) {
   image("cam0/data/a.png", 64, 48, CV_8UC3);
   const Dataset d = Dataset::load(root.string());
