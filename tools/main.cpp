@@ -17,6 +17,9 @@ int main(int argc, char** argv) {
   bool verbose = false;
   app.add_flag("-v,--verbose", verbose, "More log output");
   app.set_version_flag("--version", "omnivert 0.1.0");
+
+  omnivert::cli::add_extract_command(app);
+  omnivert::cli::add_pattern_command(app);
   omnivert::cli::add_simulate_command(app);
 
   try {

@@ -10,13 +10,16 @@ struct VerticalLine {
   double image_angle = 0.0;
   // Camera bearing, beta = bearing_sign * a (NOTES Sec. 1), in (-pi, pi].
   double bearing = 0.0;
-  // Number of 1-pixel radial steps of the annulus that hold an edge pixel of this line.
+  // Length of the line in pixels: the radial extent covered by its edge pixels (short gaps
+  // bridged); the paper thresholds it at 50% of R_max - R_min (Sec. 2).
   int edge_pixels = 0;
   // Radial extent of the supporting edge pixels, in pixels from the mirror centre.
   double r_inner = 0.0;
   double r_outer = 0.0;
   // RMS lateral distance of the supporting edge pixels from the fitted radial line, in pixels.
   double fit_rms_px = 0.0;
+  // Edge polarity: +1 if the image is brighter on the side of increasing image angle.
+  int polarity = 0;
 };
 
 }  // namespace omnivert

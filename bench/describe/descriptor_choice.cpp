@@ -1,0 +1,142 @@
+// The study behind the descriptor defaults (NOTES Sec. 3): both readings of the Gaussian
+// window (vote weight / image blur) and both normalisation units (pair / half), measured by
+// nearest-neighbour matching of lines between an image and its rotated or re-lit copy.
+//
+// Usage: descriptor_choice [REAL_IMAGE_DIR]
+// Prints one table row per configuration and transform family.
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "omnivert/core/angles.hpp"
+#include "omnivert/describe/feature_pipeline.hpp"
+#include "omnivert/describe/invariance.hpp"
+#include "omnivert/sim/radial_pattern.hpp"
+
+using namespace omnivert;
+
+namespace {
+
+struct Input {
+  std::string name;
+  cv::Mat gray;
+  CameraGeometry geometry;
+  bool real;
+  sim::RadialPatternOptions pattern;  // for drawn inputs: redraw rotated / with new noise
+};
+
+struct Acc {
+  int pairs = 0, nn_correct = 0;
+  std::vector<double> dist, ratio;
+  void add(const LinePairing& p) {
+    ++pairs;
+    nn_correct += p.nearest_is_correct;
+    dist.push_back(p.descriptor_distance);
+    ratio.push_back(p.descriptor_distance / p.nearest_wrong_distance);
+  }
+};
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+double pct(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, static_cast<std::size_t>(q * v.size()))];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<Input> inputs;
+  for (int seed = 1; seed <= 8; ++seed) {
+    sim::RadialPatternOptions o;
+    o.seed = 500 + seed;
+    const auto p = sim::draw_radial_pattern(o);
+    CameraGeometry g;
+    g.width = o.width, g.height = o.height, g.r_min = o.r_min, g.r_max = o.r_max;
+    inputs.push_back({"pattern" + std::to_string(seed), p.image, g, false, o});
+  }
+  const std::string real_dir = argc > 1 ? argv[1] : "";
+  for (const char* f : {"VMRImage0.jpg", "imgMei_001.jpg", "KaidanOmni1.jpg"}) {
+    const auto path = std::filesystem::path(real_dir) / f;
+    if (real_dir.empty() || !std::filesystem::exists(path)) continue;
+    inputs.push_back({f, cv::imread(path.string(), cv::IMREAD_GRAYSCALE), CameraGeometry{}, true, {}});
+  }
+
+  struct Config {
+    const char* name;
+    DescriptorSmoothing s;
+    DescriptorNormalization n;
+  };
+  const Config configs[] = {{"blur/pair", DescriptorSmoothing::kGaussianBlur, DescriptorNormalization::kPerPair},
+                            {"blur/half", DescriptorSmoothing::kGaussianBlur, DescriptorNormalization::kPerHalf},
+                            {"weight/pair", DescriptorSmoothing::kGaussianWeight, DescriptorNormalization::kPerPair},
+                            {"weight/half", DescriptorSmoothing::kGaussianWeight, DescriptorNormalization::kPerHalf}};
+  const double rotations[] = {17, 43, 71, 137, 251};
+  const double gains[] = {0.6, 0.8, 1.25, 1.5};
+  const double gammas[] = {0.7, 0.85, 1.2, 1.4};
+
+  std::printf("%-12s %-6s %-9s %6s %7s %9s %9s %9s %9s %9s\n", "config", "data", "transform", "pairs",
+              "NN[%]", "med.dist", "p90.dist", "max.dist", "med.ratio", "p90.ratio");
+  for (const Config& c : configs) {
+    for (int real = 0; real <= 1; ++real) {
+      Acc acc[4];  // rotation, gain, gamma, noise
+      for (const Input& in : inputs) {
+        if (in.real != static_cast<bool>(real)) continue;
+        FeaturePipelineOptions po;
+        po.descriptor.smoothing = c.s;
+        po.descriptor.normalization = c.n;
+        if (in.real) po.lines.threshold = LineThreshold::kTopK, po.lines.top_k = 25;
+        FeaturePipeline probe(in.geometry, po);
+        FrameFeatures f0;
+        if (!probe.process(in.gray, f0)) continue;
+        // Rotations must not bring content into view: keep the inscribed disc only.
+        const cv::Mat gray = in.real ? mask_to_inscribed_disc(in.gray, f0.circle.center) : in.gray;
+        FeaturePipeline base(in.geometry, po);
+        if (!base.process(gray, f0)) continue;
+        auto run = [&](const cv::Mat& img, double shift, Acc& a) {
+          FeaturePipeline p(in.geometry, po);
+          FrameFeatures f;
+          if (!p.process(img, f)) return;
+          for (const auto& pr : pair_lines(f0, f, shift, deg2rad(0.3))) a.add(pr);
+        };
+        for (double r : rotations) {
+          if (in.real) {
+            run(rotate_about(gray, f0.circle.center, deg2rad(r)), deg2rad(r), acc[0]);
+          } else {
+            auto o = in.pattern;
+            o.rotation_rad = deg2rad(r);
+            o.noise_seed = 1000 + static_cast<int>(r);
+            run(sim::draw_radial_pattern(o).image, deg2rad(r), acc[0]);
+          }
+        }
+        if (!in.real) {
+          for (int k = 0; k < 3; ++k) {
+            auto o = in.pattern;
+            o.noise_seed = 2000 + k;
+            run(sim::draw_radial_pattern(o).image, 0.0, acc[3]);
+          }
+        }
+        for (double g : gains) run(relight(gray, g, 1.0), 0.0, acc[1]);
+        for (double g : gammas) run(relight(gray, 1.0, g), 0.0, acc[2]);
+      }
+      const char* fam[] = {"rotation", "gain", "gamma", "noise"};
+      for (int k = 0; k < 4; ++k) {
+        const Acc& a = acc[k];
+        if (!a.pairs) continue;
+        std::printf("%-12s %-6s %-9s %6d %7.1f %9.3f %9.3f %9.3f %9.3f %9.3f\n", c.name, real ? "real" : "drawn", fam[k],
+                    a.pairs, 100.0 * a.nn_correct / a.pairs, median(a.dist), pct(a.dist, 0.9), pct(a.dist, 1.0),
+                    median(a.ratio), pct(a.ratio, 0.9));
+      }
+    }
+  }
+  return 0;
+}

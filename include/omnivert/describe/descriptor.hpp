@@ -1,0 +1,85 @@
+#pragma once
+// The rotation-invariant descriptor of a radial line (Sec. 3).
+//
+// Three circular areas of radius r_a = (R_max - R_min)/6 sit on the line at radii
+// R_min + r_a, R_min + 3 r_a, R_min + 5 r_a (they touch and cover the annulus; NOTES Sec. 3).
+// In each area the gradient orientation of every pixel is taken relative to the line's image
+// angle theta (Sec. 3.1: rotation invariance), and the pixel votes, with its gradient
+// magnitude, into the orientation histogram of its side of the line (Sec. 3.2: left/right
+// halves), split between the two nearest of N_b bins (eq. 2, soft binning). The histograms
+// are stacked, eq. (3)-(4):
+//   H = [H_1L, H_1R, H_2L, H_2R, H_3L, H_3R],  N = 3 areas x 2 halves x 32 bins = 192 (eq. 5).
+// "L" is the half on the side of increasing image angle, "R" the other.
+// Illumination (Sec. 3.3): each histogram unit is scaled to unit length, every bin clipped
+// at 0.1, and the unit renormalised.
+//
+// Two readings of the paper are options (NOTES Sec. 3):
+// - smoothing: "smooth each area with a Gaussian window, sigma_G = r_a/3" as a Gaussian
+//   weight on each vote by its distance from the area centre (kGaussianWeight) or as a
+//   Gaussian blur of the image before the gradients (kGaussianBlur);
+// - normalisation unit: the pair H_i = [H_iL, H_iR] of eq. (3) (kPerPair, three 64-vectors)
+//   or each half (kPerHalf, six 32-vectors).
+// The defaults were chosen by measuring nearest-neighbour matching on rotated and re-lit
+// images (docs/descriptor.md gives the numbers).
+
+#include <span>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "omnivert/describe/frame_features.hpp"
+#include "omnivert/extract/mirror_circle.hpp"
+#include "omnivert/extract/vertical_line.hpp"
+
+namespace omnivert {
+
+enum class DescriptorSmoothing { kGaussianWeight, kGaussianBlur };
+enum class DescriptorNormalization { kPerPair, kPerHalf };
+
+struct DescriptorOptions {
+  int bins = 32;  // N_b (Sec. 3.2); 8 and 16 for the study of Sec. 6.0.4
+  int areas = 3;  // 3 touching areas, or 5 overlapping by 50% (Sec. 6.0.4)
+  DescriptorSmoothing smoothing = DescriptorSmoothing::kGaussianBlur;
+  DescriptorNormalization normalization = DescriptorNormalization::kPerPair;
+  double clip = 0.1;             // Sec. 3.3
+  double sigma_fraction = 1.0 / 3.0;  // sigma_G = sigma_fraction * r_a (Sec. 3.1)
+
+  bool IsValid(std::string* why) const;
+  // Descriptor length: areas x 2 halves x bins.
+  int size() const { return areas * 2 * bins; }
+};
+
+class DescriptorExtractor {
+ public:
+  explicit DescriptorExtractor(DescriptorOptions options = {});
+
+  // One row of `out` per line (resized to lines.size() x options().size()).
+  void compute(const cv::Mat& gray,
+               const MirrorCircle& circle,
+               std::span<const VerticalLine> lines,
+               DescriptorMatrix& out);
+
+  // The same at arbitrary image angles (radians): for similarity matrices (Sec. 5).
+  void compute_at_angles(const cv::Mat& gray,
+                         const MirrorCircle& circle,
+                         std::span<const double> image_angles,
+                         DescriptorMatrix& out);
+
+  const DescriptorOptions& options() const { return options_; }
+
+  // Centres (image pixels) and radius of the circular areas of a line at image angle a.
+  std::vector<cv::Point2d> area_centers(const MirrorCircle& circle, double image_angle) const;
+  double area_radius(const MirrorCircle& circle) const;
+
+ private:
+  void prepare(const cv::Mat& gray, const MirrorCircle& circle);
+  void describe_one(const MirrorCircle& circle, double image_angle, float* row) const;
+  void normalize(float* row) const;
+
+  DescriptorOptions options_;
+  cv::Rect roi_;   // region of the gradient images in the frame
+  cv::Mat gx_, gy_, blurred_;
+};
+
+}  // namespace omnivert

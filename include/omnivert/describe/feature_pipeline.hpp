@@ -1,0 +1,63 @@
+#pragma once
+// One frame from pixels to features: mirror circle (Sec. 2 step 1), radial lines (Sec. 2
+// steps 2-5), descriptors (Sec. 3). Keeps the state a video needs: the rim radius found on
+// the first frame and the previous centre, which seeds the per-frame centre search.
+
+#include <optional>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "omnivert/core/camera_geometry.hpp"
+#include "omnivert/describe/descriptor.hpp"
+#include "omnivert/describe/frame_features.hpp"
+#include "omnivert/extract/line_extractor.hpp"
+#include "omnivert/extract/mirror_center.hpp"
+
+namespace omnivert {
+
+struct FeaturePipelineOptions {
+  MirrorCenterOptions center;
+  LineExtractorOptions lines;
+  DescriptorOptions descriptor;
+  // Detect the centre on every frame (the platform vibrates, Sec. 2). If false, the centre
+  // of the first frame (or the one given in sensor.yaml) is kept.
+  bool track_center = true;
+
+  bool IsValid(std::string* why) const;
+};
+
+class FeaturePipeline {
+ public:
+  FeaturePipeline(CameraGeometry geometry, FeaturePipelineOptions options = {});
+
+  // Processes one image (8-bit or 16-bit, grey or colour; converted to 8-bit grey). Returns
+  // false with a reason in *why for an image that does not fit the camera (wrong size, the
+  // annulus mostly outside the image) or whose mirror cannot be found on the first frame.
+  // A later frame whose rim is not found keeps the previous centre (and says so in *why,
+  // while still returning true).
+  bool process(const cv::Mat& image, FrameFeatures& out, std::string* why = nullptr);
+
+  // Converts any supported image to 8-bit grey; false if the type is not supported.
+  static bool to_gray8(const cv::Mat& image, cv::Mat& gray);
+
+  const CameraGeometry& geometry() const { return geometry_; }
+  const std::optional<MirrorCircle>& circle() const { return circle_; }
+  const FeaturePipelineOptions& options() const { return options_; }
+  LineExtractor& line_extractor() { return lines_; }
+  DescriptorExtractor& descriptor_extractor() { return descriptors_; }
+
+ private:
+  CameraGeometry geometry_;
+  FeaturePipelineOptions options_;
+  MirrorCenterDetector center_;
+  LineExtractor lines_;
+  DescriptorExtractor descriptors_;
+  std::optional<MirrorCircle> circle_;
+  cv::Mat gray_;
+};
+
+// Fraction of the annulus r_min..r_max around `circle.center` that lies inside a w x h image.
+double annulus_fraction_inside(const MirrorCircle& circle, int width, int height);
+
+}  // namespace omnivert

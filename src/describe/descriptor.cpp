@@ -1,0 +1,168 @@
+#include "omnivert/describe/descriptor.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <opencv2/imgproc.hpp>
+
+#include "omnivert/core/angles.hpp"
+#include "omnivert/core/fast_math.hpp"
+
+namespace omnivert {
+
+bool DescriptorOptions::IsValid(std::string* why) const {
+  auto fail = [&](const char* m) {
+    if (why) *why = m;
+    return false;
+  };
+  if (bins < 4 || bins > 256) return fail("bins must be in [4, 256]");
+  if (areas != 3 && areas != 5) return fail("areas must be 3 or 5");
+  if (!(clip > 0 && clip <= 1)) return fail("clip must be in (0, 1]");
+  if (!(sigma_fraction > 0 && sigma_fraction <= 2)) return fail("sigma_fraction must be in (0, 2]");
+  return true;
+}
+
+DescriptorExtractor::DescriptorExtractor(DescriptorOptions options) : options_(std::move(options)) {}
+
+double DescriptorExtractor::area_radius(const MirrorCircle& circle) const {
+  return (circle.r_max - circle.r_min) / 6.0;  // r_a, Sec. 3.1
+}
+
+std::vector<cv::Point2d> DescriptorExtractor::area_centers(const MirrorCircle& circle,
+                                                           double image_angle) const {
+  const double ra = area_radius(circle);
+  std::vector<cv::Point2d> c;
+  const double ca = std::cos(image_angle), sa = std::sin(image_angle);
+  for (int k = 0; k < options_.areas; ++k) {
+    // Three touching areas at R_min + (1, 3, 5) r_a, or five at R_min + (1..5) r_a.
+    const double r = circle.r_min + (options_.areas == 3 ? (2 * k + 1) : (k + 1)) * ra;
+    c.emplace_back(circle.center.x() + r * ca, circle.center.y() + r * sa);
+  }
+  return c;
+}
+
+void DescriptorExtractor::prepare(const cv::Mat& gray, const MirrorCircle& circle) {
+  const double ra = area_radius(circle);
+  const double reach = circle.r_max + 2;
+  const int margin = options_.smoothing == DescriptorSmoothing::kGaussianBlur
+                         ? static_cast<int>(std::ceil(3 * options_.sigma_fraction * ra)) + 2
+                         : 2;
+  roi_ = cv::Rect(static_cast<int>(circle.center.x() - reach) - margin,
+                  static_cast<int>(circle.center.y() - reach) - margin,
+                  static_cast<int>(2 * reach) + 2 * margin + 1,
+                  static_cast<int>(2 * reach) + 2 * margin + 1) &
+         cv::Rect(0, 0, gray.cols, gray.rows);
+  const cv::Mat src = gray(roi_);
+  if (options_.smoothing == DescriptorSmoothing::kGaussianBlur) {
+    // Sec. 3.1, read as a blur of the image with sigma_G before the gradients.
+    // In floating point: a blur of sigma ~10 px rounded back to 8 bits leaves a staircase
+    // whose gradients point along the pixel grid (measured: 0.31 mean descriptor change
+    // under a 17 degree rotation, against 0.00 at 90 degrees).
+    src.convertTo(blurred_, CV_32F);
+    cv::GaussianBlur(blurred_, blurred_, cv::Size(), options_.sigma_fraction * ra, 0, cv::BORDER_REPLICATE);
+    cv::Sobel(blurred_, gx_, CV_32F, 1, 0, 3);
+    cv::Sobel(blurred_, gy_, CV_32F, 0, 1, 3);
+  } else {
+    cv::Sobel(src, gx_, CV_32F, 1, 0, 3);
+    cv::Sobel(src, gy_, CV_32F, 0, 1, 3);
+  }
+}
+
+void DescriptorExtractor::describe_one(const MirrorCircle& circle,
+                                       double image_angle,
+                                       float* row) const {
+  const int nb = options_.bins;
+  const double ra = area_radius(circle);
+  const double sigma = options_.sigma_fraction * ra;
+  const float inv_2s2 = static_cast<float>(1.0 / (2 * sigma * sigma));
+  const bool weighted = options_.smoothing == DescriptorSmoothing::kGaussianWeight;
+  const float theta = static_cast<float>(image_angle);
+  const float dx = std::cos(theta), dy = std::sin(theta);
+  const float to_bin = static_cast<float>(nb / kTwoPi);
+  const float ra2 = static_cast<float>(ra * ra);
+  std::fill(row, row + options_.size(), 0.0f);
+  const auto centers = area_centers(circle, image_angle);
+  for (int k = 0; k < options_.areas; ++k) {
+    float* hl = row + (2 * k) * nb;  // H_kL: side of increasing image angle
+    float* hr = row + (2 * k + 1) * nb;
+    const float cx = static_cast<float>(centers[k].x - roi_.x);
+    const float cy = static_cast<float>(centers[k].y - roi_.y);
+    const int u0 = std::max(1, static_cast<int>(std::floor(cx - ra)));
+    const int u1 = std::min(gx_.cols - 2, static_cast<int>(std::ceil(cx + ra)));
+    const int v0 = std::max(1, static_cast<int>(std::floor(cy - ra)));
+    const int v1 = std::min(gx_.rows - 2, static_cast<int>(std::ceil(cy + ra)));
+    for (int v = v0; v <= v1; ++v) {
+      const float* px = gx_.ptr<float>(v);
+      const float* py = gy_.ptr<float>(v);
+      const float ry = v - cy;
+      for (int u = u0; u <= u1; ++u) {
+        const float rx = u - cx;
+        const float d2 = rx * rx + ry * ry;
+        if (d2 > ra2) continue;
+        const float gx = px[u], gy = py[u];
+        float m = std::sqrt(gx * gx + gy * gy);
+        if (m == 0.0f) continue;
+        if (weighted) m *= std::exp(-d2 * inv_2s2);
+        // Sec. 3.1: orientation relative to the line, in [0, 2 pi).
+        float phi = fast_atan2(gy, gx) - theta;
+        phi -= static_cast<float>(kTwoPi) * std::floor(phi * static_cast<float>(1.0 / kTwoPi));
+        // Eq. (2): m (1 - w) to the lower bin b, m w to the upper, circularly.
+        const float t = phi * to_bin;
+        int b = static_cast<int>(t);
+        const float w = t - b;
+        if (b >= nb) b -= nb;
+        const int b1 = b + 1 == nb ? 0 : b + 1;
+        float* h = (dx * ry - dy * rx) >= 0.0f ? hl : hr;  // Sec. 3.2: side of the line
+        h[b] += m * (1.0f - w);
+        h[b1] += m * w;
+      }
+    }
+  }
+  normalize(row);
+}
+
+void DescriptorExtractor::normalize(float* row) const {
+  // Sec. 3.3: unit length, clip at `clip`, renormalise, for each histogram unit.
+  const int unit = options_.normalization == DescriptorNormalization::kPerPair ? 2 * options_.bins
+                                                                               : options_.bins;
+  const float clip = static_cast<float>(options_.clip);
+  for (int s = 0; s < options_.size(); s += unit) {
+    float* h = row + s;
+    for (int pass = 0; pass < 2; ++pass) {
+      double n2 = 0;
+      for (int i = 0; i < unit; ++i) n2 += double(h[i]) * h[i];
+      if (n2 <= 0) break;  // empty (flat) area: leave zeros, never NaN
+      const float inv = static_cast<float>(1.0 / std::sqrt(n2));
+      for (int i = 0; i < unit; ++i) {
+        h[i] *= inv;
+        if (pass == 0 && h[i] > clip) h[i] = clip;
+      }
+    }
+  }
+}
+
+void DescriptorExtractor::compute(const cv::Mat& gray,
+                                  const MirrorCircle& circle,
+                                  std::span<const VerticalLine> lines,
+                                  DescriptorMatrix& out) {
+  CV_Assert(gray.type() == CV_8UC1);
+  out.resize(static_cast<Eigen::Index>(lines.size()), options_.size());
+  if (lines.empty()) return;
+  prepare(gray, circle);
+  for (std::size_t i = 0; i < lines.size(); ++i)
+    describe_one(circle, lines[i].image_angle, out.row(static_cast<Eigen::Index>(i)).data());
+}
+
+void DescriptorExtractor::compute_at_angles(const cv::Mat& gray,
+                                            const MirrorCircle& circle,
+                                            std::span<const double> image_angles,
+                                            DescriptorMatrix& out) {
+  CV_Assert(gray.type() == CV_8UC1);
+  out.resize(static_cast<Eigen::Index>(image_angles.size()), options_.size());
+  if (image_angles.empty()) return;
+  prepare(gray, circle);
+  for (std::size_t i = 0; i < image_angles.size(); ++i)
+    describe_one(circle, image_angles[i], out.row(static_cast<Eigen::Index>(i)).data());
+}
+
+}  // namespace omnivert

@@ -1,0 +1,61 @@
+#include "omnivert/describe/overlay.hpp"
+
+#include <cmath>
+#include <string>
+
+#include <opencv2/imgproc.hpp>
+
+#include "omnivert/describe/feature_pipeline.hpp"
+
+namespace omnivert {
+
+cv::Mat draw_overlay(const cv::Mat& image,
+                     const FrameFeatures& f,
+                     const DescriptorExtractor& descriptor,
+                     int highlight) {
+  cv::Mat gray, bgr;
+  FeaturePipeline::to_gray8(image, gray);
+  cv::cvtColor(gray, bgr, cv::COLOR_GRAY2BGR);
+  const double scale = std::max(1.0, std::max(bgr.cols, bgr.rows) / 800.0);
+  const int thick = static_cast<int>(std::lround(scale));
+  const int shift = 4;  // sub-pixel drawing
+  auto P = [&](double x, double y) {
+    return cv::Point(static_cast<int>(std::lround(x * 16)), static_cast<int>(std::lround(y * 16)));
+  };
+  const auto& c = f.circle;
+  cv::circle(bgr, P(c.center.x(), c.center.y()), static_cast<int>(c.r_min * 16), {255, 160, 0}, thick, cv::LINE_AA, shift);
+  cv::circle(bgr, P(c.center.x(), c.center.y()), static_cast<int>(c.r_max * 16), {255, 160, 0}, thick, cv::LINE_AA, shift);
+  if (c.rim_radius > 0)
+    cv::circle(bgr, P(c.center.x(), c.center.y()), static_cast<int>(c.rim_radius * 16), {0, 200, 255}, thick, cv::LINE_AA, shift);
+  const double m = 6 * scale;
+  cv::line(bgr, P(c.center.x() - m, c.center.y()), P(c.center.x() + m, c.center.y()), {0, 0, 255}, thick, cv::LINE_AA, shift);
+  cv::line(bgr, P(c.center.x(), c.center.y() - m), P(c.center.x(), c.center.y() + m), {0, 0, 255}, thick, cv::LINE_AA, shift);
+
+  if (highlight < 0 && !f.lines.empty()) {
+    highlight = 0;
+    for (std::size_t i = 1; i < f.lines.size(); ++i)
+      if (f.lines[i].edge_pixels > f.lines[highlight].edge_pixels) highlight = static_cast<int>(i);
+  }
+  for (std::size_t i = 0; i < f.lines.size(); ++i) {
+    const auto& l = f.lines[i];
+    const double ca = std::cos(l.image_angle), sa = std::sin(l.image_angle);
+    const cv::Scalar col = l.polarity > 0 ? cv::Scalar(0, 255, 0) : cv::Scalar(255, 0, 255);
+    cv::line(bgr,
+             P(c.center.x() + l.r_inner * ca, c.center.y() + l.r_inner * sa),
+             P(c.center.x() + l.r_outer * ca, c.center.y() + l.r_outer * sa),
+             col, thick + 1, cv::LINE_AA, shift);
+    const double rt = c.r_max + 10 * scale;
+    cv::putText(bgr, std::to_string(i),
+                cv::Point(static_cast<int>(c.center.x() + rt * ca - 6 * scale),
+                          static_cast<int>(c.center.y() + rt * sa + 4 * scale)),
+                cv::FONT_HERSHEY_SIMPLEX, 0.4 * scale, {0, 255, 255}, thick, cv::LINE_AA);
+  }
+  if (highlight >= 0 && highlight < static_cast<int>(f.lines.size())) {
+    const double ra = descriptor.area_radius(c);
+    for (const auto& p : descriptor.area_centers(c, f.lines[highlight].image_angle))
+      cv::circle(bgr, P(p.x, p.y), static_cast<int>(ra * 16), {0, 128, 255}, thick, cv::LINE_AA, shift);
+  }
+  return bgr;
+}
+
+}  // namespace omnivert

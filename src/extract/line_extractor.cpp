@@ -1,0 +1,284 @@
+#include "omnivert/extract/line_extractor.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "omnivert/core/angles.hpp"
+
+namespace omnivert {
+
+bool LineExtractorOptions::IsValid(std::string* why) const {
+  auto fail = [&](const char* m) {
+    if (why) *why = m;
+    return false;
+  };
+  if (!(gradient_threshold > 0)) return fail("gradient_threshold must be positive");
+  if (!(orientation_tolerance_deg > 0 && orientation_tolerance_deg < 45))
+    return fail("orientation_tolerance_deg must be in (0, 45)");
+  if (sectors < 36 || sectors > 7200) return fail("sectors must be in [36, 7200]");
+  if (!(lateral_tolerance_px > 0)) return fail("lateral_tolerance_px must be positive");
+  if (!(max_gap_px >= 0)) return fail("max_gap_px must not be negative");
+  if (!(min_separation_deg >= 0)) return fail("min_separation_deg must not be negative");
+  if (!(length_fraction > 0 && length_fraction <= 1)) return fail("length_fraction must be in (0, 1]");
+  if (!(adaptive_k >= 0)) return fail("adaptive_k must not be negative");
+  if (top_k < 1) return fail("top_k must be at least 1");
+  if (!(min_fraction >= 0 && min_fraction <= 1)) return fail("min_fraction must be in [0, 1]");
+  return true;
+}
+
+LineExtractor::LineExtractor(LineExtractorOptions options) : options_(std::move(options)) {}
+
+void LineExtractor::build_lut(const MirrorCircle& circle) {
+  lut_.clear();
+  const int R = static_cast<int>(std::ceil(circle.r_max)) + 1;
+  const double r0 = circle.r_min, r1 = circle.r_max;
+  const double to_sector = options_.sectors / kTwoPi;
+  for (int dv = -R; dv <= R; ++dv) {
+    for (int du = -R; du <= R; ++du) {
+      const double r = std::hypot(du, dv);
+      if (r < r0 || r > r1 || r < 1.0) continue;
+      LutEntry e;
+      e.du = du;
+      e.dv = dv;
+      e.ux = static_cast<float>(du / r);
+      e.uy = static_cast<float>(dv / r);
+      e.inv_r = static_cast<float>(1.0 / r);
+      // Built once per annulus: the only atan2 of the edge stage.
+      e.sector = static_cast<float>(wrap_positive(std::atan2(dv, du)) * to_sector);
+      lut_.push_back(e);
+    }
+  }
+  lut_r_min_ = r0;
+  lut_r_max_ = r1;
+}
+
+namespace {
+
+struct Candidate {
+  int32_t lut;
+  int32_t px;
+  int16_t gx, gy;
+  float m;
+};
+
+struct LineCandidate {
+  VerticalLine line;
+  int polarity;
+  double length;
+};
+
+}  // namespace
+
+void LineExtractor::extract(const cv::Mat& gray,
+                            const MirrorCircle& circle,
+                            std::vector<VerticalLine>& out) {
+  CV_Assert(gray.type() == CV_8UC1 && gray.isContinuous());
+  out.clear();
+  edges_.clear();
+  if (!(circle.r_max > circle.r_min)) return;
+  if (circle.r_min != lut_r_min_ || circle.r_max != lut_r_max_) build_lut(circle);
+  const int W = gray.cols, H = gray.rows;
+  if (mag_.rows != H || mag_.cols != W) mag_ = cv::Mat::zeros(H, W, CV_32F);
+  float* mag = mag_.ptr<float>();
+  const uchar* img = gray.ptr<uchar>();
+
+  const int cxi = static_cast<int>(std::lround(circle.center.x()));
+  const int cyi = static_cast<int>(std::lround(circle.center.y()));
+  const float fx = static_cast<float>(circle.center.x() - cxi);
+  const float fy = static_cast<float>(circle.center.y() - cyi);
+
+  // Step 2: one pass over the annulus: Sobel (eq. 1), magnitude threshold, orientation test.
+  const float t2 = static_cast<float>(options_.gradient_threshold * options_.gradient_threshold);
+  const float s = static_cast<float>(std::sin(deg2rad(options_.orientation_tolerance_deg)));
+  const float s2 = s * s;
+  static thread_local std::vector<Candidate> cands;
+  cands.clear();
+  for (int32_t i = 0; i < static_cast<int32_t>(lut_.size()); ++i) {
+    const LutEntry& e = lut_[i];
+    const int u = cxi + e.du, v = cyi + e.dv;
+    if (u < 1 || v < 1 || u >= W - 1 || v >= H - 1) continue;
+    const int idx = v * W + u;
+    const uchar* p = img + idx;
+    const int gx = (p[-W + 1] + 2 * p[1] + p[W + 1]) - (p[-W - 1] + 2 * p[-1] + p[W - 1]);
+    const int gy = (p[W - 1] + 2 * p[W] + p[W + 1]) - (p[-W - 1] + 2 * p[-W] + p[-W + 1]);
+    const float m2 = static_cast<float>(gx * gx + gy * gy);
+    if (m2 < t2) continue;
+    const float radial = gx * e.ux + gy * e.uy;
+    if (radial * radial > s2 * m2) continue;  // gradient not tangential: not a radial edge
+    const float m = std::sqrt(m2);
+    mag[idx] = m;
+    cands.push_back({i, idx, static_cast<int16_t>(gx), static_cast<int16_t>(gy), m});
+  }
+
+  // Step 3: thinning along the gradient, sub-pixel position, soft sector votes.
+  const int N = options_.sectors;
+  const float to_sector = static_cast<float>(N / kTwoPi);
+  for (auto& h : hist_) h.assign(N, 0.0f);
+  for (const Candidate& c : cands) {
+    const int ax = std::abs(c.gx), ay = std::abs(c.gy);
+    int off;
+    float sx, sy;
+    if (ax * 5 >= ay * 12) {  // |gx| >= 2.4 |gy|: gradient about horizontal
+      off = 1, sx = 1, sy = 0;
+    } else if (ay * 5 >= ax * 12) {
+      off = W, sx = 0, sy = 1;
+    } else if ((c.gx > 0) == (c.gy > 0)) {
+      off = W + 1, sx = 1, sy = 1;
+    } else {
+      off = W - 1, sx = -1, sy = 1;
+    }
+    const float mm = mag[c.px - off], mp = mag[c.px + off];
+    if (!(c.m > mm && c.m >= mp)) continue;
+    const float den = mm - 2 * c.m + mp;
+    const float d = den < 0 ? std::clamp(0.5f * (mm - mp) / den, -0.5f, 0.5f) : 0.0f;
+    const LutEntry& e = lut_[c.lut];
+    // Position relative to the exact centre, and the first-order angle correction of the
+    // LUT's sector for the sub-pixel centre and edge offset.
+    const float ox = d * sx - fx, oy = d * sy - fy;
+    float sec = e.sector + (-e.uy * ox + e.ux * oy) * e.inv_r * to_sector;
+    if (sec < 0) sec += N;
+    if (sec >= N) sec -= N;
+    const int8_t pol = (-c.gx * e.uy + c.gy * e.ux) > 0 ? 1 : -1;
+    const float t = sec - 0.5f;
+    const float fl = std::floor(t);
+    const float w = t - fl;
+    int k0 = static_cast<int>(fl);
+    if (k0 < 0) k0 += N;
+    const int k1 = k0 + 1 == N ? 0 : k0 + 1;
+    auto& h = hist_[pol > 0 ? 1 : 0];
+    h[k0] += 1.0f - w;
+    h[k1] += w;
+    int sec_i = static_cast<int>(sec);
+    if (sec_i >= N) sec_i = N - 1;
+    edges_.push_back({static_cast<float>(cxi + e.du) + d * sx,
+                      static_cast<float>(cyi + e.dv) + d * sy,
+                      c.m,
+                      1.0f / e.inv_r,
+                      static_cast<int16_t>(sec_i),
+                      pol});
+  }
+  for (const Candidate& c : cands) mag[c.px] = 0.0f;  // leave the buffer clean
+
+  // Buckets of edge points by (sector, polarity), for gathering a line's support.
+  bucket_start_.assign(2 * N + 1, 0);
+  for (const EdgePoint& p : edges_) ++bucket_start_[2 * p.sector + (p.polarity > 0) + 1];
+  std::partial_sum(bucket_start_.begin(), bucket_start_.end(), bucket_start_.begin());
+  bucket_items_.resize(edges_.size());
+  {
+    std::vector<int32_t>& fill = cand_;  // reuse as a cursor array
+    fill.assign(bucket_start_.begin(), bucket_start_.end() - 1);
+    for (int32_t i = 0; i < static_cast<int32_t>(edges_.size()); ++i) {
+      const EdgePoint& p = edges_[i];
+      bucket_items_[fill[2 * p.sector + (p.polarity > 0)]++] = i;
+    }
+  }
+
+  // Step 4: circular non-maximum suppression of the (3-sector) vote score.
+  const double L = circle.r_max - circle.r_min;
+  double floor_fraction = options_.length_fraction;
+  if (options_.threshold != LineThreshold::kFractionOfAnnulus) floor_fraction = options_.min_fraction;
+  const float peak_min = static_cast<float>(0.4 * floor_fraction * L);
+  const double cx = circle.center.x(), cy = circle.center.y();
+  const double tol = options_.lateral_tolerance_px;
+  const double max_gap = std::max(1.0, options_.max_gap_px);
+  static thread_local std::vector<LineCandidate> found;
+  static thread_local std::vector<float> radii;
+  found.clear();
+  std::vector<float> score(N);
+  for (int pol = 0; pol < 2; ++pol) {
+    const auto& h = hist_[pol];
+    for (int k = 0; k < N; ++k) score[k] = h[(k + N - 1) % N] + h[k] + h[(k + 1) % N];
+    for (int k = 0; k < N; ++k) {
+      const float sc = score[k];
+      if (sc < peak_min) continue;
+      bool is_max = true;
+      for (int j = 1; j <= 2 && is_max; ++j) {
+        if (score[(k + j) % N] > sc || score[(k + N - j) % N] >= sc) is_max = false;
+      }
+      if (!is_max) continue;
+
+      // Step 5: gather support around the peak and refine the angle (fit through the centre).
+      double a = (k + 0.5) / N * kTwoPi;
+      double fit_rms = 0;
+      radii.clear();
+      for (int iter = 0; iter < 4; ++iter) {
+        const double ca = std::cos(a), sa = std::sin(a);
+        double sxx = 0, sxy = 0, syy = 0, sl2 = 0, sw = 0;
+        radii.clear();
+        for (int j = -3; j <= 3; ++j) {
+          const int b = 2 * ((k + j + N) % N) + pol;
+          for (int q = bucket_start_[b]; q < bucket_start_[b + 1]; ++q) {
+            const EdgePoint& p = edges_[bucket_items_[q]];
+            const double rx = p.x - cx, ry = p.y - cy;
+            const double fwd = rx * ca + ry * sa;
+            const double lat = -rx * sa + ry * ca;
+            if (fwd <= 0 || std::abs(lat) > tol) continue;
+            const double w = p.weight;
+            sxx += w * rx * rx, sxy += w * rx * ry, syy += w * ry * ry;
+            sl2 += w * lat * lat, sw += w;
+            radii.push_back(static_cast<float>(fwd));
+          }
+        }
+        if (sw <= 0) break;
+        fit_rms = std::sqrt(sl2 / sw);
+        // Principal direction of the scatter about the centre (least-squares line through it).
+        double a_new = 0.5 * std::atan2(2 * sxy, sxx - syy);
+        if (std::cos(a_new - a) < 0) a_new += kPi;
+        const double change = std::abs(angle_diff(a_new, a));
+        a = a_new;
+        if (change < 1e-7) break;
+      }
+      if (radii.size() < 2) continue;
+      std::sort(radii.begin(), radii.end());
+      double covered = 1.0;
+      for (std::size_t q = 1; q < radii.size(); ++q) {
+        const double gap = radii[q] - radii[q - 1];
+        covered += gap <= max_gap ? gap : 1.0;
+      }
+      LineCandidate lc;
+      lc.line.image_angle = wrap_angle(a);
+      lc.line.bearing = lc.line.image_angle;
+      lc.line.edge_pixels = static_cast<int>(std::lround(covered));
+      lc.line.r_inner = radii.front();
+      lc.line.r_outer = radii.back();
+      lc.line.fit_rms_px = fit_rms;
+      lc.line.polarity = pol ? 1 : -1;
+      lc.polarity = pol;
+      lc.length = covered;
+      found.push_back(lc);
+    }
+  }
+
+  // Histogram thresholding (Sec. 2, last step) and the preprint's alternatives.
+  double thr = options_.length_fraction * L;
+  if (options_.threshold == LineThreshold::kAdaptive && !found.empty()) {
+    double m = 0, m2 = 0;
+    for (const auto& f : found) m += f.length, m2 += f.length * f.length;
+    m /= found.size();
+    const double sd = std::sqrt(std::max(0.0, m2 / found.size() - m * m));
+    thr = std::max(options_.min_fraction * L, m + options_.adaptive_k * sd);
+  } else if (options_.threshold == LineThreshold::kTopK) {
+    thr = options_.min_fraction * L;
+  }
+  std::sort(found.begin(), found.end(), [](const LineCandidate& x, const LineCandidate& y) {
+    return x.length > y.length;
+  });
+  const double sep = deg2rad(options_.min_separation_deg);
+  for (const LineCandidate& f : found) {
+    if (f.length < thr) break;
+    if (options_.threshold == LineThreshold::kTopK && static_cast<int>(out.size()) >= options_.top_k)
+      break;
+    bool dup = false;
+    for (const VerticalLine& o : out)
+      if (o.polarity == f.line.polarity &&
+          std::abs(angle_diff(o.image_angle, f.line.image_angle)) < sep)
+        dup = true;
+    if (!dup) out.push_back(f.line);
+  }
+  std::sort(out.begin(), out.end(), [](const VerticalLine& x, const VerticalLine& y) {
+    return x.image_angle < y.image_angle;
+  });
+}
+
+}  // namespace omnivert
