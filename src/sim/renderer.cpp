@@ -10,7 +10,9 @@ namespace omnivert::sim {
 
 namespace {
 
-constexpr int kBins = 4096;          // azimuth bins of the interval look-up
+constexpr int kBins = 4096;
+constexpr double kPanelCell = 0.25;  // [m] cell size of the per-wall panel index          //
+                                     // azimuth bins of the interval look-up
 constexpr float kRimValue = 6.0f;    // outside the mirror: dark (the rim a circle detector finds)
 constexpr float kSelfValue = 32.0f;  // the camera's own reflection inside r_min
 
@@ -80,6 +82,19 @@ Renderer::Renderer(const CatadioptricCamera& camera, const World& world)
   for (std::size_t i = 0; i < world_.walls.size(); ++i) {
     textures_.emplace_back(world_.walls[i], world_.height, world_.seed * 1000003ULL + i);
     wall_top_.push_back(world_.top(world_.walls[i]));
+    // Panels overlapping each 0.25 m cell along the wall, in their drawing order (a later
+    // panel covers an earlier one): a sample looks at a few panels, not all of them.
+    const Wall& wall = world_.walls[i];
+    const int cells = static_cast<int>(std::ceil(wall.length() / kPanelCell)) + 1;
+    std::vector<std::vector<int>> index(static_cast<std::size_t>(cells));
+    for (std::size_t k = 0; k < wall.panels.size(); ++k) {
+      const Panel& p = wall.panels[k];
+      const int c0 = std::clamp(static_cast<int>(std::floor(p.s0 / kPanelCell)), 0, cells - 1);
+      const int c1 = std::clamp(static_cast<int>(std::floor(p.s1 / kPanelCell)), 0, cells - 1);
+      for (int c = c0; c <= c1; ++c)
+        index[static_cast<std::size_t>(c)].push_back(static_cast<int>(k));
+    }
+    panel_index_.push_back(std::move(index));
   }
   // Per-pixel table. Radius r of a pixel centre; its footprint is 1 px radially and
   // 1/r rad in azimuth.
@@ -304,7 +319,11 @@ float Renderer::wall_texture(int wi, double s, double z, double ds, double dz) c
     if (s >= st.s0 && s < st.s1) v = st.intensity;
   }
   v += textures_[static_cast<std::size_t>(wi)].noise(s, z);
-  for (const Panel& p : w.panels) {
+  const auto& cells = panel_index_[static_cast<std::size_t>(wi)];
+  const int cell = std::clamp(
+      static_cast<int>(std::floor(s / kPanelCell)), 0, static_cast<int>(cells.size()) - 1);
+  for (const int k : cells[static_cast<std::size_t>(cell)]) {
+    const Panel& p = w.panels[static_cast<std::size_t>(k)];
     if (s < p.s0 || s >= p.s1) continue;
     const double cov = coverage(z, dz, p.z0, p.z1);
     if (cov <= 0.0) continue;

@@ -364,35 +364,57 @@ World make_hall() {
   const double x0 = -2.0, x1 = 14.0, y0 = -2.0, y1 = 6.0;
   // The same window, every 1.5 m, on both long walls: almost identical vertical edges
   // (Sec. 9.1, Fig. 10: repetitive texture causes the false matches).
+  // Identical mullioned windows every 1.5 m with an identical radiator below each, and
+  // lattices of identical slats: many vertical edges that look alike and lie side by side
+  // at nearly the same distance, so their descriptors are nearly the same.
+  auto flat_panel = [](Wall& w, double s0, double s1, double z0, double z1, double intensity) {
+    Panel p;
+    p.s0 = s0;
+    p.s1 = s1;
+    p.z0 = z0;
+    p.z1 = z1;
+    p.intensity = intensity;
+    w.panels.push_back(p);
+  };
   auto windows = [&](Wall& w) {
-    for (double s = 0.6; s + 0.8 < w.length() - 0.3; s += 1.5) {
-      Panel frame;
-      frame.s0 = s - 0.08;
-      frame.s1 = s + 0.88;
-      frame.z0 = 0.8;
-      frame.z1 = 3.2;
-      frame.intensity = 90;
-      w.panels.push_back(frame);
+    for (double s = 0.4; s + 1.2 < w.length() - 0.3; s += 1.5) {
+      flat_panel(w, s - 0.06, s + 1.26, 0.9, 3.2, 90);  // frame
       Panel glass;
       glass.s0 = s;
-      glass.s1 = s + 0.8;
-      glass.z0 = 0.88;
-      glass.z1 = 3.12;
+      glass.s1 = s + 1.2;
+      glass.z0 = 0.96;
+      glass.z1 = 3.14;
       glass.intensity = 235;
       glass.pattern = Pattern::kStripes;
-      glass.period = 0.6;
-      glass.amplitude = 12;
+      glass.period = 0.7;
+      glass.amplitude = 10;
       w.panels.push_back(glass);
+      for (int m = 1; m < 4; ++m) {  // mullions: four panes
+        const double c = s + 0.3 * m;
+        flat_panel(w, c - 0.025, c + 0.025, 0.96, 3.14, 90);
+      }
+      for (int f = 0; f < 7; ++f) {  // radiator fins
+        const double c = s + 0.24 + 0.12 * f;
+        flat_panel(w, c, c + 0.05, 0.15, 0.7, 235);
+      }
     }
+  };
+  auto lattice = [&](Wall& w, double s0, double s1) {
+    for (double s = s0; s + 0.1 < s1; s += 0.25)
+      flat_panel(w, s, s + 0.1, 0.0, w.z1 < 0 ? 4.0 : w.z1, 95);
   };
   Wall south = b.wall({x0, y0}, {x1, y0}, 175, 2.0);
   windows(south);
   Wall north = b.wall({x1, y1}, {x0, y1}, 175, 2.0);
   windows(north);
   Wall east = b.wall({x1, y0}, {x1, y1}, 160, 2.0);
+  lattice(east, 0.5, 3.2);
   b.door(east, 3.5, 1.6);
+  lattice(east, 5.4, 7.6);
   Wall west = b.wall({x0, y1}, {x0, y0}, 160, 2.0);
+  lattice(west, 0.5, 3.2);
   b.door(west, 3.5, 1.6);
+  lattice(west, 5.4, 7.6);
   for (Wall* w : {&south, &north, &east, &west}) {
     b.skirting(*w);
     world.walls.push_back(*w);

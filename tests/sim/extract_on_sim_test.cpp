@@ -41,7 +41,8 @@ TEST(ExtractOnSimulatedFrames, ExtractedLinesAreGroundTruthLinesAtTheirBearing) 
       for (const VerticalLine& l : lines) {
         ++extracted;
         double best = kPi;
-        for (const VisibleLine& g : truth) best = std::min(best, std::abs(angle_diff(l.bearing, g.bearing)));
+        for (const VisibleLine& g : truth)
+          best = std::min(best, std::abs(angle_diff(l.bearing, g.bearing)));
         if (rad2deg(best) < 0.25) {
           ++near_truth;
           max_err = std::max(max_err, rad2deg(best));
@@ -59,10 +60,16 @@ TEST(ExtractOnSimulatedFrames, ExtractedLinesAreGroundTruthLinesAtTheirBearing) 
         }
       }
     }
-    std::printf("%s: %d lines extracted in 5 frames, %d within 0.25 deg of a ground-truth line "
-                "(mean %.4f, max %.4f deg); long ground-truth lines found: %d of %d\n",
-                name.c_str(), extracted, near_truth, near_truth ? sum_err / near_truth : 0.0, max_err,
-                long_found, long_truth);
+    std::printf(
+        "%s: %d lines extracted in 5 frames, %d within 0.25 deg of a ground-truth line "
+        "(mean %.4f, max %.4f deg); long ground-truth lines found: %d of %d\n",
+        name.c_str(),
+        extracted,
+        near_truth,
+        near_truth ? sum_err / near_truth : 0.0,
+        max_err,
+        long_found,
+        long_truth);
     ASSERT_GT(extracted, 15) << name;
     EXPECT_GE(near_truth, extracted * 95 / 100) << name;
     // Mean, not max: a line next to another (a box corner in front of a door frame) can pull

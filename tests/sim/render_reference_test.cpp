@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "omnivert/core/angles.hpp"
 #include "omnivert/sim/renderer.hpp"
 #include "omnivert/sim/simulator.hpp"
 
@@ -59,7 +60,8 @@ float bilinear(const cv::Mat1f& m, double x, double y) {
 }
 
 // Every ground-truth line is an edge the image shows: along its visible extent, the median
-// intensity step across it (3 px apart) is at least 5 grey levels for nearly all lines.
+// intensity step across it (3 px apart) is at least 5 grey levels for nearly all lines that
+// have no other line within 3 px.
 // (Lines hidden by occlusion but listed, or listed at a wrong place, would fail this.)
 TEST(GroundTruthLines, EveryListedLineShowsAsAnEdge) {
   const CatadioptricCamera cam;
@@ -71,7 +73,16 @@ TEST(GroundTruthLines, EveryListedLineShowsAsAnEdge) {
     for (double t : {0.0, 10.0, 20.0, 25.0}) {
       const CameraPose pose = camera_pose(pose_at(motion, t), Extrinsics{}, 0.9);
       const cv::Mat1f img = r.render(pose);
-      for (const VisibleLine& l : r.visible_lines(pose)) {
+      const auto lines = r.visible_lines(pose);
+      for (const VisibleLine& l : lines) {
+        // Only lines the image can resolve: no other line within 3 px (tangentially, at
+        // the outer end), where the probes 1.5 px either side would straddle both.
+        bool crowded = false;
+        for (const VisibleLine& o : lines) {
+          if (&o != &l && std::abs(angle_diff(o.bearing, l.bearing)) * l.r_outer < 3.0)
+            crowded = true;
+        }
+        if (crowded) continue;
         std::vector<double> steps;
         const double ca = std::cos(l.bearing), sa = std::sin(l.bearing);
         for (double rr = l.r_inner + 2; rr <= l.r_outer - 2; rr += 1.0) {
@@ -89,7 +100,7 @@ TEST(GroundTruthLines, EveryListedLineShowsAsAnEdge) {
                 name.c_str(),
                 total,
                 weak);
-    EXPECT_GT(total, 200) << name;
+    EXPECT_GT(total, 100) << name;
     EXPECT_LT(weak, total * 3 / 100) << name;
   }
 }

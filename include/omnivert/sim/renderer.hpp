@@ -92,6 +92,7 @@ class Renderer {
   std::vector<VerticalEdge> edges_;
   std::vector<WallTexture> textures_;
   std::vector<double> wall_top_;
+  std::vector<std::vector<std::vector<int>>> panel_index_;  // wall -> 0.25 m cell -> panels
 
   // Per-pixel look-up table (pixels whose footprint touches the world annulus).
   std::vector<int> px_index_;
