@@ -298,6 +298,10 @@ TEST_F(DatasetTest, GroundTruthIsReadAndChecked) {
     ASSERT_EQ(gt.lines.size(), 2u);
     EXPECT_EQ(gt.lines[1].line_id, 4);
     EXPECT_DOUBLE_EQ(gt.lines[1].bearing, 0.6);
+    ASSERT_EQ(gt.lines_in_frame(1).size(), 1u);
+    EXPECT_DOUBLE_EQ(gt.lines_in_frame(1)[0].bearing, 0.6);
+    EXPECT_TRUE(gt.lines_in_frame(2).empty());
+    EXPECT_TRUE(gt.lines_in_frame(3).empty());
   }
   write("ground_truth/lines.csv",
         "#timestamp [ns],frame,line_id,bearing [rad],r_inner [px],r_outer "

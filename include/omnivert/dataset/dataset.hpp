@@ -23,6 +23,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -85,6 +86,14 @@ struct GroundTruth {
   std::vector<LineRecord> lines;  // empty when lines.csv is absent
   bool has_poses = false;
   bool has_lines = false;
+  // lines[line_offsets[k] .. line_offsets[k + 1]) are the lines of frame k (size: images + 1).
+  std::vector<std::size_t> line_offsets;
+
+  // The ground-truth lines of one frame (empty without lines.csv).
+  std::span<const LineRecord> lines_in_frame(std::size_t frame) const {
+    if (frame + 1 >= line_offsets.size()) return {};
+    return {lines.data() + line_offsets[frame], line_offsets[frame + 1] - line_offsets[frame]};
+  }
 };
 
 struct LoadOptions {
