@@ -105,8 +105,8 @@ RadialPattern draw_radial_pattern(const RadialPatternOptions& o) {
     for (int i = 0; i < 60; ++i) {
       const double r = o.r_min + (o.r_max - o.r_min) * U(rng);
       const double a = U(rng) * kTwoPi;
-      blobs.push_back({cx + r * std::cos(a), cy + r * std::sin(a), 4 + 10 * U(rng),
-                       (2 * U(rng) - 1) * 12});
+      blobs.push_back(
+          {cx + r * std::cos(a), cy + r * std::sin(a), 4 + 10 * U(rng), (2 * U(rng) - 1) * 12});
     }
   }
 
@@ -181,7 +181,8 @@ RadialPattern draw_radial_pattern(const RadialPatternOptions& o) {
         for (const Blob& b : blobs) {
           const double ex = u - b.x, ey = v - b.y;
           const double d2 = ex * ex + ey * ey;
-          if (d2 < 9 * b.sigma * b.sigma) t += b.amplitude * std::exp(-d2 / (2 * b.sigma * b.sigma));
+          if (d2 < 9 * b.sigma * b.sigma)
+            t += b.amplitude * std::exp(-d2 / (2 * b.sigma * b.sigma));
         }
         row[u] += static_cast<float>(t);
       }

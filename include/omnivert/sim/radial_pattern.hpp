@@ -43,7 +43,7 @@ struct RadialEdgeTruth {
   double image_angle;  // radians, (-pi, pi]
   double r_from;       // radial extent inside the annulus, px
   double r_to;
-  bool full;           // a sector boundary spanning the whole annulus
+  bool full;  // a sector boundary spanning the whole annulus
 };
 
 struct RadialPattern {

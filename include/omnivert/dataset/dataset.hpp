@@ -1,0 +1,143 @@
+#pragma once
+// The dataset reader every omnivert tool uses. Layout (EuRoC-style, written by
+// `omnivert simulate`, format in docs/simulator.md):
+//
+//   cam0/data.csv        #timestamp [ns],filename          (images, 8-bit grey PNG or similar)
+//   cam0/data/<file>
+//   cam0/sensor.yaml     resolution, center, r_min, r_max, bearing_sign (core/camera_geometry.hpp)
+//   wheel0/data.csv      #timestamp [ns],left [m],right [m]   (cumulative travel; or [ticks])
+//   wheel0/sensor.yaml   wheel_base, unit: meters|ticks, ticks_per_meter_left/right,
+//                        counter_bits, odometry_k
+//   ground_truth/        optional: extrinsics.yaml (phi, rho, psi), poses.csv, lines.csv
+//
+// Dataset::load validates everything it reads and throws omnivert::InputError naming the
+// file, the line and the problem: missing files, unparsable rows, duplicate or decreasing
+// timestamps, image files that do not exist, wheel data that does not cover the images,
+// implausible jumps of the wheel counters (wrapped counters are unwrapped when
+// counter_bits is given).
+//
+// Images: load() checks that every listed image file exists and reads the first one to
+// check its size and depth against cam0/sensor.yaml (all of them with
+// LoadOptions::check_all_images). image(i) checks each image it reads, so a bad image later
+// in the sequence is reported, with its file name, when a tool reaches it.
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "omnivert/core/camera_geometry.hpp"
+
+namespace omnivert::dataset {
+
+struct ImageRecord {
+  std::int64_t timestamp_ns = 0;
+  std::string filename;  // as listed in cam0/data.csv
+  std::string path;      // full path
+  int line = 0;          // line in cam0/data.csv
+};
+
+enum class WheelUnit { kMeters, kTicks };
+
+struct WheelSensor {
+  double wheel_base = 0;  // e [m], eq. (15)
+  WheelUnit unit = WheelUnit::kMeters;
+  double ticks_per_meter_left = 0;
+  double ticks_per_meter_right = 0;
+  int counter_bits = 0;              // 0: counters do not wrap
+  std::optional<double> odometry_k;  // Chong-Kleeman K [m], eq. (31)
+};
+
+// Cumulative travel of each wheel [m] since the first wheel sample.
+struct WheelTravel {
+  double left = 0;
+  double right = 0;
+};
+
+struct WheelRecord {
+  std::int64_t timestamp_ns = 0;
+  WheelTravel travel;  // meters, counters unwrapped, relative to the first sample
+  int line = 0;
+};
+
+struct Extrinsics {
+  double phi = 0, rho = 0, psi = 0;
+};
+
+struct PoseRecord {
+  std::int64_t timestamp_ns = 0;
+  double x = 0, y = 0, theta = 0;
+};
+
+struct LineRecord {
+  std::int64_t timestamp_ns = 0;
+  int frame = 0;
+  int line_id = 0;
+  double bearing = 0;  // camera bearing [rad]
+  double r_inner = 0, r_outer = 0;
+};
+
+struct GroundTruth {
+  std::optional<Extrinsics> extrinsics;
+  std::vector<PoseRecord> poses;  // empty when poses.csv is absent
+  std::vector<LineRecord> lines;  // empty when lines.csv is absent
+  bool has_poses = false;
+  bool has_lines = false;
+  // lines[line_offsets[k] .. line_offsets[k + 1]) are the lines of frame k (size: images + 1).
+  std::vector<std::size_t> line_offsets;
+
+  // The ground-truth lines of one frame (empty without lines.csv).
+  std::span<const LineRecord> lines_in_frame(std::size_t frame) const {
+    if (frame + 1 >= line_offsets.size()) return {};
+    return {lines.data() + line_offsets[frame], line_offsets[frame + 1] - line_offsets[frame]};
+  }
+};
+
+struct LoadOptions {
+  // Read every image on load (slow for long sequences) instead of only the first.
+  bool check_all_images = false;
+  // Without wheel0/ the dataset still loads (images only) when this is false.
+  bool require_wheel = true;
+  // A wheel moving faster than this between two samples is an error (a wrapped counter
+  // without counter_bits, a glitch) [m/s].
+  double max_wheel_speed = 5.0;
+};
+
+class Dataset {
+ public:
+  static Dataset load(const std::string& dir, const LoadOptions& options = {});
+
+  const std::string& root() const { return root_; }
+  const CameraGeometry& camera() const { return camera_; }
+  const std::vector<ImageRecord>& images() const { return images_; }
+  std::size_t size() const { return images_.size(); }
+
+  // Reads image i as 8-bit grey (colour images are converted); throws InputError naming
+  // the image file if it cannot be read, is not 8 bits deep or has the wrong size.
+  cv::Mat1b image(std::size_t i) const;
+
+  bool has_wheel() const { return !wheel_.empty(); }
+  const WheelSensor& wheel_sensor() const { return wheel_sensor_; }
+  const std::vector<WheelRecord>& wheel() const { return wheel_; }
+  // Wheel travel interpolated (linearly) at a timestamp inside the wheel data; throws
+  // std::out_of_range outside.
+  WheelTravel travel_at(std::int64_t timestamp_ns) const;
+  // Wheel travel at each image timestamp (same order as images()).
+  const std::vector<WheelTravel>& travel_at_images() const { return travel_at_images_; }
+
+  const std::optional<GroundTruth>& ground_truth() const { return ground_truth_; }
+
+ private:
+  std::string root_;
+  CameraGeometry camera_;
+  std::vector<ImageRecord> images_;
+  WheelSensor wheel_sensor_;
+  std::vector<WheelRecord> wheel_;
+  std::vector<WheelTravel> travel_at_images_;
+  std::optional<GroundTruth> ground_truth_;
+};
+
+}  // namespace omnivert::dataset

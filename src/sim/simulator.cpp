@@ -1,0 +1,349 @@
+#include "omnivert/sim/simulator.hpp"
+
+#include <chrono>
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "omnivert/core/angles.hpp"
+#include "omnivert/core/error.hpp"
+
+namespace omnivert::sim {
+
+namespace fs = std::filesystem;
+
+CameraPose camera_pose(const Pose2& robot, const Extrinsics& x, double camera_height) {
+  const double c = std::cos(robot.z()), s = std::sin(robot.z());
+  const double ox = x.rho * std::cos(x.phi), oy = x.rho * std::sin(x.phi);
+  CameraPose p;
+  p.x = robot.x() + c * ox - s * oy;
+  p.y = robot.y() + s * ox + c * oy;
+  p.yaw = robot.z() + x.phi + x.psi;
+  p.height = camera_height;
+  return p;
+}
+
+namespace {
+
+double distance_to_segment(const Eigen::Vector2d& p,
+                           const Eigen::Vector2d& a,
+                           const Eigen::Vector2d& b) {
+  const Eigen::Vector2d u = b - a;
+  const double t = std::clamp((p - a).dot(u) / u.squaredNorm(), 0.0, 1.0);
+  return (a + t * u - p).norm();
+}
+
+FILE* open_or_throw(const fs::path& p) {
+  FILE* f = std::fopen(p.c_str(), "w");
+  if (!f) throw std::runtime_error("cannot write " + p.string());
+  return f;
+}
+
+struct FileCloser {
+  FILE* f;
+  ~FileCloser() {
+    if (f) std::fclose(f);
+  }
+};
+
+void write_text(const fs::path& p, const std::string& text) {
+  std::ofstream out(p);
+  out << text;
+  if (!out) throw std::runtime_error("cannot write " + p.string());
+}
+
+std::string fmt(const char* format, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, format, v);
+  return buf;
+}
+
+}  // namespace
+
+std::string free_space_violation(const World& world,
+                                 const std::vector<MotionPiece>& motion,
+                                 double t_end,
+                                 double clearance) {
+  for (double t = 0.0; t <= t_end + 1e-9; t += 0.02) {
+    const Pose2 p = pose_at(motion, t);
+    for (std::size_t i = 0; i < world.walls.size(); ++i) {
+      const Wall& w = world.walls[i];
+      if (distance_to_segment(p.head<2>(), w.from, w.to) < clearance) {
+        char where[200];
+        std::snprintf(
+            where,
+            sizeof where,
+            "at t = %.2f s the robot (x = %.2f, y = %.2f) comes within %.2f m of wall %zu "
+            "of world '%s'",
+            t,
+            p.x(),
+            p.y(),
+            clearance,
+            i + 1,
+            world.name.c_str());
+        return where;
+      }
+    }
+  }
+  return {};
+}
+
+namespace {
+
+void write_dataset(const World& world,
+                   const Trajectory& trajectory,
+                   const SimConfig& cfg,
+                   const fs::path& dir,
+                   SimSummary& summary,
+                   const std::function<void(int, int)>& progress) {
+  const Pose2 start = trajectory.has_start ? trajectory.start : Pose2(world.start);
+  const std::vector<MotionPiece> motion = trajectory.pieces(start);
+  const double t_motion = duration(motion);
+
+  // Frame times: the first 10 ms after the start of the wheel data (so that every image
+  // timestamp falls between two wheel samples), then every 1/rate.
+  const std::int64_t frame_step_ns = std::llround(1e9 / cfg.frame_rate);
+  const std::int64_t first_offset_ns = 10'000'000;
+  // The last frame is at or after the end of the motion, so that it shows the final pose.
+  int n_frames =
+      static_cast<int>(std::ceil((t_motion * 1e9 - static_cast<double>(first_offset_ns)) /
+                                 static_cast<double>(frame_step_ns))) +
+      1;
+  n_frames = std::max(n_frames, 1);
+  if (cfg.max_frames > 0) n_frames = std::min(n_frames, cfg.max_frames);
+  auto frame_time = [&](int k) {
+    return static_cast<double>(first_offset_ns + k * frame_step_ns) * 1e-9;
+  };
+  const double t_last = frame_time(n_frames - 1);
+
+  // The robot must stay in the free space of the world.
+  if (const std::string p = free_space_violation(world, motion, t_last, cfg.min_clearance);
+      !p.empty()) {
+    throw InputError("trajectory '" + trajectory.name + "' leaves the free space: " + p +
+                     "; give the trajectory a 'start' or choose another world");
+  }
+
+  fs::create_directories(dir / "cam0" / "data");
+  fs::create_directories(dir / "wheel0");
+  fs::create_directories(dir / "ground_truth");
+  const std::int64_t t0 = cfg.start_ns;
+
+  // Wheels (50 Hz), covering every image.
+  std::mt19937_64 wheel_rng(cfg.seed * 2 + 1);
+  const WheelSamples wheels = simulate_wheels(motion, t_last, cfg.wheel, wheel_rng);
+  {
+    FILE* f = open_or_throw(dir / "wheel0" / "data.csv");
+    FileCloser closer{f};
+    const WheelConfig& wc = cfg.wheel;
+    std::fprintf(f,
+                 wc.ticks ? "#timestamp [ns],left [ticks],right [ticks]\n"
+                          : "#timestamp [ns],left [m],right [m]\n");
+    for (std::size_t i = 0; i < wheels.t.size(); ++i) {
+      const std::int64_t ts = t0 + std::llround(wheels.t[i] * 1e9);
+      if (wc.ticks) {
+        std::fprintf(f,
+                     "%" PRId64 ",%" PRId64 ",%" PRId64 "\n",
+                     ts,
+                     to_ticks(wheels.left[i], wc.ticks_per_meter_left, wc.counter_bits),
+                     to_ticks(wheels.right[i], wc.ticks_per_meter_right, wc.counter_bits));
+      } else {
+        std::fprintf(f, "%" PRId64 ",%.9f,%.9f\n", ts, wheels.left[i], wheels.right[i]);
+      }
+    }
+    summary.wheel_samples = static_cast<int>(wheels.t.size());
+  }
+  {
+    const WheelConfig& wc = cfg.wheel;
+    std::string y = "# omnivert simulator: wheel encoders (dataset format: docs/simulator.md)\n";
+    y += "wheel_base: " + fmt("%.9g", wc.wheel_base) + "   # e [m], eq. (15)\n";
+    y += std::string("unit: ") + (wc.ticks ? "ticks" : "meters") + "\n";
+    if (wc.ticks) {
+      y += "ticks_per_meter_left: " + fmt("%.9g", wc.ticks_per_meter_left) + "\n";
+      y += "ticks_per_meter_right: " + fmt("%.9g", wc.ticks_per_meter_right) + "\n";
+      if (wc.counter_bits > 0) y += "counter_bits: " + std::to_string(wc.counter_bits) + "\n";
+    }
+    y += "odometry_k: " + fmt("%.9g", wc.odometry_k) + "   # Chong-Kleeman K [m], eq. (31)\n";
+    y += "rate_hz: " + fmt("%.9g", wc.rate_hz) + "\n";
+    write_text(dir / "wheel0" / "sensor.yaml", y);
+  }
+  {
+    const CatadioptricCamera& c = cfg.camera;
+    std::string y = "# omnivert simulator: catadioptric camera, unified sphere model with the\n";
+    y += "# mirror axis vertical: r = gamma cos(el) / (xi - sin(el)) (docs/simulator.md)\n";
+    y += "model: unified\n";
+    y += "resolution: [" + std::to_string(c.width) + ", " + std::to_string(c.height) + "]\n";
+    y += "center: [" + fmt("%.9g", c.cx) + ", " + fmt("%.9g", c.cy) + "]\n";
+    y += "r_min: " + fmt("%.9g", c.r_min) + "\n";
+    y += "r_max: " + fmt("%.9g", c.r_max) + "\n";
+    y += "bearing_sign: " + std::to_string(c.bearing_sign) + "\n";
+    y += "rim_radius: " + fmt("%.9g", c.rim_radius()) +
+         "   # dark beyond: the mirror's outer boundary\n";
+    y += "xi: " + fmt("%.9g", c.xi) + "\n";
+    y += "gamma: " + fmt("%.9g", c.gamma) + "\n";
+    y += "rate_hz: " + fmt("%.9g", cfg.frame_rate) + "\n";
+    write_text(dir / "cam0" / "sensor.yaml", y);
+  }
+  {
+    const Extrinsics& x = cfg.extrinsics;
+    const double tx = x.rho * std::cos(x.phi), ty = x.rho * std::sin(x.phi);
+    std::string y = "# Camera-to-odometry extrinsics (NOTES Sec. 1, Fig. 19): camera centre at\n";
+    y += "# rho (cos phi, sin phi) in the robot frame, camera x-axis at phi + psi.\n";
+    y += "phi: " + fmt("%.12g", x.phi) + "   # [rad]\n";
+    y += "rho: " + fmt("%.12g", x.rho) + "   # [m]\n";
+    y += "psi: " + fmt("%.12g", x.psi) + "   # [rad]\n";
+    y += "# the same as T_base_cam = [Rz(yaw) | (x, y, z)]\n";
+    y += "T_base_cam: {x: " + fmt("%.12g", tx) + ", y: " + fmt("%.12g", ty) +
+         ", z: " + fmt("%.12g", cfg.camera_height) +
+         ", yaw: " + fmt("%.12g", wrap_angle(x.phi + x.psi)) + "}\n";
+    write_text(dir / "ground_truth" / "extrinsics.yaml", y);
+  }
+  save_world(world, (dir / "ground_truth" / "world.yaml").string());
+
+  Renderer renderer(cfg.camera, world);
+  {
+    FILE* f = open_or_throw(dir / "ground_truth" / "edges.csv");
+    FileCloser closer{f};
+    std::fprintf(f, "#line_id,x [m],y [m],z_bottom [m],z_top [m]\n");
+    for (const VerticalEdge& e : renderer.edges()) {
+      std::fprintf(f, "%d,%.6f,%.6f,%.4f,%.4f\n", e.id, e.p.x(), e.p.y(), e.z0, e.z1);
+    }
+  }
+  {
+    const WheelConfig& wc = cfg.wheel;
+    const ImageSensor& s = cfg.image;
+    std::string y = "# Settings of the simulation that wrote this dataset.\n";
+    y += "seed: " + std::to_string(cfg.seed) + "\n";
+    y += "world: " + world.name + "\n";
+    y += "trajectory: " + trajectory.name + "\n";
+    y += "start: [" + fmt("%.9g", start.x()) + ", " + fmt("%.9g", start.y()) + ", " +
+         fmt("%.9g", start.z()) + "]\n";
+    y += "frames: " + std::to_string(n_frames) + "\n";
+    y += "frame_rate: " + fmt("%.9g", cfg.frame_rate) + "\n";
+    y += "camera_height: " + fmt("%.9g", cfg.camera_height) + "\n";
+    y += "true_wheel_base: " + fmt("%.9g", wc.true_wheel_base()) + "\n";
+    y += "wheel_base_error: " + fmt("%.9g", wc.wheel_base_error) + "\n";
+    y += "radius_error_left: " + fmt("%.9g", wc.radius_error_left) + "\n";
+    y += "radius_error_right: " + fmt("%.9g", wc.radius_error_right) + "\n";
+    y += "odometry_k: " + fmt("%.9g", wc.odometry_k) + "\n";
+    y += "image_noise_sigma: " + fmt("%.9g", s.noise_sigma) + "\n";
+    y += "gain_flicker: " + fmt("%.9g", s.gain_flicker) + "\n";
+    y += "exposure: " + fmt("%.9g", s.exposure) + "\n";
+    y += "blur_sigma: " + fmt("%.9g", s.blur_sigma) + "\n";
+    y += "min_line_px: " + fmt("%.9g", cfg.min_line_px) + "\n";
+    write_text(dir / "ground_truth" / "simulation.yaml", y);
+  }
+
+  // Frames.
+  FILE* fcam = open_or_throw(dir / "cam0" / "data.csv");
+  FileCloser ccam{fcam};
+  FILE* fpose = open_or_throw(dir / "ground_truth" / "poses.csv");
+  FileCloser cpose{fpose};
+  FILE* flines = open_or_throw(dir / "ground_truth" / "lines.csv");
+  FileCloser clines{flines};
+  std::fprintf(fcam, "#timestamp [ns],filename\n");
+  std::fprintf(fpose, "#timestamp [ns],x [m],y [m],theta [rad]\n");
+  std::fprintf(flines, "#timestamp [ns],frame,line_id,bearing [rad],r_inner [px],r_outer [px]\n");
+  std::mt19937_64 image_rng(cfg.seed * 2 + 2);
+  cv::Mat1f clean;
+  cv::Mat1b img;
+  const std::vector<int> png_params = {cv::IMWRITE_PNG_COMPRESSION, 3};
+  long total_lines = 0;
+  Pose2 prev = pose_at(motion, frame_time(0));
+  for (int k = 0; k < n_frames; ++k) {
+    const double t = frame_time(k);
+    const std::int64_t ts = t0 + first_offset_ns + k * frame_step_ns;
+    const Pose2 robot = pose_at(motion, t);
+    summary.distance += (robot.head<2>() - prev.head<2>()).norm();
+    prev = robot;
+    const CameraPose cam = camera_pose(robot, cfg.extrinsics, cfg.camera_height);
+    renderer.render(cam, clean);
+    apply_image_sensor(clean, cfg.image, image_rng, img);
+    const std::string name = std::to_string(ts) + ".png";
+    if (!cv::imwrite((dir / "cam0" / "data" / name).string(), img, png_params)) {
+      throw std::runtime_error("cannot write image " + (dir / "cam0" / "data" / name).string());
+    }
+    std::fprintf(fcam, "%" PRId64 ",%s\n", ts, name.c_str());
+    std::fprintf(
+        fpose, "%" PRId64 ",%.9f,%.9f,%.9f\n", ts, robot.x(), robot.y(), wrap_angle(robot.z()));
+    for (const VisibleLine& l : renderer.visible_lines(cam, cfg.min_line_px)) {
+      std::fprintf(flines,
+                   "%" PRId64 ",%d,%d,%.9f,%.3f,%.3f\n",
+                   ts,
+                   k,
+                   l.line_id,
+                   l.bearing,
+                   l.r_inner,
+                   l.r_outer);
+      ++total_lines;
+    }
+    if (progress) progress(k + 1, n_frames);
+  }
+  summary.frames = n_frames;
+  summary.mean_lines = static_cast<double>(total_lines) / n_frames;
+  for (FILE* f : {fcam, fpose, flines}) {
+    if (std::ferror(f)) throw std::runtime_error("write error in " + dir.string());
+  }
+}
+
+}  // namespace
+
+SimSummary simulate(const World& world,
+                    const Trajectory& trajectory,
+                    const SimConfig& cfg,
+                    const std::string& out_dir,
+                    bool overwrite,
+                    const std::function<void(int, int)>& progress) {
+  const auto t_start = std::chrono::steady_clock::now();
+  if (const std::string p = cfg.camera.validate(); !p.empty()) throw InputError("camera: " + p);
+  if (const std::string p = world.validate(); !p.empty())
+    throw InputError("world '" + world.name + "': " + p);
+  if (const std::string p = trajectory.validate(); !p.empty()) {
+    throw InputError("trajectory '" + trajectory.name + "': " + p);
+  }
+  if (!(cfg.frame_rate > 0) || !(cfg.wheel.rate_hz > 0)) throw InputError("rates must be positive");
+  if (cfg.wheel.odometry_k < 0) throw InputError("odometry_k must not be negative");
+  if (!(cfg.wheel.wheel_base > 0) || !(cfg.wheel.true_wheel_base() > 0)) {
+    throw InputError("the wheel base must be positive");
+  }
+  if (cfg.wheel.ticks &&
+      (!(cfg.wheel.ticks_per_meter_left > 0) || !(cfg.wheel.ticks_per_meter_right > 0))) {
+    throw InputError("ticks per meter must be positive");
+  }
+  if (cfg.wheel.counter_bits < 0 || cfg.wheel.counter_bits > 62) {
+    throw InputError("counter_bits must be in 0..62");
+  }
+  if (!(cfg.camera_height > 0) || !(cfg.camera_height < world.height)) {
+    throw InputError("the camera height must lie between the floor and the ceiling of world '" +
+                     world.name + "' (0 to " + std::to_string(world.height) + " m)");
+  }
+
+  const fs::path out = fs::path(out_dir);
+  std::error_code ec;
+  if (fs::exists(out, ec) && !overwrite) {
+    throw InputError(out.string(), 0, "already exists (use --force to replace it)");
+  }
+  fs::path parent = out.parent_path();
+  if (parent.empty()) parent = ".";
+  fs::create_directories(parent);
+  const fs::path tmp = parent / (out.filename().string() + ".partial-" + std::to_string(cfg.seed));
+  fs::remove_all(tmp, ec);
+  SimSummary summary;
+  try {
+    write_dataset(world, trajectory, cfg, tmp, summary, progress);
+    if (fs::exists(out)) fs::remove_all(out);
+    fs::rename(tmp, out);
+  } catch (...) {
+    fs::remove_all(tmp, ec);
+    throw;
+  }
+  summary.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  return summary;
+}
+
+}  // namespace omnivert::sim

@@ -1,0 +1,217 @@
+// End to end: simulate, read back with the dataset reader, and check the ground truth is
+// self-consistent: the wheel travel integrated with eq. (14)-(15) reproduces
+// ground_truth/poses.csv, the lines' bearings follow from the edges, the poses and the
+// extrinsics (NOTES Sec. 1), runs are reproducible, and no partial dataset is left behind.
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "omnivert/core/angles.hpp"
+#include "omnivert/core/error.hpp"
+#include "omnivert/dataset/dataset.hpp"
+#include "omnivert/sim/simulator.hpp"
+
+namespace omnivert::sim {
+namespace {
+
+namespace fs = std::filesystem;
+
+class SimulatorTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir = fs::temp_directory_path() / ("omnivert_sim_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+  }
+  void TearDown() override { fs::remove_all(dir); }
+  fs::path dir;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+TEST_F(SimulatorTest, WheelTravelIntegratesToTheGroundTruthPoses) {
+  SimConfig cfg;
+  cfg.wheel.odometry_k = 0.0;  // ground-truth wheel travel
+  cfg.camera.width = 320;      // small images: this test is about odometry
+  cfg.camera.height = 240;
+  cfg.camera.cx = 160.3;
+  cfg.camera.cy = 119.6;
+  cfg.camera.gamma = 60;
+  cfg.camera.r_min = 28;
+  cfg.camera.r_max = 105;
+  const std::string out = (dir / "paper").string();
+  const SimSummary s = simulate(world_preset("corridor"), load_trajectory("paper"), cfg, out);
+  EXPECT_EQ(s.frames, 93);
+  EXPECT_NEAR(s.distance, 2.3, 0.04);
+
+  const dataset::Dataset d = dataset::Dataset::load(out);
+  ASSERT_TRUE(d.ground_truth().has_value());
+  const auto& gt = *d.ground_truth();
+  ASSERT_EQ(gt.poses.size(), d.size());
+  ASSERT_TRUE(gt.extrinsics.has_value());
+  EXPECT_DOUBLE_EQ(gt.extrinsics->phi, -0.34);
+  EXPECT_DOUBLE_EQ(gt.extrinsics->rho, 0.23);
+  EXPECT_DOUBLE_EQ(gt.extrinsics->psi, 0.33);
+  const double e = d.wheel_sensor().wheel_base;
+
+  // Eq. (14)-(15) over the 50 Hz wheel samples, starting at the first image's pose with the
+  // travel interpolated at its timestamp.
+  const auto& wheel = d.wheel();
+  double x = gt.poses[0].x, y = gt.poses[0].y, th = gt.poses[0].theta;
+  dataset::WheelTravel prev = d.travel_at_images()[0];
+  std::size_t w = 0;
+  while (wheel[w].timestamp_ns <= d.images()[0].timestamp_ns) ++w;
+  double max_pos = 0, max_th = 0;
+  auto step = [&](const dataset::WheelTravel& now) {
+    const double dl = now.left - prev.left, dr = now.right - prev.right;
+    const double drho = 0.5 * (dr + dl), dth = (dr - dl) / e;  // eq. (15)
+    x += drho * std::cos(th + 0.5 * dth);                      // eq. (14)
+    y += drho * std::sin(th + 0.5 * dth);
+    th += dth;
+    prev = now;
+  };
+  for (std::size_t i = 1; i < d.size(); ++i) {
+    const std::int64_t t = d.images()[i].timestamp_ns;
+    while (wheel[w].timestamp_ns < t) step(wheel[w++].travel);
+    step(d.travel_at_images()[i]);
+    max_pos = std::max(max_pos, std::hypot(x - gt.poses[i].x, y - gt.poses[i].y));
+    max_th = std::max(max_th, std::abs(angle_diff(th, gt.poses[i].theta)));
+  }
+  std::printf("odometry vs ground truth over %zu frames: max %.2e m, %.2e rad\n",
+              d.size(),
+              max_pos,
+              max_th);
+  EXPECT_LT(max_pos, 1e-4);
+  EXPECT_LT(max_th, 1e-5);
+  EXPECT_NEAR(std::abs(gt.poses.back().theta), kPi, 1e-6);  // the paper's 180 degree turn
+
+  // Every ground-truth line's bearing follows from edges.csv, the pose and the extrinsics.
+  std::map<int, Eigen::Vector2d> edges;
+  {
+    std::ifstream in(fs::path(out) / "ground_truth" / "edges.csv");
+    std::string line;
+    std::getline(in, line);
+    while (std::getline(in, line)) {
+      int id;
+      double ex, ey, z0, z1;
+      ASSERT_EQ(std::sscanf(line.c_str(), "%d,%lf,%lf,%lf,%lf", &id, &ex, &ey, &z0, &z1), 5);
+      edges[id] = {ex, ey};
+    }
+  }
+  ASSERT_FALSE(gt.lines.empty());
+  const auto& X = *gt.extrinsics;
+  for (const auto& l : gt.lines) {
+    const auto& p = gt.poses[static_cast<std::size_t>(l.frame)];
+    const double xc = p.x + X.rho * std::cos(p.theta + X.phi),
+                 yc = p.y + X.rho * std::sin(p.theta + X.phi);
+    const Eigen::Vector2d f = edges.at(l.line_id);
+    const double beta = std::atan2(f.y() - yc, f.x() - xc) - (p.theta + X.phi + X.psi);
+    ASSERT_NEAR(angle_diff(l.bearing, beta), 0.0, 1e-6);
+    ASSERT_GE(l.r_inner, cfg.camera.r_min - 1e-3);
+    ASSERT_LE(l.r_outer, cfg.camera.r_max + 1e-3);
+  }
+}
+
+TEST(Presets, EveryTrajectoryPresetFitsEveryWorldPreset) {
+  for (const std::string& wn : world_presets()) {
+    const World w = world_preset(wn);
+    for (const std::string& tn : trajectory_presets()) {
+      const auto motion = load_trajectory(tn).pieces(w.start);
+      EXPECT_EQ(free_space_violation(w, motion, duration(motion), 0.25), "") << wn << " " << tn;
+    }
+  }
+}
+
+TEST_F(SimulatorTest, SameSeedSameDataDifferentSeedDifferentNoise) {
+  SimConfig cfg;
+  cfg.max_frames = 3;
+  const World w = world_preset("office");
+  const Trajectory t = load_trajectory("zigzag");
+  simulate(w, t, cfg, (dir / "a").string());
+  simulate(w, t, cfg, (dir / "b").string());
+  cfg.seed = 2;
+  simulate(w, t, cfg, (dir / "c").string());
+  const fs::path img = fs::path("cam0") / "data" / "1600000000343333333.png";
+  EXPECT_EQ(slurp(dir / "a" / img), slurp(dir / "b" / img));
+  EXPECT_EQ(slurp(dir / "a" / "wheel0" / "data.csv"), slurp(dir / "b" / "wheel0" / "data.csv"));
+  EXPECT_NE(slurp(dir / "a" / img), slurp(dir / "c" / img));
+  EXPECT_NE(slurp(dir / "a" / "wheel0" / "data.csv"), slurp(dir / "c" / "wheel0" / "data.csv"));
+  EXPECT_EQ(slurp(dir / "a" / "ground_truth" / "lines.csv"),
+            slurp(dir / "c" / "ground_truth" / "lines.csv"));
+}
+
+TEST_F(SimulatorTest, FailedRunLeavesNoDatasetAndExistingOutputIsKept) {
+  SimConfig cfg;
+  Trajectory t;
+  t.name = "into-the-wall";
+  t.segments = {{Segment::Kind::kStraight, 0.5, 0, 0},
+                {Segment::Kind::kTurn, 0, kPi / 2, 0},
+                {Segment::Kind::kStraight, 3.0, 0, 0}};
+  const std::string out = (dir / "bad").string();
+  try {
+    simulate(world_preset("corridor"), t, cfg, out);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("trajectory 'into-the-wall' leaves the free space"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(fs::exists(out));
+  for (const auto& entry : fs::directory_iterator(dir))
+    ADD_FAILURE() << "left behind: " << entry.path();
+
+  cfg.max_frames = 1;
+  const std::string ok = (dir / "ok").string();
+  simulate(world_preset("corridor"), load_trajectory("straight"), cfg, ok);
+  try {
+    simulate(world_preset("corridor"), load_trajectory("straight"), cfg, ok);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), ok + ": already exists (use --force to replace it)");
+  }
+  EXPECT_NO_THROW(simulate(world_preset("corridor"), load_trajectory("straight"), cfg, ok, true));
+}
+
+TEST_F(SimulatorTest, WrappingTickCountersReadBackAsMeters) {
+  SimConfig cfg;
+  cfg.max_frames = 40;
+  cfg.wheel.ticks = true;
+  cfg.wheel.ticks_per_meter_left = 20000;
+  cfg.wheel.ticks_per_meter_right = 19000;
+  cfg.wheel.counter_bits = 12;  // wraps every ~0.2 m
+  cfg.wheel.odometry_k = 0;
+  cfg.camera.width = 160;
+  cfg.camera.height = 120;
+  cfg.camera.cx = 80.2;
+  cfg.camera.cy = 60.1;
+  cfg.camera.gamma = 30;
+  cfg.camera.r_min = 14;
+  cfg.camera.r_max = 50;
+  const std::string out = (dir / "ticks").string();
+  simulate(world_preset("hall"), load_trajectory("paper"), cfg, out);
+  const dataset::Dataset d = dataset::Dataset::load(out);
+  ASSERT_EQ(d.wheel_sensor().unit, dataset::WheelUnit::kTicks);
+  // 40 frames at 3.8 cm: about 1.5 m, several wraps of the 12-bit counters.
+  const auto& last = d.wheel().back().travel;
+  EXPECT_GT(last.left, 1.4);
+  const double expected =
+      (d.wheel().back().timestamp_ns - d.wheel().front().timestamp_ns) * 1e-9 * 0.114;
+  EXPECT_NEAR(last.left, expected, 1.0 / 20000 + 1e-9);
+  EXPECT_NEAR(last.right, expected, 1.0 / 19000 + 1e-9);
+}
+
+}  // namespace
+}  // namespace omnivert::sim
