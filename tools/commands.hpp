@@ -23,5 +23,7 @@ void add_extract_command(CLI::App& app);
 void add_pattern_command(CLI::App& app);
 // omnivert simulate: render a dataset with ground truth (tools/cmd_simulate.cpp).
 void add_simulate_command(CLI::App& app);
+void add_track_command(CLI::App& app);
+void add_evaluate_command(CLI::App& app);
 
 }  // namespace omnivert::cli

@@ -21,6 +21,8 @@ int main(int argc, char** argv) {
   omnivert::cli::add_extract_command(app);
   omnivert::cli::add_pattern_command(app);
   omnivert::cli::add_simulate_command(app);
+  omnivert::cli::add_track_command(app);
+  omnivert::cli::add_evaluate_command(app);
 
   try {
     app.parse(argc, argv);

@@ -1,0 +1,46 @@
+#pragma once
+// Tracking a whole dataset: every image through the frame pipeline (Sec. 2-3), every frame
+// through the tracker (Sec. 4, 9.1) with the wheel travel between frames. Used by
+// `omnivert track` and by the calibration.
+//
+// A frame whose image cannot be read, or whose mirror is not found, is reported in
+// `warnings` and passed to the tracker with no lines, so that frame numbers and odometry
+// stay aligned; tracking goes on. A dataset with no images, or with no frame that could be
+// processed, is an InputError.
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "omnivert/dataset/dataset.hpp"
+#include "omnivert/describe/feature_pipeline.hpp"
+#include "omnivert/match/tracker.hpp"
+#include "omnivert/match/tracks_io.hpp"
+
+namespace omnivert {
+
+struct TrackDatasetOptions {
+  FeaturePipelineOptions pipeline;
+  TrackerOptions tracker = recommended_tracker_options(0.0);
+  // Use the wheel odometry for the tracker's bearing gate when the dataset has it (and the
+  // gate is enabled in `tracker`; its wheel base is taken from wheel0/sensor.yaml).
+  bool use_odometry = true;
+};
+
+struct TrackDatasetResult {
+  std::vector<TrackRow> rows;
+  TrackerStats stats;
+  std::int64_t frames = 0;
+  std::int64_t frames_skipped = 0;  // unreadable, or no mirror found
+  std::vector<std::string> warnings;
+  std::vector<FrameFeatures> features;  // per frame, when keep_features is set
+};
+
+// `progress(done, total)` is called after each frame when set.
+TrackDatasetResult track_dataset(const dataset::Dataset& data,
+                                 const TrackDatasetOptions& options,
+                                 const std::function<void(std::size_t, std::size_t)>& progress = {},
+                                 bool keep_features = false);
+
+}  // namespace omnivert

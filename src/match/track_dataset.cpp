@@ -1,0 +1,71 @@
+#include "omnivert/match/track_dataset.hpp"
+
+#include "omnivert/core/error.hpp"
+
+namespace omnivert {
+
+TrackDatasetResult track_dataset(const dataset::Dataset& data,
+                                 const TrackDatasetOptions& options,
+                                 const std::function<void(std::size_t, std::size_t)>& progress,
+                                 bool keep_features) {
+  const std::string csv = data.root() + "/cam0/data.csv";
+  if (data.size() == 0) throw InputError(csv, 0, "the dataset has no images");
+  TrackerOptions to = options.tracker;
+  const bool odometry = options.use_odometry && data.has_wheel();
+  if (to.gate.enabled) {
+    if (odometry) {
+      to.gate.wheel_base = data.wheel_sensor().wheel_base;
+    } else {
+      to.gate.enabled = false;  // no wheel data: no gate
+    }
+  }
+  Tracker tracker(to);
+  FeaturePipeline pipe(data.camera(), options.pipeline);
+  TrackDatasetResult out;
+  std::vector<TrackAssignment> assignments;
+  FrameFeatures f;
+  const auto& travel = data.travel_at_images();
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    const auto& rec = data.images()[i];
+    bool ok = true;
+    try {
+      const cv::Mat img = data.image(i);
+      std::string why;
+      ok = pipe.process(img, f, &why);
+      if (!ok) {
+        out.warnings.push_back(rec.path + ": " + why + "; frame " + std::to_string(i) + " skipped");
+      } else if (!why.empty()) {
+        out.warnings.push_back(rec.path + ": " + why);
+      }
+    } catch (const InputError& e) {
+      ok = false;
+      out.warnings.push_back(std::string(e.what()) + "; frame " + std::to_string(i) + " skipped");
+    }
+    if (!ok) {
+      ++out.frames_skipped;
+      f.lines.clear();
+      f.descriptors.resize(0, options.pipeline.descriptor.size());
+    }
+    if (odometry && to.gate.enabled) {
+      const WheelIncrement inc =
+          i == 0 ? WheelIncrement{}
+                 : increment_between(travel[i - 1].left, travel[i - 1].right, travel[i].left, travel[i].right);
+      tracker.add_frame(f, inc, &assignments);
+    } else {
+      tracker.add_frame(f, &assignments);
+    }
+    append_track_rows(static_cast<std::int64_t>(i), rec.timestamp_ns, f, assignments, &out.rows);
+    if (keep_features) out.features.push_back(f);
+    ++out.frames;
+    if (progress) progress(i + 1, data.size());
+  }
+  if (out.frames_skipped == out.frames) {
+    throw InputError(csv, 0,
+                     "no frame could be processed (" +
+                         (out.warnings.empty() ? std::string("?") : out.warnings.front()) + ")");
+  }
+  out.stats = tracker.stats();
+  return out;
+}
+
+}  // namespace omnivert

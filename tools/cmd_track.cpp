@@ -1,0 +1,70 @@
+// omnivert track DATASET --out DIR: lines tracked through a video (Sec. 4, 9.1).
+
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include <spdlog/spdlog.h>
+
+#include "commands.hpp"
+#include "omnivert/core/angles.hpp"
+#include "omnivert/core/error.hpp"
+#include "omnivert/core/progress.hpp"
+#include "omnivert/match/track_dataset.hpp"
+#include "omnivert/match/tracks_plot.hpp"
+#include "pipeline_options.hpp"
+#include "tracker_options.hpp"
+
+namespace omnivert::cli {
+
+namespace {
+
+struct TrackArgs {
+  std::string dataset;
+  std::string out;
+  FeaturePipelineOptions pipeline;
+  TrackerFlags tracker;
+};
+
+void run_track(const TrackArgs& a) {
+  namespace fs = std::filesystem;
+  std::string why;
+  if (!a.pipeline.IsValid(&why)) throw InputError("invalid extraction options: " + why);
+  dataset::LoadOptions lo;
+  lo.require_wheel = false;
+  const auto data = dataset::Dataset::load(a.dataset, lo);
+  std::error_code ec;
+  fs::create_directories(a.out, ec);
+  if (ec) throw InputError(a.out, 0, "cannot create the output folder: " + ec.message());
+
+  TrackDatasetOptions o;
+  o.pipeline = a.pipeline;
+  o.tracker = a.tracker.options();
+  Progress bar("track", data.size());
+  const auto r = track_dataset(data, o, [&](std::size_t done, std::size_t) { bar.update(done); });
+  bar.finish();
+  for (const auto& w : r.warnings) spdlog::warn("{}", w);
+
+  const fs::path csv = fs::path(a.out) / "tracks.csv";
+  const fs::path png = fs::path(a.out) / "tracks.png";
+  write_tracks_csv(csv, r.rows);
+  write_tracks_png(png, r.rows);
+  std::printf("%lld frames (%lld skipped), %zu detections, %lld tracks\n%s\n",
+              static_cast<long long>(r.frames), static_cast<long long>(r.frames_skipped), r.rows.size(),
+              static_cast<long long>(r.stats.new_tracks), r.stats.BriefReport().c_str());
+  std::printf("wrote %s and %s\n", csv.c_str(), png.c_str());
+}
+
+}  // namespace
+
+void add_track_command(CLI::App& app) {
+  auto a = std::make_shared<TrackArgs>();
+  CLI::App* cmd = app.add_subcommand("track", "Track vertical lines through a dataset (tracks.csv, tracks.png)");
+  cmd->add_option("DATASET", a->dataset, "Dataset folder (cam0/, optional wheel0/)")->required();
+  cmd->add_option("--out", a->out, "Output folder")->required();
+  add_pipeline_options(cmd, a->pipeline);
+  add_tracker_options(cmd, a->tracker);
+  cmd->callback([a] { run_track(*a); });
+}
+
+}  // namespace omnivert::cli
