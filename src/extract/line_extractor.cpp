@@ -55,19 +55,6 @@ void LineExtractor::build_lut(const MirrorCircle& circle) {
 
 namespace {
 
-struct Candidate {
-  int32_t lut;
-  int32_t px;
-  int16_t gx, gy;
-  float m;
-};
-
-struct LineCandidate {
-  VerticalLine line;
-  int polarity;
-  double length;
-};
-
 }  // namespace
 
 void LineExtractor::extract(const cv::Mat& gray,
@@ -92,7 +79,7 @@ void LineExtractor::extract(const cv::Mat& gray,
   const float t2 = static_cast<float>(options_.gradient_threshold * options_.gradient_threshold);
   const float s = static_cast<float>(std::sin(deg2rad(options_.orientation_tolerance_deg)));
   const float s2 = s * s;
-  static thread_local std::vector<Candidate> cands;
+  std::vector<Candidate>& cands = cands_;
   cands.clear();
   for (int32_t i = 0; i < static_cast<int32_t>(lut_.size()); ++i) {
     const LutEntry& e = lut_[i];
@@ -166,7 +153,7 @@ void LineExtractor::extract(const cv::Mat& gray,
   std::partial_sum(bucket_start_.begin(), bucket_start_.end(), bucket_start_.begin());
   bucket_items_.resize(edges_.size());
   {
-    std::vector<int32_t>& fill = cand_;  // reuse as a cursor array
+    std::vector<int32_t>& fill = bucket_fill_;
     fill.assign(bucket_start_.begin(), bucket_start_.end() - 1);
     for (int32_t i = 0; i < static_cast<int32_t>(edges_.size()); ++i) {
       const EdgePoint& p = edges_[i];
@@ -182,10 +169,11 @@ void LineExtractor::extract(const cv::Mat& gray,
   const double cx = circle.center.x(), cy = circle.center.y();
   const double tol = options_.lateral_tolerance_px;
   const double max_gap = std::max(1.0, options_.max_gap_px);
-  static thread_local std::vector<LineCandidate> found;
-  static thread_local std::vector<float> radii;
+  std::vector<LineCandidate>& found = found_;
+  std::vector<float>& radii = radii_;
+  std::vector<float>& score = score_;
   found.clear();
-  std::vector<float> score(N);
+  score.resize(N);
   for (int pol = 0; pol < 2; ++pol) {
     const auto& h = hist_[pol];
     for (int k = 0; k < N; ++k) score[k] = h[(k + N - 1) % N] + h[k] + h[(k + 1) % N];

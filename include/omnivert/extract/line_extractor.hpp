@@ -98,11 +98,24 @@ class LineExtractor {
   // Lookup table over the annulus, valid for (lut_r_min_, lut_r_max_).
   std::vector<LutEntry> lut_;
   double lut_r_min_ = -1, lut_r_max_ = -1;
-  // Reused buffers.
-  cv::Mat mag_;                  // float magnitude of candidates (0 elsewhere)
-  std::vector<int32_t> cand_;    // candidate pixel index into lut_
-  std::vector<int32_t> cand_px_; // candidate linear pixel index into mag_
+  struct Candidate {  // a pixel that passed the magnitude and orientation tests
+    int32_t lut;
+    int32_t px;
+    int16_t gx, gy;
+    float m;
+  };
+  struct LineCandidate {
+    VerticalLine line;
+    int polarity;
+    double length;
+  };
+  // Reused buffers (no allocation per frame once warmed up).
+  cv::Mat mag_;  // float magnitude of candidates (0 elsewhere)
+  std::vector<Candidate> cands_;
   std::vector<EdgePoint> edges_;
+  std::vector<LineCandidate> found_;
+  std::vector<float> radii_, score_;
+  std::vector<int32_t> bucket_fill_;
   std::vector<float> hist_[2];
   std::vector<int32_t> bucket_start_;
   std::vector<int32_t> bucket_items_;
