@@ -75,13 +75,23 @@ int main(int argc, char** argv) {
     const char* name;
     DescriptorSmoothing s;
     DescriptorNormalization n;
+    bool log;
+    double offset = 1.0;
   };
-  const Config configs[] = {{"blur/pair", DescriptorSmoothing::kGaussianBlur, DescriptorNormalization::kPerPair},
-                            {"blur/half", DescriptorSmoothing::kGaussianBlur, DescriptorNormalization::kPerHalf},
-                            {"weight/pair", DescriptorSmoothing::kGaussianWeight, DescriptorNormalization::kPerPair},
-                            {"weight/half", DescriptorSmoothing::kGaussianWeight, DescriptorNormalization::kPerHalf}};
+  const Config configs[] = {
+      {"log1/blur/pair", DescriptorSmoothing::kGaussianBlur, DescriptorNormalization::kPerPair, true, 1.0},
+      {"log2/blur/pair", DescriptorSmoothing::kGaussianBlur, DescriptorNormalization::kPerPair, true, 2.0},
+      {"log4/blur/pair", DescriptorSmoothing::kGaussianBlur, DescriptorNormalization::kPerPair, true, 4.0},
+      {"log8/blur/pair", DescriptorSmoothing::kGaussianBlur, DescriptorNormalization::kPerPair, true, 8.0},
+      {"log16/blur/pair", DescriptorSmoothing::kGaussianBlur, DescriptorNormalization::kPerPair, true, 16.0},
+      {"log32/blur/pair", DescriptorSmoothing::kGaussianBlur, DescriptorNormalization::kPerPair, true, 32.0},
+      {"log/blur/half", DescriptorSmoothing::kGaussianBlur, DescriptorNormalization::kPerHalf, true},
+      {"blur/pair", DescriptorSmoothing::kGaussianBlur, DescriptorNormalization::kPerPair, false},
+      {"blur/half", DescriptorSmoothing::kGaussianBlur, DescriptorNormalization::kPerHalf, false},
+      {"weight/pair", DescriptorSmoothing::kGaussianWeight, DescriptorNormalization::kPerPair, false},
+      {"weight/half", DescriptorSmoothing::kGaussianWeight, DescriptorNormalization::kPerHalf, false}};
   const double rotations[] = {17, 43, 71, 137, 251};
-  const double gains[] = {0.6, 0.8, 1.25, 1.5};
+  const double gains[] = {0.6, 0.8, 1.25, 1.5};  // 1.25 and 1.5 saturate bright regions
   const double gammas[] = {0.7, 0.85, 1.2, 1.4};
 
   std::printf("%-12s %-6s %-9s %6s %7s %9s %9s %9s %9s %9s\n", "config", "data", "transform", "pairs",
@@ -94,16 +104,24 @@ int main(int argc, char** argv) {
         FeaturePipelineOptions po;
         po.descriptor.smoothing = c.s;
         po.descriptor.normalization = c.n;
+        po.descriptor.log_intensity = c.log;
+        po.descriptor.log_offset = c.offset;
         if (in.real) po.lines.threshold = LineThreshold::kTopK, po.lines.top_k = 25;
         FeaturePipeline probe(in.geometry, po);
         FrameFeatures f0;
         if (!probe.process(in.gray, f0)) continue;
-        // Rotations must not bring content into view: keep the inscribed disc only.
-        const cv::Mat gray = in.real ? mask_to_inscribed_disc(in.gray, f0.circle.center) : in.gray;
-        FeaturePipeline base(in.geometry, po);
+        const cv::Mat& gray = in.gray;
+        // The annulus as a user's sensor.yaml would give it, for every transformed copy.
+        CameraGeometry geo = in.geometry;
+        if (in.real) geo.center = f0.circle.center;
+        geo.r_min = f0.circle.r_min;
+        // Real images: the annulus ends where a rotation brings no new content into a descriptor.
+        geo.r_max = in.real ? std::min(f0.circle.r_max, rotation_safe_r_max(f0.circle.center, gray.cols, gray.rows, f0.circle.r_min))
+                            : f0.circle.r_max;
+        FeaturePipeline base(geo, po);
         if (!base.process(gray, f0)) continue;
         auto run = [&](const cv::Mat& img, double shift, Acc& a) {
-          FeaturePipeline p(in.geometry, po);
+          FeaturePipeline p(geo, po);
           FrameFeatures f;
           if (!p.process(img, f)) return;
           for (const auto& pr : pair_lines(f0, f, shift, deg2rad(0.3))) a.add(pr);

@@ -31,14 +31,10 @@ cv::Mat relight(const cv::Mat& image, double gain, double gamma) {
   return out;
 }
 
-cv::Mat mask_to_inscribed_disc(const cv::Mat& image, const Eigen::Vector2d& center) {
-  const double r = std::min({center.x(), center.y(), image.cols - 1 - center.x(), image.rows - 1 - center.y()});
-  cv::Mat mask = cv::Mat::zeros(image.size(), CV_8U);
-  cv::circle(mask, cv::Point(static_cast<int>(std::lround(center.x() * 16)), static_cast<int>(std::lround(center.y() * 16))),
-             static_cast<int>(std::max(0.0, r) * 16), cv::Scalar(255), cv::FILLED, cv::LINE_AA, 4);
-  cv::Mat out = cv::Mat::zeros(image.size(), image.type());
-  image.copyTo(out, mask);
-  return out;
+double rotation_safe_r_max(const Eigen::Vector2d& c, int width, int height, double r_min) {
+  const double inscribed = std::min({c.x(), c.y(), width - 1 - c.x(), height - 1 - c.y()});
+  // r_max + 3 sigma_G = r_max + (r_max - r_min) / 6 <= inscribed - 2
+  return (inscribed - 2 + r_min / 6.0) / (7.0 / 6.0);
 }
 
 std::vector<LinePairing> pair_lines(const FrameFeatures& a,

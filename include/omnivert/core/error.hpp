@@ -19,15 +19,7 @@ class InputError : public std::runtime_error {
   int line() const { return line_; }
 
  private:
-  static std::string format(const std::string& file, int line, const std::string& problem) {
-    std::string s;
-    if (!file.empty()) {
-      s += file;
-      if (line > 0) s += ":" + std::to_string(line);
-      s += ": ";
-    }
-    return s + problem;
-  }
+  static std::string format(const std::string& file, int line, const std::string& problem);
   std::string file_;
   int line_;
 };

@@ -44,6 +44,16 @@ struct DescriptorOptions {
   DescriptorNormalization normalization = DescriptorNormalization::kPerPair;
   double clip = 0.1;             // Sec. 3.3
   double sigma_fraction = 1.0 / 3.0;  // sigma_G = sigma_fraction * r_a (Sec. 3.1)
+  // Gradients of log(log_offset + I) instead of I (an extension of Sec. 3.3): a gain g and gamma y
+  // map log I to const + y log I, so after the blur and unit normalisation the descriptor is
+  // unchanged by both (up to noise and saturation). Applies to the blur reading.
+  bool log_intensity = true;
+  // Offset in log(offset + I): keeps near-black pixels (noise, interpolation) from dominating.
+  double log_offset = 2.0;
+
+  // Blur reading: gradients are sampled every floor(sigma_G / this) pixels (>= 1); the
+  // blurred image holds nothing finer. A large value forces full resolution.
+  double min_samples_per_sigma = 5.0;
 
   bool IsValid(std::string* why) const;
   // Descriptor length: areas x 2 halves x bins.
@@ -78,8 +88,12 @@ class DescriptorExtractor {
   void normalize(float* row) const;
 
   DescriptorOptions options_;
-  cv::Rect roi_;   // region of the gradient images in the frame
-  cv::Mat gx_, gy_, blurred_;
+  cv::Rect roi_;   // region of the frame the gradient images cover
+  int step_ = 1;   // one gradient sample every step_ pixels (blur reading)
+  cv::Mat full_, blurred_, gx_, gy_;
+  cv::Mat log_lut_;  // grey level -> log(offset + I) (or I)
+  double log_lut_offset_ = -1;
+  bool log_lut_log_ = false;
 };
 
 }  // namespace omnivert

@@ -29,10 +29,10 @@ struct LinePairing {
   double nearest_wrong_distance = 0;
 };
 
-// Blacks out everything outside the largest disc about `center` that fits in the image, so
-// that a rotation about the centre brings no new content into view (for images whose
-// mirror is cropped by the frame).
-cv::Mat mask_to_inscribed_disc(const cv::Mat& image, const Eigen::Vector2d& center);
+// The largest r_max for which the descriptor's support (the outer area plus its 3-sigma blur,
+// sigma_G = r_a/3, r_a = (r_max - r_min)/6) stays inside the disc about `center` that fits in
+// the image: with it, a rotation about the centre brings no new content into any descriptor.
+double rotation_safe_r_max(const Eigen::Vector2d& center, int width, int height, double r_min);
 
 // Pairs lines of two frames whose image angles agree within `tolerance_rad` after removing
 // `shift_rad`, and of the same polarity. One pairing per original line at most.

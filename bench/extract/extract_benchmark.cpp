@@ -1,0 +1,112 @@
+// Per-frame cost of the front end on a 640x480 frame: mirror centre + radial lines +
+// 192-D descriptors (the pipeline of Sec. 2-3), and its stages, against two peers measured
+// in the same run on the same frame: ORB (500 keypoints, detect + describe) and OpenCV's
+// LSD/EDLines + LBD (BinaryDescriptor: detect + compute).
+//
+// Report: median real time per frame (run with --benchmark_repetitions=9
+// --benchmark_report_aggregates_only=true).
+
+#include <benchmark/benchmark.h>
+#include <opencv2/features2d.hpp>
+#include <opencv2/line_descriptor.hpp>
+
+#include "omnivert/describe/feature_pipeline.hpp"
+#include "omnivert/sim/radial_pattern.hpp"
+
+namespace {
+
+using namespace omnivert;
+
+const sim::RadialPattern& frame() {
+  static const sim::RadialPattern p = [] {
+    sim::RadialPatternOptions o;
+    o.seed = 11;
+    o.full_edges = 20;
+    o.patches = 8;
+    return sim::draw_radial_pattern(o);
+  }();
+  return p;
+}
+
+CameraGeometry geometry() {
+  CameraGeometry g;
+  g.width = 640;
+  g.height = 480;
+  g.r_min = 40;
+  g.r_max = 220;
+  return g;
+}
+
+// The whole front end in steady state: the centre is re-detected every frame (Sec. 2).
+void BM_FrontEnd(benchmark::State& state) {
+  FeaturePipeline pipe(geometry());
+  FrameFeatures f;
+  pipe.process(frame().image, f);  // first frame: rim estimation
+  for (auto _ : state) {
+    pipe.process(frame().image, f);
+    benchmark::DoNotOptimize(f.descriptors.data());
+  }
+  state.counters["lines"] = static_cast<double>(f.lines.size());
+}
+BENCHMARK(BM_FrontEnd)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_MirrorCentre(benchmark::State& state) {
+  MirrorCenterDetector det;
+  const MirrorCircle prior = frame().circle;
+  for (auto _ : state) benchmark::DoNotOptimize(det.detect(frame().image, prior));
+}
+BENCHMARK(BM_MirrorCentre)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_RadialLines(benchmark::State& state) {
+  LineExtractor ex;
+  std::vector<VerticalLine> lines;
+  ex.extract(frame().image, frame().circle, lines);
+  for (auto _ : state) {
+    ex.extract(frame().image, frame().circle, lines);
+    benchmark::DoNotOptimize(lines.data());
+  }
+  state.counters["lines"] = static_cast<double>(lines.size());
+}
+BENCHMARK(BM_RadialLines)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_Descriptors(benchmark::State& state) {
+  LineExtractor ex;
+  std::vector<VerticalLine> lines;
+  ex.extract(frame().image, frame().circle, lines);
+  DescriptorExtractor d;
+  DescriptorMatrix m;
+  for (auto _ : state) {
+    d.compute(frame().image, frame().circle, lines, m);
+    benchmark::DoNotOptimize(m.data());
+  }
+  state.counters["lines"] = static_cast<double>(lines.size());
+}
+BENCHMARK(BM_Descriptors)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_Peer_ORB(benchmark::State& state) {
+  auto orb = cv::ORB::create(500);
+  std::vector<cv::KeyPoint> kp;
+  cv::Mat desc;
+  for (auto _ : state) {
+    orb->detectAndCompute(frame().image, cv::noArray(), kp, desc);
+    benchmark::DoNotOptimize(desc.data);
+  }
+  state.counters["keypoints"] = static_cast<double>(kp.size());
+}
+BENCHMARK(BM_Peer_ORB)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_Peer_LBD(benchmark::State& state) {
+  auto bd = cv::line_descriptor::BinaryDescriptor::createBinaryDescriptor();
+  std::vector<cv::line_descriptor::KeyLine> lines;
+  cv::Mat desc;
+  for (auto _ : state) {
+    lines.clear();
+    bd->detect(frame().image, lines);
+    bd->compute(frame().image, lines, desc);
+    benchmark::DoNotOptimize(desc.data);
+  }
+  state.counters["lines"] = static_cast<double>(lines.size());
+}
+BENCHMARK(BM_Peer_LBD)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace

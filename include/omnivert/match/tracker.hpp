@@ -1,0 +1,134 @@
+#pragma once
+// Tracking of vertical lines across a video (Sec. 9.1), plus the constraints the paper names
+// as its next step (mutual assignment, and a gate from wheel odometry).
+//
+// For each new frame t, every line is matched (Matcher, tests 1-3 of Sec. 4) against the
+// lines of frame t-1; a line with no accepted match there is matched against frame t-2, and
+// so on up to `look_back` frames back (20 in the paper). A line with no accepted match in any
+// of them starts a new track. A matched line takes the track id of the line it matched.
+// Track ids are 0, 1, 2, ... in order of creation and never reused.
+//
+// In each look-back frame the candidate set is that frame's full set of lines, so tests 2 and
+// 3 measure distinctiveness within one image as in the paper; earlier frames are searched
+// only for the lines still unmatched (the most recent frame wins).
+//
+// Optional constraints (off by default = the paper's three rules alone):
+//  - mutual: the nearest candidate B_j of A_i must have A_i as its nearest line among all
+//    lines of the new frame (mutual nearest neighbours), and a track already claimed by a
+//    line of the new frame (in a more recent look-back frame) cannot be claimed again. With
+//    it, a track holds at most one line per frame. Without it, two lines of one frame can
+//    take the same id (the paper's behaviour).
+//  - odometry gate (odometry_gate.hpp): an accepted match whose bearing change contradicts
+//    the wheel travel since the candidate frame is vetoed; the line goes on looking back.
+//
+// Bookkeeping: a ring buffer holds the last `look_back` frames (descriptors, bearings, track
+// ids, accumulated odometry). Buffers grow to the largest frame seen and are then reused: no
+// allocation per frame in steady state.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "omnivert/describe/frame_features.hpp"
+#include "omnivert/match/matcher.hpp"
+#include "omnivert/match/odometry_gate.hpp"
+
+namespace omnivert {
+
+struct TrackerOptions {
+  MatchOptions match;        // tests 1-3 (Sec. 4)
+  int look_back = 20;        // frames searched back for an unmatched line (Sec. 9.1)
+  bool mutual = false;       // one-to-one, mutual nearest neighbours
+  OdometryGateOptions gate;  // bearing-change gate from wheel travel (off by default)
+
+  bool IsValid(std::string* error) const;
+};
+
+// The paper's tracker alone: tests 1-3 with Table 2's factors, look-back 20 (Sec. 9.1).
+TrackerOptions paper_tracker_options();
+// What we recommend (docs/tracking.md, measured there): the paper's rules plus the mutual
+// constraint, and the odometry gate when the wheel base is known (wheel_base > 0; pass 0
+// when there is no odometry).
+TrackerOptions recommended_tracker_options(double wheel_base);
+
+// What the tracker decided for one line of a frame.
+struct TrackAssignment {
+  std::int64_t track_id = -1;
+  // How many frames back the matched line was (1 = previous frame); 0 for a new track.
+  int frames_back = 0;
+  // Index of the matched line in that frame; -1 for a new track.
+  int matched_line = -1;
+  float distance = 0.0f;  // descriptor distance of the match (0 for a new track)
+  bool is_new() const { return frames_back == 0; }
+};
+
+// Counters over a run: each rule's effect is visible here (docs/tracking.md).
+struct TrackerStats {
+  std::int64_t frames = 0;
+  std::int64_t lines = 0;
+  std::int64_t matched_previous = 0;   // matched in frame t-1
+  std::int64_t matched_look_back = 0;  // matched in frames t-2 .. t-look_back
+  std::int64_t new_tracks = 0;
+  // Rejections of a best candidate, over all look-back attempts (one line can count several
+  // times, once per frame it was tried against).
+  std::int64_t rejected_test1 = 0;
+  std::int64_t rejected_test2 = 0;
+  std::int64_t rejected_test3 = 0;
+  std::int64_t rejected_mutual = 0;   // not mutual nearest neighbours
+  std::int64_t rejected_claimed = 0;  // track already taken in this frame (mutual on)
+  std::int64_t rejected_gate = 0;     // odometry gate veto
+  std::string BriefReport() const;
+};
+
+class Tracker {
+ public:
+  // Throws InputError with the reason when the options are not valid (TrackerOptions::IsValid).
+  explicit Tracker(TrackerOptions options);
+
+  // Processes the next frame. `since_previous` is the wheel travel from the previous frame
+  // to this one (ignored for the first frame and when the gate is off). A frame that could
+  // not be read should still be passed, with no lines, so that frame counts and odometry
+  // stay right. `out` is resized to the number of lines, in line order. Throws
+  // std::invalid_argument when the descriptors do not have one row per line or change width.
+  void add_frame(const FrameFeatures& frame,
+                 const WheelIncrement& since_previous,
+                 std::vector<TrackAssignment>* out);
+  // Same, without odometry (the gate must be off; std::invalid_argument otherwise).
+  void add_frame(const FrameFeatures& frame, std::vector<TrackAssignment>* out);
+
+  const TrackerOptions& options() const { return options_; }
+  const TrackerStats& stats() const { return stats_; }
+  std::int64_t frames_seen() const { return frame_count_; }
+  std::int64_t tracks_created() const { return next_track_id_; }
+
+ private:
+  struct Slot {
+    DescriptorMatrix descriptors;  // capacity rows; the first `num_lines` are live
+    std::vector<double> bearings;
+    std::vector<std::int64_t> track_ids;
+    int num_lines = 0;
+    OdometryAccumulator odometry;
+  };
+
+  // The slot of frame (frame_count_ - k), k = 1..look_back; requires k <= frames held.
+  Slot& slot_back(int k);
+  void store_frame(const FrameFeatures& frame, const std::vector<TrackAssignment>& out);
+  bool track_claimed(std::int64_t id) const;
+
+  TrackerOptions options_;
+  Matcher matcher_;
+  std::vector<Slot> ring_;
+  std::int64_t frame_count_ = 0;
+  std::int64_t next_track_id_ = 0;
+  OdometryAccumulator odometry_;
+  Eigen::Index descriptor_width_ = 0;
+  TrackerStats stats_;
+  // Per-frame work space.
+  std::vector<int> unmatched_;
+  std::vector<int> still_unmatched_;
+  std::vector<std::int64_t> claimed_;
+  DescriptorMatrix query_;
+  std::vector<MatchResult> results_;
+};
+
+}  // namespace omnivert

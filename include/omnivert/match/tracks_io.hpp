@@ -1,0 +1,54 @@
+#pragma once
+// tracks.csv: the tracker's output, one row per reported line per frame (drawn as the paper's
+// Fig. 22 by tracks_plot.hpp).
+//
+// Columns (header line first; only the first four are required when reading):
+//   frame          0-based image index in the dataset (cam0/data.csv order)
+//   timestamp_ns   image timestamp
+//   track_id       stable integer id, 0, 1, 2, ... in order of creation
+//   bearing_rad    camera bearing beta in (-pi, pi] (NOTES Sec. 1)
+//   image_angle_rad, edge_pixels, r_inner, r_outer   the detection (extract/vertical_line.hpp)
+//   matched_frame  frame of the observation this one was matched to; -1 starts a new track
+//   distance       descriptor distance of that match (eq. 6); 0 for a new track
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "omnivert/describe/frame_features.hpp"
+#include "omnivert/match/tracker.hpp"
+
+namespace omnivert {
+
+struct TrackRow {
+  std::int64_t frame = 0;
+  std::int64_t timestamp_ns = 0;
+  std::int64_t track_id = 0;
+  double bearing = 0.0;
+  double image_angle = 0.0;
+  int edge_pixels = 0;
+  double r_inner = 0.0;
+  double r_outer = 0.0;
+  std::int64_t matched_frame = -1;
+  double distance = 0.0;
+};
+
+// Appends one row per line of `frame` (in line order) from the tracker's assignments.
+void append_track_rows(std::int64_t frame_index,
+                       std::int64_t timestamp_ns,
+                       const FrameFeatures& frame,
+                       const std::vector<TrackAssignment>& assignments,
+                       std::vector<TrackRow>* rows);
+
+// Writes tracks.csv. The file is written under a temporary name and renamed when complete,
+// so a failed run never leaves a partial file that looks complete. Throws InputError when the
+// file cannot be written.
+void write_tracks_csv(const std::filesystem::path& path, const std::vector<TrackRow>& rows);
+
+// Reads tracks.csv (columns found by header name, any order; unknown columns ignored).
+// Throws InputError(file, line, problem) for a missing file, a missing required column, a
+// malformed or non-finite number, a negative frame or track id.
+std::vector<TrackRow> read_tracks_csv(const std::filesystem::path& path);
+
+}  // namespace omnivert

@@ -1,0 +1,282 @@
+#include "omnivert/eval/tracking_eval.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <cstdio>
+#include <iterator>
+#include <map>
+#include <unordered_map>
+
+#include "omnivert/core/error.hpp"
+
+namespace omnivert {
+
+bool TrackingEvalOptions::IsValid(std::string* error) const {
+  auto fail = [&](const std::string& why) {
+    if (error) *error = why;
+    return false;
+  };
+  if (!(association_tolerance > 0.0 && association_tolerance < kPi)) {
+    return fail("association tolerance must be in (0, pi) radians");
+  }
+  if (look_back < 1) return fail("look-back must be at least 1 frame");
+  if (interval < 1) return fail("interval must be at least 1 frame");
+  if (!(std::isfinite(annulus_r_min) && std::isfinite(annulus_r_max) && annulus_r_min >= 0.0 &&
+        annulus_r_max > annulus_r_min)) {
+    return fail("the annulus needs 0 <= R_min < R_max (pixels)");
+  }
+  if (!(long_line_fraction > 0.0 && long_line_fraction <= 1.0)) {
+    return fail("long-line fraction must be in (0, 1]");
+  }
+  return true;
+}
+
+namespace {
+
+void add(TrackingCounts* into, const TrackingCounts& c) {
+  into->matches += c.matches;
+  into->correct += c.correct;
+  into->false_matches += c.false_matches;
+  into->unverified += c.unverified;
+  into->new_entries += c.new_entries;
+  into->false_new_entries += c.false_new_entries;
+}
+
+}  // namespace
+
+TrackingEvaluation evaluate_tracking(const std::vector<TrackRow>& tracks,
+                                     const std::vector<GroundTruthLine>& ground_truth,
+                                     const TrackingEvalOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw InputError("evaluation options: " + error);
+  TrackingEvaluation ev;
+
+  std::int64_t num_frames = options.num_frames;
+  if (num_frames <= 0) {
+    for (const TrackRow& r : tracks) num_frames = std::max(num_frames, r.frame + 1);
+    for (const GroundTruthLine& g : ground_truth) num_frames = std::max(num_frames, g.frame + 1);
+  }
+
+  // Ground truth by frame.
+  std::unordered_map<std::int64_t, std::vector<std::size_t>> gt_by_frame;
+  for (std::size_t k = 0; k < ground_truth.size(); ++k) {
+    gt_by_frame[ground_truth[k].frame].push_back(k);
+  }
+
+  // Rule 1: associate each detection to the nearest true bearing within the tolerance.
+  const std::size_t n = tracks.size();
+  std::vector<std::int64_t> assoc(n, -1);
+  // Every world line within the tolerance (sorted ids): more than one when true lines are
+  // closer than the tolerance (crossings, lines far ahead), where the nearest is noise.
+  std::vector<std::vector<std::int64_t>> within(n);
+  std::vector<char> gt_detected(ground_truth.size(), 0);
+  double sq_sum = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto it = gt_by_frame.find(tracks[i].frame);
+    if (it == gt_by_frame.end()) continue;
+    double best = options.association_tolerance;
+    std::size_t best_k = ground_truth.size();
+    for (std::size_t k : it->second) {
+      const double d = std::abs(angle_diff(tracks[i].bearing, ground_truth[k].bearing));
+      if (d <= options.association_tolerance) within[i].push_back(ground_truth[k].line_id);
+      if (d <= best) {
+        best = d;
+        best_k = k;
+      }
+    }
+    std::sort(within[i].begin(), within[i].end());
+    within[i].erase(std::unique(within[i].begin(), within[i].end()), within[i].end());
+    if (within[i].size() > 1) ++ev.ambiguous_detections;
+    if (best_k == ground_truth.size()) continue;
+    assoc[i] = ground_truth[best_k].line_id;
+    gt_detected[best_k] = 1;
+    ++ev.associated_detections;
+    const double e = angle_diff(tracks[i].bearing, ground_truth[best_k].bearing);
+    sq_sum += e * e;
+  }
+  ev.detections = static_cast<std::int64_t>(n);
+  ev.bearing_rms =
+      ev.associated_detections > 0 ? std::sqrt(sq_sum / ev.associated_detections) : 0.0;
+
+  // Rule 6: recall of long lines.
+  const double long_min =
+      options.long_line_fraction * (options.annulus_r_max - options.annulus_r_min);
+  for (std::size_t k = 0; k < ground_truth.size(); ++k) {
+    if (ground_truth[k].r_outer - ground_truth[k].r_inner >= long_min) {
+      ++ev.long_lines;
+      ev.long_lines_detected += gt_detected[k];
+    }
+  }
+
+  // World lines detected per frame (sorted), for rule 4.
+  std::unordered_map<std::int64_t, std::vector<std::int64_t>> detected_by_frame;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (assoc[i] >= 0) detected_by_frame[tracks[i].frame].push_back(assoc[i]);
+  }
+  for (auto& [f, v] : detected_by_frame) std::sort(v.begin(), v.end());
+  auto detected_in = [&](std::int64_t frame, std::int64_t line) {
+    const auto it = detected_by_frame.find(frame);
+    return it != detected_by_frame.end() &&
+           std::binary_search(it->second.begin(), it->second.end(), line);
+  };
+
+  // Tracks: detections by id, in frame order.
+  std::map<std::int64_t, std::vector<std::size_t>> by_track;
+  for (std::size_t i = 0; i < n; ++i) by_track[tracks[i].track_id].push_back(i);
+
+  const std::int64_t num_intervals =
+      std::max<std::int64_t>(1, (num_frames + options.interval - 1) / options.interval);
+  ev.intervals.resize(static_cast<std::size_t>(num_intervals));
+  for (std::int64_t k = 0; k < num_intervals; ++k) {
+    auto& c = ev.intervals[static_cast<std::size_t>(k)];
+    c.first_frame = k * options.interval;
+    c.end_frame =
+        std::min<std::int64_t>((k + 1) * options.interval, std::max<std::int64_t>(num_frames, 1));
+  }
+  auto bucket = [&](std::int64_t frame) -> TrackingCounts& {
+    const std::int64_t k = std::clamp<std::int64_t>(frame / options.interval, 0, num_intervals - 1);
+    return ev.intervals[static_cast<std::size_t>(k)];
+  };
+
+  // Rule 3: identity sets propagated along the links of each track.
+  std::vector<std::vector<std::int64_t>> identity(n);
+  std::vector<std::int64_t> common;
+  for (auto& [id, dets] : by_track) {
+    std::stable_sort(dets.begin(), dets.end(), [&](std::size_t a, std::size_t b) {
+      return tracks[a].frame < tracks[b].frame;
+    });
+    const std::int64_t start_frame = tracks[dets.front()].frame;
+    for (std::size_t k = 0; k < dets.size(); ++k) {
+      const std::size_t i = dets[k];
+      const TrackRow& d = tracks[i];
+      if (k > 0 && tracks[dets[k - 1]].frame == d.frame) ++ev.duplicate_ids;
+      if (d.frame == start_frame) {
+        identity[i] = within[i];
+        // Rule 2: the first detection(s) of a track id are new entries. Rule 4.
+        TrackingCounts& c = bucket(d.frame);
+        ++c.new_entries;
+        if (assoc[i] >= 0) {
+          for (int b = 1; b <= options.look_back; ++b) {
+            if (detected_in(d.frame - b, assoc[i])) {
+              ++c.false_new_entries;
+              break;
+            }
+          }
+        }
+        continue;
+      }
+      // Rule 2: the predecessor, at matched_frame when known, else the latest earlier frame.
+      std::int64_t pred_frame = -1;
+      if (d.matched_frame >= 0) {
+        for (std::size_t m = 0; m < k; ++m) {
+          if (tracks[dets[m]].frame == d.matched_frame) pred_frame = d.matched_frame;
+        }
+      }
+      if (pred_frame < 0) {
+        for (std::size_t m = k; m-- > 0;) {
+          if (tracks[dets[m]].frame < d.frame) {
+            pred_frame = tracks[dets[m]].frame;
+            break;
+          }
+        }
+      }
+      std::size_t pred = n;
+      double pred_d = 10.0;
+      for (std::size_t m = 0; m < k; ++m) {
+        const std::size_t j = dets[m];
+        if (tracks[j].frame != pred_frame) continue;
+        const double dd = std::abs(angle_diff(tracks[j].bearing, d.bearing));
+        if (dd < pred_d) {
+          pred_d = dd;
+          pred = j;
+        }
+      }
+      assert(pred < n);
+      // Rule 3.
+      TrackingCounts& c = bucket(d.frame);
+      ++c.matches;
+      if (within[i].empty() || identity[pred].empty()) {
+        ++c.unverified;
+        identity[i] = within[i];
+        continue;
+      }
+      common.clear();
+      std::set_intersection(identity[pred].begin(),
+                            identity[pred].end(),
+                            within[i].begin(),
+                            within[i].end(),
+                            std::back_inserter(common));
+      if (!common.empty()) {
+        ++c.correct;
+        identity[i] = common;
+      } else {
+        ++c.false_matches;
+        identity[i] = within[i];
+      }
+    }
+  }
+  ev.total.first_frame = 0;
+  ev.total.end_frame = std::max<std::int64_t>(num_frames, 1);
+  for (const auto& c : ev.intervals) add(&ev.total, c);
+  return ev;
+}
+
+std::string format_tracking_table(const TrackingEvaluation& ev, const std::string& title) {
+  std::string s = title + "\n";
+  char buf[256];
+  std::snprintf(buf,
+                sizeof(buf),
+                "%-16s %9s %10s %10s %11s %12s\n",
+                "Frame interval",
+                "Matches",
+                "Correct %",
+                "False m. %",
+                "False new %",
+                "Unverified %");
+  s += buf;
+  auto row = [&](const std::string& label, const TrackingCounts& c) {
+    std::snprintf(buf,
+                  sizeof(buf),
+                  "%-16s %9lld %10.2f %10.2f %11.2f %12.2f\n",
+                  label.c_str(),
+                  static_cast<long long>(c.matches),
+                  c.percent_correct(),
+                  c.percent_false_matches(),
+                  c.percent_false_new_entries(),
+                  c.percent_unverified());
+    s += buf;
+  };
+  for (const auto& c : ev.intervals) {
+    row(std::to_string(c.first_frame) + "-" + std::to_string(c.end_frame), c);
+  }
+  row("Total", ev.total);
+  std::snprintf(buf,
+                sizeof(buf),
+                "False matches: %lld, false new entries: %lld (of %lld new tracks)\n",
+                static_cast<long long>(ev.total.false_matches),
+                static_cast<long long>(ev.total.false_new_entries),
+                static_cast<long long>(ev.total.new_entries));
+  s += buf;
+  std::snprintf(buf,
+                sizeof(buf),
+                "Detections: %lld, associated within tolerance: %lld (%.1f%%), ambiguous "
+                "(several true lines within tolerance): %lld, duplicate ids in a frame: %lld\n",
+                static_cast<long long>(ev.detections),
+                static_cast<long long>(ev.associated_detections),
+                ev.detections > 0 ? 100.0 * ev.associated_detections / ev.detections : 0.0,
+                static_cast<long long>(ev.ambiguous_detections),
+                static_cast<long long>(ev.duplicate_ids));
+  s += buf;
+  std::snprintf(buf,
+                sizeof(buf),
+                "Recall of long lines: %.2f%% (%lld of %lld)\nBearing RMS error: %.3f deg\n",
+                100.0 * ev.long_line_recall(),
+                static_cast<long long>(ev.long_lines_detected),
+                static_cast<long long>(ev.long_lines),
+                rad2deg(ev.bearing_rms));
+  s += buf;
+  return s;
+}
+
+}  // namespace omnivert

@@ -1,0 +1,166 @@
+#include "omnivert/match/matcher.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <sstream>
+
+namespace omnivert {
+
+bool MatchOptions::IsValid(std::string* error) const {
+  auto fail = [&](const std::string& why) {
+    if (error) *error = why;
+    return false;
+  };
+  // Descriptor distances are non-negative; a non-positive bound would reject everything.
+  if (!(std::isfinite(f1) && f1 > 0.0)) return fail("F1 must be a positive number (Table 2: 1.05)");
+  // F2 and F3 "clearly range from zero to one" (Sec. 4.2, 4.3).
+  if (!(f2 > 0.0 && f2 <= 1.0)) return fail("F2 must be in (0, 1] (Table 2: 0.75)");
+  if (!(f3 > 0.0 && f3 <= 1.0)) return fail("F3 must be in (0, 1] (Table 2: 0.8)");
+  return true;
+}
+
+const char* to_string(MatchVerdict v) {
+  switch (v) {
+    case MatchVerdict::kAccepted:
+      return "accepted";
+    case MatchVerdict::kNoCandidates:
+      return "no candidates";
+    case MatchVerdict::kFailedTest1:
+      return "failed test 1";
+    case MatchVerdict::kFailedTest2:
+      return "failed test 2";
+    case MatchVerdict::kFailedTest3:
+      return "failed test 3";
+  }
+  return "?";
+}
+
+MatchVerdict apply_match_tests(const MatchOptions& options,
+                               int num_candidates,
+                               double min_distance,
+                               double second_distance,
+                               double mean_distance) {
+  if (num_candidates <= 0) return MatchVerdict::kNoCandidates;
+  // Sec. 4.1, eq. (8).
+  if (options.use_test1 && !(min_distance <= options.f1)) return MatchVerdict::kFailedTest1;
+  // Sec. 4.2, eq. (9); with one candidate the mean is the minimum itself, so this rejects
+  // every non-zero distance (see the header).
+  if (options.use_test2 && !(min_distance <= options.f2 * mean_distance)) {
+    return MatchVerdict::kFailedTest2;
+  }
+  // Sec. 4.3, eq. (10); second_distance is +inf for a single candidate (vacuous test).
+  if (options.use_test3 && num_candidates >= 2 && !(min_distance <= options.f3 * second_distance)) {
+    return MatchVerdict::kFailedTest3;
+  }
+  return MatchVerdict::kAccepted;
+}
+
+Matcher::Matcher(MatchOptions options) : options_(options) {}
+
+Matcher::DistanceView Matcher::compute_distances(const ConstDescriptors& query,
+                                                 const ConstDescriptors& candidates) {
+  assert(query.rows() == 0 || candidates.rows() == 0 || query.cols() == candidates.cols());
+  rows_ = query.rows();
+  cols_ = candidates.rows();
+  // Grow the work space only when a larger problem arrives (no allocation in steady state).
+  if (distances_.rows() < rows_ || distances_.cols() < cols_) {
+    // Generous steps (at least 64, then doubling) so that growth stops after a few frames.
+    auto grow = [](Eigen::Index have, Eigen::Index need) {
+      return have >= need ? have : std::max<Eigen::Index>({need, 2 * have, 64});
+    };
+    distances_.resize(grow(distances_.rows(), rows_), grow(distances_.cols(), cols_));
+  }
+  if (query_norms_.size() < rows_) query_norms_.resize(distances_.rows());
+  if (candidate_norms_.size() < cols_) candidate_norms_.resize(distances_.cols());
+  if (rows_ == 0 || cols_ == 0) return last_distances();
+
+  // Eq. (6) as |a - b|^2 = |a|^2 + |b|^2 - 2 a.b: one matrix product for all pairs.
+  auto d = distances_.topLeftCorner(rows_, cols_);
+  d.noalias() = query * candidates.transpose();
+  query_norms_.head(rows_) = query.rowwise().squaredNorm();
+  candidate_norms_.head(cols_) = candidates.rowwise().squaredNorm();
+  for (Eigen::Index i = 0; i < rows_; ++i) {
+    const float qn = query_norms_(i);
+    for (Eigen::Index j = 0; j < cols_; ++j) {
+      // Rounding can make the expansion slightly negative for near-identical descriptors.
+      const float sq = qn + candidate_norms_(j) - 2.0f * d(i, j);
+      d(i, j) = std::sqrt(std::max(sq, 0.0f));
+    }
+  }
+  return last_distances();
+}
+
+MatchResult Matcher::evaluate_row(const Eigen::Ref<const Eigen::RowVectorXf>& row) const {
+  MatchResult r;
+  const Eigen::Index n = row.size();
+  if (n == 0) return r;
+  float best = std::numeric_limits<float>::infinity();
+  float second = std::numeric_limits<float>::infinity();
+  int best_j = -1;
+  double sum = 0.0;
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const float v = row(j);
+    sum += v;
+    if (v < best) {  // strict: ties keep the lowest index
+      second = best;
+      best = v;
+      best_j = static_cast<int>(j);
+    } else if (v < second) {
+      second = v;
+    }
+  }
+  r.best = best_j;
+  r.min_distance = best;
+  r.second_distance = second;
+  r.mean_distance = static_cast<float>(sum / static_cast<double>(n));
+  r.verdict =
+      apply_match_tests(options_, static_cast<int>(n), best, second, sum / static_cast<double>(n));
+  return r;
+}
+
+void Matcher::match(const ConstDescriptors& query,
+                    const ConstDescriptors& candidates,
+                    std::vector<MatchResult>* results) {
+  const DistanceView d = compute_distances(query, candidates);
+  results->resize(static_cast<std::size_t>(query.rows()));
+  for (Eigen::Index i = 0; i < query.rows(); ++i) {
+    (*results)[static_cast<std::size_t>(i)] = cols_ == 0 ? MatchResult{} : evaluate_row(d.row(i));
+  }
+}
+
+std::vector<MatchResult> match_brute_force(const MatchOptions& options,
+                                           const DescriptorMatrix& query,
+                                           const DescriptorMatrix& candidates) {
+  std::vector<MatchResult> out(static_cast<std::size_t>(query.rows()));
+  const Eigen::Index nb = candidates.rows();
+  std::vector<std::pair<double, int>> row;
+  for (Eigen::Index i = 0; i < query.rows(); ++i) {
+    row.clear();
+    double sum = 0.0;
+    for (Eigen::Index j = 0; j < nb; ++j) {
+      double s = 0.0;  // eq. (6), term by term
+      for (Eigen::Index k = 0; k < query.cols(); ++k) {
+        const double diff = static_cast<double>(query(i, k)) - candidates(j, k);
+        s += diff * diff;
+      }
+      const double dist = std::sqrt(s);
+      sum += dist;
+      row.emplace_back(dist, static_cast<int>(j));
+    }
+    MatchResult& r = out[static_cast<std::size_t>(i)];
+    if (nb == 0) continue;
+    std::stable_sort(
+        row.begin(), row.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    r.best = row[0].second;
+    r.min_distance = static_cast<float>(row[0].first);
+    const double second = nb >= 2 ? row[1].first : std::numeric_limits<double>::infinity();
+    r.second_distance = static_cast<float>(second);
+    const double mean = sum / static_cast<double>(nb);
+    r.mean_distance = static_cast<float>(mean);
+    r.verdict = apply_match_tests(options, static_cast<int>(nb), row[0].first, second, mean);
+  }
+  return out;
+}
+
+}  // namespace omnivert

@@ -1,0 +1,241 @@
+#include "omnivert/match/tracker.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cassert>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "omnivert/core/error.hpp"
+
+namespace omnivert {
+namespace {
+
+// Capacity for a frame of n lines: at least 64 (frames have 20-40 lines), else the next power
+// of two, so that buffers reach their final size after a few frames and then stay.
+Eigen::Index line_capacity(Eigen::Index n) {
+  return std::max<Eigen::Index>(64,
+                                static_cast<Eigen::Index>(std::bit_ceil(
+                                    static_cast<std::size_t>(std::max<Eigen::Index>(n, 1)))));
+}
+
+}  // namespace
+
+bool TrackerOptions::IsValid(std::string* error) const {
+  if (!match.IsValid(error)) return false;
+  if (look_back < 1 || look_back > 1000) {
+    if (error) *error = "look-back must be between 1 and 1000 frames (paper: 20)";
+    return false;
+  }
+  return gate.IsValid(error);
+}
+
+TrackerOptions paper_tracker_options() { return TrackerOptions{}; }
+
+TrackerOptions recommended_tracker_options(double wheel_base) {
+  TrackerOptions o;
+  o.mutual = true;
+  if (wheel_base > 0.0) {
+    o.gate.enabled = true;
+    o.gate.wheel_base = wheel_base;
+  }
+  return o;
+}
+
+std::string TrackerStats::BriefReport() const {
+  std::ostringstream s;
+  s << frames << " frames, " << lines << " lines: " << matched_previous
+    << " matched in the previous frame, " << matched_look_back << " by look-back, " << new_tracks
+    << " new tracks; rejected: test1 " << rejected_test1 << ", test2 " << rejected_test2
+    << ", test3 " << rejected_test3 << ", mutual " << rejected_mutual << ", claimed "
+    << rejected_claimed << ", odometry gate " << rejected_gate;
+  return s.str();
+}
+
+Tracker::Tracker(TrackerOptions options) : options_(options), matcher_(options.match) {
+  // Options usually come from the user (flags, config): report, do not crash.
+  std::string error;
+  if (!options_.IsValid(&error)) throw InputError("tracker options: " + error);
+  ring_.resize(static_cast<std::size_t>(options_.look_back));
+}
+
+Tracker::Slot& Tracker::slot_back(int k) {
+  const std::int64_t frame = frame_count_ - k;
+  assert(k >= 1 && k <= options_.look_back && frame >= 0);
+  return ring_[static_cast<std::size_t>(frame % options_.look_back)];
+}
+
+bool Tracker::track_claimed(std::int64_t id) const {
+  return std::find(claimed_.begin(), claimed_.end(), id) != claimed_.end();
+}
+
+void Tracker::add_frame(const FrameFeatures& frame, std::vector<TrackAssignment>* out) {
+  if (options_.gate.enabled) {
+    throw std::invalid_argument("Tracker::add_frame: the odometry gate needs wheel increments");
+  }
+  add_frame(frame, WheelIncrement{}, out);
+}
+
+void Tracker::add_frame(const FrameFeatures& frame,
+                        const WheelIncrement& since_previous,
+                        std::vector<TrackAssignment>* out) {
+  const int n = static_cast<int>(frame.lines.size());
+  // Contract: one descriptor row per line, one width for the whole run.
+  if (frame.descriptors.rows() != n) {
+    throw std::invalid_argument("Tracker::add_frame: " + std::to_string(n) + " lines but " +
+                                std::to_string(frame.descriptors.rows()) + " descriptor rows");
+  }
+  if (n > 0 && descriptor_width_ > 0 && frame.descriptors.cols() != descriptor_width_) {
+    throw std::invalid_argument("Tracker::add_frame: descriptor width changed from " +
+                                std::to_string(descriptor_width_) + " to " +
+                                std::to_string(frame.descriptors.cols()));
+  }
+  if (n > 0) descriptor_width_ = frame.descriptors.cols();
+  if (frame_count_ > 0 && options_.gate.enabled) {
+    odometry_.add(since_previous, options_.gate.wheel_base);
+  }
+  out->assign(static_cast<std::size_t>(n), TrackAssignment{});
+  claimed_.clear();
+  if (static_cast<Eigen::Index>(unmatched_.capacity()) < n) {
+    const auto cap = static_cast<std::size_t>(line_capacity(n));
+    unmatched_.reserve(cap);
+    still_unmatched_.reserve(cap);
+    claimed_.reserve(cap);
+  }
+  unmatched_.resize(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) unmatched_[static_cast<std::size_t>(i)] = i;
+
+  const int held = static_cast<int>(std::min<std::int64_t>(frame_count_, options_.look_back));
+  for (int k = 1; k <= held && !unmatched_.empty(); ++k) {
+    Slot& slot = slot_back(k);
+    if (slot.num_lines == 0) continue;
+    const auto candidates = slot.descriptors.topRows(slot.num_lines);
+    // Query rows: the lines still unmatched (all of them for k = 1).
+    const int nq = static_cast<int>(unmatched_.size());
+    // All lines still in play (always so for k = 1): match the frame's own matrix, no copy.
+    const bool all_rows = nq == n;
+    if (all_rows) {
+      matcher_.match(frame.descriptors, candidates, &results_);
+    } else {
+      if (query_.rows() < nq || query_.cols() != frame.descriptors.cols()) {
+        query_.resize(line_capacity(std::max<Eigen::Index>(query_.rows(), nq)),
+                      frame.descriptors.cols());
+      }
+      for (int q = 0; q < nq; ++q) {
+        query_.row(q) = frame.descriptors.row(unmatched_[static_cast<std::size_t>(q)]);
+      }
+      matcher_.match(query_.topRows(nq), candidates, &results_);
+    }
+    const BearingGate gate = options_.gate.enabled
+                                 ? make_bearing_gate(options_.gate, slot.odometry, odometry_)
+                                 : BearingGate{};
+    still_unmatched_.clear();
+    for (int q = 0; q < nq; ++q) {
+      const int i = unmatched_[static_cast<std::size_t>(q)];
+      const MatchResult& r = results_[static_cast<std::size_t>(q)];
+      bool ok = r.accepted();
+      switch (r.verdict) {
+        case MatchVerdict::kFailedTest1:
+          ++stats_.rejected_test1;
+          break;
+        case MatchVerdict::kFailedTest2:
+          ++stats_.rejected_test2;
+          break;
+        case MatchVerdict::kFailedTest3:
+          ++stats_.rejected_test3;
+          break;
+        default:
+          break;
+      }
+      const std::int64_t id = ok ? slot.track_ids[static_cast<std::size_t>(r.best)] : -1;
+      if (ok && options_.mutual) {
+        // Reverse direction first (so that the reason does not depend on the order in which
+        // lines are processed): the nearest line of the new frame to B_best must be A_i.
+        // Computed for the accepted candidate only (n dot products), ties to lowest index.
+        int nearest = -1;
+        if (all_rows) {
+          // The whole column of distances to B_best is at hand (row q is line q).
+          Eigen::Index idx = 0;
+          matcher_.last_distances().col(r.best).minCoeff(&idx);
+          nearest = static_cast<int>(idx);
+        } else {
+          const auto b = slot.descriptors.row(r.best);
+          float nearest_sq = std::numeric_limits<float>::infinity();
+          for (int a = 0; a < n; ++a) {
+            const float sq = (frame.descriptors.row(a) - b).squaredNorm();
+            if (sq < nearest_sq) {
+              nearest_sq = sq;
+              nearest = a;
+            }
+          }
+        }
+        if (nearest != i) {
+          ++stats_.rejected_mutual;
+          ok = false;
+        } else if (track_claimed(id)) {
+          // One line per track and frame: taken by a line matched in a more recent frame.
+          ++stats_.rejected_claimed;
+          ok = false;
+        }
+      }
+      if (ok && options_.gate.enabled &&
+          !gate.admits(slot.bearings[static_cast<std::size_t>(r.best)],
+                       frame.lines[static_cast<std::size_t>(i)].bearing)) {
+        ++stats_.rejected_gate;
+        ok = false;
+      }
+      if (!ok) {
+        still_unmatched_.push_back(i);
+        continue;
+      }
+      TrackAssignment& a = (*out)[static_cast<std::size_t>(i)];
+      a.track_id = id;
+      a.frames_back = k;
+      a.matched_line = r.best;
+      a.distance = r.min_distance;
+      if (options_.mutual) claimed_.push_back(id);
+      if (k == 1) {
+        ++stats_.matched_previous;
+      } else {
+        ++stats_.matched_look_back;
+      }
+    }
+    unmatched_.swap(still_unmatched_);
+  }
+
+  // Sec. 9.1: no correspondence in any of the frames looked at: a new track.
+  for (int i : unmatched_) {
+    TrackAssignment& a = (*out)[static_cast<std::size_t>(i)];
+    a.track_id = next_track_id_++;
+    ++stats_.new_tracks;
+  }
+  store_frame(frame, *out);
+  ++stats_.frames;
+  stats_.lines += n;
+}
+
+void Tracker::store_frame(const FrameFeatures& frame, const std::vector<TrackAssignment>& out) {
+  // The slot of frame t replaces that of frame t - look_back, which is no longer needed.
+  Slot& slot = ring_[static_cast<std::size_t>(frame_count_ % options_.look_back)];
+  const int n = static_cast<int>(frame.lines.size());
+  const Eigen::Index cols = frame.descriptors.cols();
+  if (slot.descriptors.rows() < n || slot.descriptors.cols() != cols) {
+    slot.descriptors.resize(line_capacity(std::max<Eigen::Index>(slot.descriptors.rows(), n)),
+                            cols);
+    slot.bearings.reserve(static_cast<std::size_t>(slot.descriptors.rows()));
+    slot.track_ids.reserve(static_cast<std::size_t>(slot.descriptors.rows()));
+  }
+  if (n > 0) slot.descriptors.topRows(n) = frame.descriptors;
+  slot.bearings.resize(static_cast<std::size_t>(n));
+  slot.track_ids.resize(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    slot.bearings[static_cast<std::size_t>(i)] = frame.lines[static_cast<std::size_t>(i)].bearing;
+    slot.track_ids[static_cast<std::size_t>(i)] = out[static_cast<std::size_t>(i)].track_id;
+  }
+  slot.num_lines = n;
+  slot.odometry = odometry_;
+  ++frame_count_;
+}
+
+}  // namespace omnivert

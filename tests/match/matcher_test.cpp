@@ -1,0 +1,215 @@
+#include "omnivert/match/matcher.hpp"
+
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+namespace omnivert {
+namespace {
+
+// Descriptors at exactly known distances from A = e_0: B_j = cos(t_j) e_0 + sin(t_j) e_{j+1}
+// has |A - B_j| = sqrt(2 - 2 cos t_j) = d_j.
+struct KnownDistances {
+  DescriptorMatrix a;
+  DescriptorMatrix b;
+};
+
+KnownDistances make_known(const std::vector<double>& d, int dim = kPaperDescriptorSize) {
+  KnownDistances k;
+  k.a = DescriptorMatrix::Zero(1, dim);
+  k.a(0, 0) = 1.0f;
+  k.b = DescriptorMatrix::Zero(static_cast<Eigen::Index>(d.size()), dim);
+  for (std::size_t j = 0; j < d.size(); ++j) {
+    const double c = 1.0 - d[j] * d[j] / 2.0;
+    k.b(static_cast<Eigen::Index>(j), 0) = static_cast<float>(c);
+    k.b(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(j + 1)) =
+        static_cast<float>(std::sqrt(1.0 - c * c));
+  }
+  return k;
+}
+
+MatchResult match_one(const std::vector<double>& d, MatchOptions o = {}) {
+  const KnownDistances k = make_known(d);
+  Matcher m(o);
+  std::vector<MatchResult> r;
+  m.match(k.a, k.b, &r);
+  EXPECT_EQ(r.size(), 1u);
+  return r[0];
+}
+
+// A paper-like descriptor: non-negative, unit length per 32-bin histogram, clipped at 0.1,
+// renormalised (Sec. 3.3).
+DescriptorMatrix random_descriptors(int n, std::mt19937& rng, int dim = kPaperDescriptorSize) {
+  std::exponential_distribution<float> e(1.0f);
+  DescriptorMatrix d(n, dim);
+  for (int i = 0; i < n; ++i) {
+    for (int k = 0; k < dim; ++k) d(i, k) = e(rng);
+    d.row(i).normalize();
+    d.row(i) = d.row(i).cwiseMin(0.1f);
+    d.row(i).normalize();
+  }
+  return d;
+}
+
+TEST(MatchOptions, Validation) {
+  std::string error;
+  EXPECT_TRUE(MatchOptions{}.IsValid(&error));
+  MatchOptions o;
+  o.f2 = 1.5;
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_NE(error.find("F2"), std::string::npos);
+  o = {};
+  o.f3 = 0.0;
+  EXPECT_FALSE(o.IsValid(&error));
+  o = {};
+  o.f1 = -1.0;
+  EXPECT_FALSE(o.IsValid(&error));
+  o = {};
+  o.f1 = std::nan("");
+  EXPECT_FALSE(o.IsValid(&error));
+}
+
+TEST(Matcher, KnownDistancesAreReproduced) {
+  const std::vector<double> d = {0.57, 0.72, 0.74, 0.78, 0.83};
+  const MatchResult r = match_one(d);
+  EXPECT_EQ(r.best, 0);
+  EXPECT_NEAR(r.min_distance, 0.57, 1e-5);
+  EXPECT_NEAR(r.second_distance, 0.72, 1e-5);
+  EXPECT_NEAR(r.mean_distance, 3.64 / 5.0, 1e-5);
+}
+
+// The paper's Table 1 example with Table 2's factors: B1 passes tests 1 and 3 and fails
+// test 2, exactly as Sec. 4 says, provided <D_i> is the mean of all five distances
+// (0.728; 0.75 * 0.728 = 0.546 < 0.57). With the minimum excluded from the mean ("all
+// other descriptors": 0.7675; 0.75 * 0.7675 = 0.5756 >= 0.57) B1 would pass test 2.
+TEST(Matcher, PaperTable1FailsTest2Only) {
+  const std::vector<double> d = {0.57, 0.72, 0.74, 0.78, 0.83};
+  EXPECT_EQ(match_one(d).verdict, MatchVerdict::kFailedTest2);
+  MatchOptions only1;
+  only1.use_test2 = only1.use_test3 = false;
+  EXPECT_TRUE(match_one(d, only1).accepted());
+  MatchOptions only3;
+  only3.use_test1 = only3.use_test2 = false;
+  EXPECT_TRUE(match_one(d, only3).accepted());  // 0.57 <= 0.8 * 0.72 = 0.576, narrowly
+  MatchOptions only2;
+  only2.use_test1 = only2.use_test3 = false;
+  EXPECT_EQ(match_one(d, only2).verdict, MatchVerdict::kFailedTest2);
+  // The other reading of the mean would accept: documented in docs/tracking.md.
+  const double mean_of_others = (0.72 + 0.74 + 0.78 + 0.83) / 4.0;
+  EXPECT_LE(0.57, 0.75 * mean_of_others);
+  EXPECT_GT(0.57, 0.75 * (0.57 + 0.72 + 0.74 + 0.78 + 0.83) / 5.0);
+}
+
+TEST(Matcher, Test1RejectsFarNearest) {
+  // min 1.1 > F1 = 1.05; test 2: 1.1 <= 0.75 * 1.725; test 3: 1.1 <= 0.8 * 1.9.
+  const std::vector<double> d = {1.1, 1.9, 1.95, 1.95};
+  EXPECT_EQ(match_one(d).verdict, MatchVerdict::kFailedTest1);
+  MatchOptions o;
+  o.f1 = 1.2;
+  EXPECT_TRUE(match_one(d, o).accepted());
+}
+
+TEST(Matcher, Test3RejectsCloseSecond) {
+  // test 3: 0.5 > 0.8 * 0.6 = 0.48; tests 1 and 2 pass (0.75 * 1.06 = 0.795).
+  const std::vector<double> d = {0.6, 0.5, 1.4, 1.4, 1.4};
+  const MatchResult r = match_one(d);
+  EXPECT_EQ(r.best, 1);
+  EXPECT_EQ(r.verdict, MatchVerdict::kFailedTest3);
+  MatchOptions o;
+  o.f3 = 0.85;  // 0.5 <= 0.51
+  EXPECT_TRUE(match_one(d, o).accepted());
+}
+
+TEST(Matcher, ClearMatchAccepted) {
+  const MatchResult r = match_one({1.3, 1.2, 0.2, 1.25});
+  EXPECT_EQ(r.best, 2);
+  EXPECT_TRUE(r.accepted());
+}
+
+TEST(Matcher, SmallCandidateSets) {
+  // None: no candidates.
+  {
+    const KnownDistances k = make_known({});
+    Matcher m;
+    std::vector<MatchResult> r;
+    m.match(k.a, k.b, &r);
+    ASSERT_EQ(r.size(), 1u);
+    EXPECT_EQ(r[0].verdict, MatchVerdict::kNoCandidates);
+    EXPECT_EQ(r[0].best, -1);
+  }
+  // One: the mean is the minimum; test 2 rejects any non-zero distance.
+  EXPECT_EQ(match_one({0.1}).verdict, MatchVerdict::kFailedTest2);
+  MatchOptions no2;
+  no2.use_test2 = false;
+  EXPECT_TRUE(match_one({0.1}, no2).accepted());  // test 3 vacuous, test 1 passes
+  // Two: test 2 is min <= F2 / (2 - F2) * Smin = 0.6 * Smin.
+  EXPECT_EQ(match_one({0.5, 0.8}).verdict, MatchVerdict::kFailedTest2);  // 0.5 > 0.48
+  EXPECT_TRUE(match_one({0.5, 0.9}).accepted());                         // 0.5 <= 0.54
+  // Tie between the two nearest: the lowest index, rejected by test 3.
+  const MatchResult tie = match_one({0.3, 0.3, 1.5, 1.5});
+  EXPECT_EQ(tie.verdict, MatchVerdict::kFailedTest3);
+}
+
+TEST(Matcher, EmptyQuery) {
+  Matcher m;
+  std::vector<MatchResult> r(3);
+  DescriptorMatrix a(0, 192), b = DescriptorMatrix::Zero(4, 192);
+  m.match(a, b, &r);
+  EXPECT_TRUE(r.empty());
+}
+
+// The fast path (one matrix product, float) against the definition (double, term by term).
+TEST(Matcher, AgreesWithBruteForceOnRandomInputs) {
+  std::mt19937 rng(7);
+  Matcher m;
+  std::vector<MatchResult> fast;
+  int accepted = 0, compared = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const int na = std::uniform_int_distribution<int>(0, 45)(rng);
+    const int nb = std::uniform_int_distribution<int>(0, 45)(rng);
+    DescriptorMatrix a = random_descriptors(na, rng);
+    const DescriptorMatrix b = random_descriptors(nb, rng);
+    // Make some queries noisy copies of candidates so that all verdicts occur.
+    std::normal_distribution<float> noise(0.0f, 0.01f);
+    for (int i = 0; i < na && nb > 0; i += 2) {
+      const int j = std::uniform_int_distribution<int>(0, nb - 1)(rng);
+      for (int k = 0; k < a.cols(); ++k) a(i, k) = b(j, k) + noise(rng);
+      a.row(i).normalize();
+    }
+    m.match(a, b, &fast);
+    const auto ref = match_brute_force(MatchOptions{}, a, b);
+    const auto dist = m.last_distances();
+    ASSERT_EQ(fast.size(), ref.size());
+    for (int i = 0; i < na; ++i) {
+      for (int j = 0; j < nb; ++j) {
+        const double exact = (a.row(i).cast<double>() - b.row(j).cast<double>()).norm();
+        ASSERT_NEAR(dist(i, j), exact, 2e-4) << i << "," << j;
+      }
+      const MatchResult& f = fast[static_cast<std::size_t>(i)];
+      const MatchResult& r = ref[static_cast<std::size_t>(i)];
+      ++compared;
+      if (nb == 0) {
+        EXPECT_EQ(f.verdict, MatchVerdict::kNoCandidates);
+        continue;
+      }
+      EXPECT_NEAR(f.min_distance, r.min_distance, 2e-4);
+      EXPECT_NEAR(f.mean_distance, r.mean_distance, 2e-4);
+      if (nb >= 2) EXPECT_NEAR(f.second_distance, r.second_distance, 2e-4);
+      // Float rounding may swap a near-tie; everything else must agree exactly.
+      if (r.second_distance - r.min_distance > 1e-3f) {
+        EXPECT_EQ(f.best, r.best);
+      }
+      const bool near_boundary = std::abs(r.min_distance - 1.05) < 1e-3 ||
+                                 std::abs(r.min_distance - 0.75 * r.mean_distance) < 1e-3 ||
+                                 std::abs(r.min_distance - 0.8 * r.second_distance) < 1e-3;
+      if (!near_boundary) EXPECT_EQ(f.verdict, r.verdict) << "query " << i;
+      accepted += r.accepted();
+    }
+  }
+  EXPECT_GT(accepted, 500);  // the random sets do exercise acceptance
+  EXPECT_GT(compared, 3000);
+}
+
+}  // namespace
+}  // namespace omnivert

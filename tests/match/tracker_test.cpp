@@ -1,0 +1,511 @@
+#include "omnivert/match/tracker.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <random>
+#include <set>
+#include <stdexcept>
+
+#include <gtest/gtest.h>
+
+#include "omnivert/core/angles.hpp"
+#include "omnivert/core/error.hpp"
+
+namespace omnivert {
+namespace {
+
+// A unit, non-negative, clipped descriptor like the paper's (Sec. 3.3).
+Eigen::RowVectorXf random_descriptor(std::mt19937& rng, int dim = kPaperDescriptorSize) {
+  std::exponential_distribution<float> e(1.0f);
+  Eigen::RowVectorXf d(dim);
+  for (int k = 0; k < dim; ++k) d(k) = e(rng);
+  d.normalize();
+  d = d.cwiseMin(0.1f);
+  d.normalize();
+  return d;
+}
+
+Eigen::RowVectorXf perturb(const Eigen::RowVectorXf& d, float sigma, std::mt19937& rng) {
+  std::normal_distribution<float> n(0.0f, sigma);
+  Eigen::RowVectorXf p = d;
+  for (int k = 0; k < p.size(); ++k) p(k) = std::max(0.0f, p(k) + n(rng));
+  p.normalize();
+  return p;
+}
+
+// A world line of a synthetic sequence: its appearance, its bearing over time, and the frames
+// in which it is seen.
+struct SynthLine {
+  Eigen::RowVectorXf descriptor;
+  double bearing0 = 0.0;
+  double rate = 0.0;  // radians per frame
+  int first = 0;
+  int last = 0;          // inclusive
+  std::set<int> hidden;  // frames (within first..last) in which it is not detected
+};
+
+struct SynthFrame {
+  FrameFeatures features;
+  std::vector<int> world_ids;  // world line of each detected line
+};
+
+// Builds frame f: every visible line, in a shuffled order, with a noisy descriptor.
+SynthFrame make_frame(const std::vector<SynthLine>& world, int f, float sigma, std::mt19937& rng) {
+  SynthFrame out;
+  std::vector<int> visible;
+  for (int w = 0; w < static_cast<int>(world.size()); ++w) {
+    const SynthLine& l = world[static_cast<std::size_t>(w)];
+    if (f >= l.first && f <= l.last && !l.hidden.count(f)) visible.push_back(w);
+  }
+  std::shuffle(visible.begin(), visible.end(), rng);
+  out.features.descriptors.resize(static_cast<Eigen::Index>(visible.size()), kPaperDescriptorSize);
+  for (std::size_t i = 0; i < visible.size(); ++i) {
+    const SynthLine& l = world[static_cast<std::size_t>(visible[i])];
+    VerticalLine v;
+    v.bearing = wrap_angle(l.bearing0 + l.rate * f);
+    v.image_angle = v.bearing;
+    out.features.lines.push_back(v);
+    out.features.descriptors.row(static_cast<Eigen::Index>(i)) = perturb(l.descriptor, sigma, rng);
+    out.world_ids.push_back(visible[i]);
+  }
+  return out;
+}
+
+std::vector<SynthLine> make_world(int n, int frames, std::mt19937& rng) {
+  std::vector<SynthLine> w(static_cast<std::size_t>(n));
+  std::uniform_real_distribution<double> b(-kPi, kPi), r(-0.02, 0.02);
+  for (auto& l : w) {
+    l.descriptor = random_descriptor(rng);
+    l.bearing0 = b(rng);
+    l.rate = r(rng);
+    l.first = 0;
+    l.last = frames - 1;
+  }
+  return w;
+}
+
+// Runs a sequence; returns, per frame, the track id of each world line seen (world -> id).
+std::vector<std::map<int, std::int64_t>> run(Tracker& tracker,
+                                             const std::vector<SynthLine>& world,
+                                             int frames,
+                                             float sigma,
+                                             std::mt19937& rng) {
+  std::vector<std::map<int, std::int64_t>> ids(static_cast<std::size_t>(frames));
+  std::vector<TrackAssignment> out;
+  for (int f = 0; f < frames; ++f) {
+    const SynthFrame fr = make_frame(world, f, sigma, rng);
+    tracker.add_frame(fr.features, &out);
+    EXPECT_EQ(out.size(), fr.world_ids.size());
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      ids[static_cast<std::size_t>(f)][fr.world_ids[i]] = out[i].track_id;
+    }
+  }
+  return ids;
+}
+
+TEST(TrackerOptions, Validation) {
+  std::string error;
+  EXPECT_TRUE(TrackerOptions{}.IsValid(&error));
+  TrackerOptions o;
+  o.look_back = 0;
+  EXPECT_FALSE(o.IsValid(&error));
+  o = {};
+  o.gate.enabled = true;  // wheel base missing
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_NE(error.find("wheel base"), std::string::npos);
+  o.gate.wheel_base = 0.4;
+  EXPECT_TRUE(o.IsValid(&error));
+}
+
+TEST(Tracker, IdsPreservedOverASequence) {
+  std::mt19937 rng(11);
+  const int frames = 60;
+  const auto world = make_world(30, frames, rng);
+  for (bool mutual : {false, true}) {
+    TrackerOptions o;
+    o.mutual = mutual;
+    Tracker tracker(o);
+    const auto ids = run(tracker, world, frames, 0.01f, rng);
+    // Every world line keeps the id it got in frame 0, and ids are 0..29.
+    std::set<std::int64_t> seen;
+    for (int w = 0; w < 30; ++w) {
+      const std::int64_t id0 = ids[0].at(w);
+      seen.insert(id0);
+      for (int f = 1; f < frames; ++f) {
+        ASSERT_EQ(ids[static_cast<std::size_t>(f)].at(w), id0) << "line " << w << " frame " << f;
+      }
+    }
+    EXPECT_EQ(seen.size(), 30u);
+    EXPECT_EQ(*seen.rbegin(), 29);
+    EXPECT_EQ(tracker.tracks_created(), 30);
+    EXPECT_EQ(tracker.stats().matched_previous, 30 * (frames - 1));
+    EXPECT_EQ(tracker.stats().matched_look_back, 0);
+  }
+}
+
+TEST(Tracker, LookBackRecoversDropoutsAndNewLinesGetNewIds) {
+  std::mt19937 rng(23);
+  const int frames = 80;
+  auto world = make_world(25, frames, rng);
+  // Line 3 is missed for 5 frames, line 7 for 19 frames (back in frame 50: 20 frames back).
+  for (int f = 10; f < 15; ++f) world[3].hidden.insert(f);
+  for (int f = 31; f < 50; ++f) world[7].hidden.insert(f);
+  // Line 9 is missed for 25 frames: beyond the look-back, it must come back as a new track.
+  for (int f = 20; f < 45; ++f) world[9].hidden.insert(f);
+  // Lines 20-24 vanish at frame 40; 5 new lines appear at frame 41.
+  for (int w = 20; w < 25; ++w) world[static_cast<std::size_t>(w)].last = 39;
+  std::mt19937 rng2(99);
+  for (int k = 0; k < 5; ++k) {
+    SynthLine l;
+    l.descriptor = random_descriptor(rng2);
+    l.bearing0 = -3.0 + k;
+    l.first = 41;
+    l.last = frames - 1;
+    world.push_back(l);
+  }
+
+  Tracker tracker{TrackerOptions{}};
+  const auto ids = run(tracker, world, frames, 0.01f, rng);
+  EXPECT_EQ(ids[15].at(3), ids[9].at(3));   // 6 frames back
+  EXPECT_EQ(ids[50].at(7), ids[30].at(7));  // 20 frames back: the limit, still found
+  EXPECT_NE(ids[45].at(9), ids[19].at(9));  // 26 frames back: a new id
+  EXPECT_EQ(ids[45].at(9), ids[79].at(9));  // and then tracked under it
+  std::set<std::int64_t> fresh;
+  for (int w = 25; w < 30; ++w) {
+    const std::int64_t id = ids[41].at(w);
+    EXPECT_GE(id, 25);  // never an id of an earlier line
+    fresh.insert(id);
+    EXPECT_EQ(ids[79].at(w), id);
+  }
+  EXPECT_EQ(fresh.size(), 5u);
+  // 25 initial + 5 new + line 9's second life.
+  EXPECT_EQ(tracker.tracks_created(), 31);
+  EXPECT_EQ(tracker.stats().matched_look_back, 2);
+
+  // With a look-back of 3 frames, line 3's 5-frame gap is too long: a new id.
+  std::mt19937 rng3(23);
+  TrackerOptions short_o;
+  short_o.look_back = 3;
+  Tracker short_tracker(short_o);
+  const auto ids3 = run(short_tracker, world, frames, 0.01f, rng3);
+  EXPECT_NE(ids3[15].at(3), ids3[9].at(3));
+}
+
+// A frame with no lines (e.g. an unreadable image) counts as a frame for the look-back.
+TEST(Tracker, EmptyFramesCountTowardsLookBack) {
+  std::mt19937 rng(5);
+  const auto world = make_world(10, 1, rng);
+  TrackerOptions o;
+  o.look_back = 4;
+  Tracker tracker(o);
+  std::vector<TrackAssignment> out;
+  const SynthFrame f0 = make_frame(world, 0, 0.01f, rng);
+  tracker.add_frame(f0.features, &out);
+  const std::int64_t id_first = out[0].track_id;
+  const int w_first = f0.world_ids[0];
+  FrameFeatures empty;
+  for (int k = 0; k < 3; ++k) {
+    tracker.add_frame(empty, &out);
+    EXPECT_TRUE(out.empty());
+  }
+  SynthFrame f4 = make_frame(world, 0, 0.01f, rng);  // 4 frames after f0: within reach
+  tracker.add_frame(f4.features, &out);
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    if (f4.world_ids[i] == w_first) {
+      EXPECT_EQ(out[i].track_id, id_first);
+      EXPECT_EQ(out[i].frames_back, 4);
+    }
+  }
+  EXPECT_EQ(tracker.frames_seen(), 5);
+}
+
+// Two lines of the new frame both nearest to one line of the previous frame: the paper's
+// rules give both the same id; the mutual constraint keeps it for the nearer one only.
+TEST(Tracker, MutualConstraintRemovesDoubleClaim) {
+  std::mt19937 rng(3);
+  std::vector<Eigen::RowVectorXf> base;
+  for (int k = 0; k < 8; ++k) base.push_back(random_descriptor(rng));
+  FrameFeatures prev;
+  prev.descriptors.resize(8, kPaperDescriptorSize);
+  for (int k = 0; k < 8; ++k) {
+    prev.descriptors.row(k) = base[static_cast<std::size_t>(k)];
+    prev.lines.push_back(VerticalLine{});
+  }
+  FrameFeatures now = prev;
+  // Lines 0 and 1 of the new frame both look like line 0 of the previous frame; line 1 is the
+  // farther of the two. Line 1's own old appearance is replaced (it is gone).
+  now.descriptors.row(0) = perturb(base[0], 0.003f, rng);
+  now.descriptors.row(1) = perturb(base[0], 0.012f, rng);
+  const float d0 = (now.descriptors.row(0) - prev.descriptors.row(0)).norm();
+  const float d1 = (now.descriptors.row(1) - prev.descriptors.row(0)).norm();
+  ASSERT_LT(d0, d1);
+
+  for (bool mutual : {false, true}) {
+    TrackerOptions o;
+    o.mutual = mutual;
+    Tracker tracker(o);
+    std::vector<TrackAssignment> out;
+    tracker.add_frame(prev, &out);
+    const std::int64_t id0 = out[0].track_id;
+    tracker.add_frame(now, &out);
+    EXPECT_EQ(out[0].track_id, id0);
+    if (!mutual) {
+      EXPECT_EQ(out[1].track_id, id0);  // the double claim
+      EXPECT_EQ(tracker.stats().rejected_mutual, 0);
+    } else {
+      EXPECT_NE(out[1].track_id, id0);
+      EXPECT_TRUE(out[1].is_new());
+      EXPECT_EQ(tracker.stats().rejected_mutual, 1);
+    }
+    for (int k = 2; k < 8; ++k) EXPECT_EQ(out[static_cast<std::size_t>(k)].frames_back, 1);
+  }
+}
+
+// With mutual on, a track taken in a recent frame cannot be claimed again through look-back.
+TEST(Tracker, MutualTrackClaimedOnceAcrossLookBack) {
+  std::mt19937 rng(31);
+  std::vector<Eigen::RowVectorXf> base;
+  for (int k = 0; k < 6; ++k) base.push_back(random_descriptor(rng));
+  auto frame_of = [&](const std::vector<Eigen::RowVectorXf>& rows) {
+    FrameFeatures f;
+    f.descriptors.resize(static_cast<Eigen::Index>(rows.size()), kPaperDescriptorSize);
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      f.descriptors.row(static_cast<Eigen::Index>(i)) = rows[i];
+      f.lines.push_back(VerticalLine{});
+    }
+    return f;
+  };
+  // Frame 0: appearance X of line 0 (and others). Frame 1: appearance Y of line 0 (changed).
+  // Frame 2: both X (a lookalike) and Y. Y matches frame 1; X fails in frame 1 (nearest is Y'
+  // of track 0, but Y is its mutual nearest) and reaches frame 0, where track 0 is taken.
+  const Eigen::RowVectorXf x = base[0];
+  const Eigen::RowVectorXf y = perturb(base[0], 0.02f, rng);
+  std::vector<Eigen::RowVectorXf> f0 = {x, base[1], base[2], base[3], base[4], base[5]};
+  std::vector<Eigen::RowVectorXf> f1 = {y, base[1], base[2], base[3], base[4], base[5]};
+  std::vector<Eigen::RowVectorXf> f2 = {perturb(y, 0.002f, rng),
+                                        perturb(x, 0.002f, rng),
+                                        base[1],
+                                        base[2],
+                                        base[3],
+                                        base[4],
+                                        base[5]};
+  TrackerOptions o;
+  o.mutual = true;
+  Tracker tracker(o);
+  std::vector<TrackAssignment> out;
+  tracker.add_frame(frame_of(f0), &out);
+  const std::int64_t id0 = out[0].track_id;
+  tracker.add_frame(frame_of(f1), &out);
+  ASSERT_EQ(out[0].track_id, id0);
+  tracker.add_frame(frame_of(f2), &out);
+  EXPECT_EQ(out[0].track_id, id0);
+  EXPECT_EQ(out[0].frames_back, 1);
+  EXPECT_TRUE(out[1].is_new());
+  EXPECT_GE(tracker.stats().rejected_claimed, 1);
+  std::set<std::int64_t> ids;
+  for (const auto& a : out) EXPECT_TRUE(ids.insert(a.track_id).second) << "duplicate id";
+}
+
+TEST(BearingGate, IncrementFromCumulativeTravel) {
+  const WheelIncrement inc = increment_between(1.0, 2.0, 1.25, 2.5);
+  EXPECT_DOUBLE_EQ(inc.d_left, 0.25);
+  EXPECT_DOUBLE_EQ(inc.d_right, 0.5);
+}
+
+TEST(BearingGate, PureRotationAndTranslationBounds) {
+  OdometryGateOptions o;
+  o.enabled = true;
+  o.wheel_base = 0.4;
+  o.min_feature_distance = 0.5;
+  o.max_camera_offset = 0.2;
+  o.bearing_tolerance = 0.0;
+  o.slip_fraction = 0.0;
+  OdometryAccumulator a, b;
+  b.add({0.04, -0.04}, o.wheel_base);  // turn on the spot by 0.2 rad
+  BearingGate g = make_bearing_gate(o, a, b);
+  EXPECT_NEAR(g.predicted_change, -0.2, 1e-12);
+  EXPECT_NEAR(g.max_deviation, std::asin(2 * 0.2 * std::sin(0.1) / 0.5), 1e-12);
+  EXPECT_TRUE(g.admits(1.0, 0.8));
+  EXPECT_FALSE(g.admits(1.0, 1.0));
+  // Across the wrap: 3.1 - 0.2 -> 2.9; -3.1 - 0.2 -> wraps to +2.98.
+  EXPECT_TRUE(g.admits(-3.1, wrap_angle(-3.3)));
+  // Straight 0.6 m: farther than D_min, nothing can be said.
+  OdometryAccumulator c;
+  c.add({0.6, 0.6}, o.wheel_base);
+  g = make_bearing_gate(o, a, c);
+  EXPECT_FALSE(g.informative);
+  EXPECT_TRUE(g.admits(0.0, 3.0));
+  // Slip and tolerance widen the gate.
+  o.bearing_tolerance = 0.01;
+  o.slip_fraction = 0.05;
+  g = make_bearing_gate(o, a, b);
+  EXPECT_NEAR(
+      g.max_deviation, std::asin(2 * 0.2 * std::sin(0.1) / 0.5) + 0.05 * 0.08 / 0.4 + 0.01, 1e-12);
+}
+
+// Soundness: for random extrinsics (rho <= rho_max), random drives and random static lines at
+// least D_min from the camera at both frames, the true bearing change (eqs. 16-17) always
+// lies inside the gate with zero tolerance and zero slip.
+TEST(BearingGate, TrueBearingChangesAlwaysAdmitted) {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  OdometryGateOptions o;
+  o.enabled = true;
+  o.wheel_base = 0.4;
+  o.min_feature_distance = 0.8;
+  o.max_camera_offset = 0.3;
+  o.bearing_tolerance = 0.0;
+  o.slip_fraction = 0.0;
+  int informative = 0, tight = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const double phi = kPi * u(rng), psi = kPi * u(rng);
+    const double rho = 0.3 * std::abs(u(rng));
+    double x = 0, y = 0, th = kPi * u(rng);
+    auto camera = [&](double& cx, double& cy) {
+      cx = x + rho * std::cos(th + phi);
+      cy = y + rho * std::sin(th + phi);
+    };
+    auto bearing = [&](double fx, double fy) {  // eq. (16)
+      double cx, cy;
+      camera(cx, cy);
+      return wrap_angle(std::atan2(fy - cy, fx - cx) - (th + phi + psi));
+    };
+    // A static line 0.8-3 m from the start.
+    double c0x, c0y;
+    camera(c0x, c0y);
+    const double r0 = 0.8 + 2.2 * std::abs(u(rng)), a0 = kPi * u(rng);
+    const double fx = c0x + r0 * std::cos(a0), fy = c0y + r0 * std::sin(a0);
+    const double b0 = bearing(fx, fy);
+    OdometryAccumulator before, after;
+    const int steps = 1 + static_cast<int>(10 * std::abs(u(rng)));
+    for (int s = 0; s < steps; ++s) {
+      const WheelIncrement inc{0.05 * u(rng), 0.05 * u(rng)};
+      after.add(inc, o.wheel_base);
+      // Differential drive, integrated in sub-steps (exact arcs in the limit).
+      for (int k = 0; k < 20; ++k) {
+        const double dr = 0.5 * (inc.d_right + inc.d_left) / 20,
+                     dt = (inc.d_right - inc.d_left) / o.wheel_base / 20;
+        x += dr * std::cos(th + dt / 2);
+        y += dr * std::sin(th + dt / 2);
+        th += dt;
+      }
+    }
+    double c1x, c1y;
+    camera(c1x, c1y);
+    if (std::hypot(fx - c1x, fy - c1y) < o.min_feature_distance) continue;
+    const BearingGate g = make_bearing_gate(o, before, after);
+    const double b1 = bearing(fx, fy);
+    ASSERT_TRUE(g.admits(b0, b1)) << "trial " << trial << " deviation "
+                                  << angle_diff(b1, b0 + g.predicted_change) << " bound "
+                                  << g.max_deviation;
+    informative += g.informative;
+    if (g.informative &&
+        std::abs(angle_diff(b1, b0 + g.predicted_change)) > 0.5 * g.max_deviation) {
+      ++tight;
+    }
+  }
+  EXPECT_GT(informative, 10000);
+  EXPECT_GT(tight, 100);  // the bound is reached in part, not vacuously loose
+}
+
+// A constructed false match: the nearest descriptor sits at an impossible bearing.
+TEST(Tracker, OdometryGateRejectsImpossibleBearingJump) {
+  std::mt19937 rng(41);
+  FrameFeatures f0;
+  f0.descriptors.resize(6, kPaperDescriptorSize);
+  for (int k = 0; k < 6; ++k) {
+    f0.descriptors.row(k) = random_descriptor(rng);
+    VerticalLine v;
+    v.bearing = -2.5 + k;
+    f0.lines.push_back(v);
+  }
+  // The robot turns by d_theta = (0.03 + 0.03) / 0.4 = 0.15 rad: bearings shift by -0.15.
+  const WheelIncrement turn{0.03, -0.03};
+  FrameFeatures f1 = f0;
+  for (int k = 0; k < 6; ++k) {
+    f1.descriptors.row(k) = perturb(f0.descriptors.row(k), 0.005f, rng);
+    f1.lines[static_cast<std::size_t>(k)].bearing = wrap_angle(f0.lines[k].bearing - 0.15);
+  }
+  // Line 2 of the new frame looks like line 2 but is 1 rad away from where it can be.
+  f1.lines[2].bearing = wrap_angle(f0.lines[2].bearing - 0.15 + 1.0);
+
+  for (bool gate : {false, true}) {
+    TrackerOptions o;
+    o.gate.enabled = gate;
+    o.gate.wheel_base = 0.4;
+    Tracker tracker(o);
+    std::vector<TrackAssignment> out0, out1;
+    tracker.add_frame(f0, WheelIncrement{}, &out0);
+    tracker.add_frame(f1, turn, &out1);
+    for (int k = 0; k < 6; ++k) {
+      if (k == 2) continue;
+      EXPECT_EQ(out1[static_cast<std::size_t>(k)].track_id, out0[k].track_id);
+    }
+    if (gate) {
+      EXPECT_TRUE(out1[2].is_new());
+      EXPECT_EQ(tracker.stats().rejected_gate, 1);
+    } else {
+      EXPECT_EQ(out1[2].track_id, out0[2].track_id);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace omnivert
+
+namespace omnivert {
+namespace {
+
+TEST(TrackerOptions, PaperAndRecommended) {
+  const TrackerOptions p = paper_tracker_options();
+  EXPECT_EQ(p.look_back, 20);
+  EXPECT_DOUBLE_EQ(p.match.f1, 1.05);
+  EXPECT_DOUBLE_EQ(p.match.f2, 0.75);
+  EXPECT_DOUBLE_EQ(p.match.f3, 0.8);
+  EXPECT_FALSE(p.mutual);
+  EXPECT_FALSE(p.gate.enabled);
+  std::string error;
+  const TrackerOptions r = recommended_tracker_options(0.45);
+  EXPECT_TRUE(r.IsValid(&error)) << error;
+  EXPECT_TRUE(r.mutual);
+  EXPECT_TRUE(r.gate.enabled);
+  EXPECT_DOUBLE_EQ(r.gate.wheel_base, 0.45);
+  const TrackerOptions no_odometry = recommended_tracker_options(0.0);
+  EXPECT_TRUE(no_odometry.IsValid(&error));
+  EXPECT_FALSE(no_odometry.gate.enabled);
+}
+
+TEST(Tracker, BrokenFrameContractThrows) {
+  Tracker t{TrackerOptions{}};
+  std::vector<TrackAssignment> out;
+  FrameFeatures f;
+  f.lines.resize(3);
+  f.descriptors = DescriptorMatrix::Zero(2, 192);
+  EXPECT_THROW(t.add_frame(f, &out), std::invalid_argument);
+  f.descriptors = DescriptorMatrix::Zero(3, 192);
+  t.add_frame(f, &out);
+  f.descriptors = DescriptorMatrix::Zero(3, 96);
+  EXPECT_THROW(t.add_frame(f, &out), std::invalid_argument);
+  Tracker gated{recommended_tracker_options(0.5)};
+  f.descriptors = DescriptorMatrix::Zero(3, 192);
+  EXPECT_THROW(gated.add_frame(f, &out), std::invalid_argument);  // no wheel increment
+  gated.add_frame(f, WheelIncrement{}, &out);
+}
+
+TEST(Tracker, InvalidOptionsThrowInputError) {
+  TrackerOptions o;
+  o.look_back = 0;
+  EXPECT_THROW(Tracker{o}, InputError);
+  o = {};
+  o.gate.enabled = true;  // no wheel base
+  try {
+    Tracker t(o);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("wheel base"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace omnivert
