@@ -12,6 +12,7 @@
 
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
+#include "omnivert/sim/map_picture.hpp"
 
 namespace omnivert::sim {
 
@@ -282,6 +283,20 @@ void write_dataset(const World& world,
       ++total_lines;
     }
     if (progress) progress(k + 1, n_frames);
+  }
+  // A top view of the world and the path, for people to look at.
+  {
+    std::vector<Pose2> path;
+    std::vector<Eigen::Vector2d> cams;
+    for (double t = 0.0; t <= t_last + 1e-9; t += 0.1) {
+      path.push_back(pose_at(motion, t));
+      const CameraPose c = camera_pose(path.back(), cfg.extrinsics, cfg.camera_height);
+      cams.emplace_back(c.x, c.y);
+    }
+    const fs::path map = dir / "ground_truth" / "map.png";
+    if (!cv::imwrite(map.string(), draw_map(world, path, cams))) {
+      throw std::runtime_error("cannot write " + map.string());
+    }
   }
   summary.frames = n_frames;
   summary.mean_lines = static_cast<double>(total_lines) / n_frames;

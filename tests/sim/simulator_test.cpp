@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
 
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
