@@ -1,54 +1,13 @@
 // The tracker allocates nothing per frame in steady state (buffers grow to the largest frame
-// and are reused). Counted by replacing malloc in this test executable (glibc supports
-// replacing malloc, calloc, realloc, free and the aligned variants; each forwards to glibc's
-// own __libc_* entry points). Eigen and std::vector both allocate through malloc here.
+// and are reused). Allocations are counted by tests/support/alloc_counter.cpp.
 
-#include <atomic>
 #include <cstddef>
 #include <random>
 
 #include <gtest/gtest.h>
 
 #include "omnivert/match/tracker.hpp"
-
-extern "C" {
-void* __libc_malloc(std::size_t);
-void* __libc_calloc(std::size_t, std::size_t);
-void* __libc_realloc(void*, std::size_t);
-void* __libc_memalign(std::size_t, std::size_t);
-void __libc_free(void*);
-}
-
-namespace {
-std::atomic<long> g_allocations{0};
-}
-
-extern "C" {
-void* malloc(std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_malloc(n);
-}
-void* calloc(std::size_t k, std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_calloc(k, n);
-}
-void* realloc(void* p, std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_realloc(p, n);
-}
-void free(void* p) { __libc_free(p); }
-void* memalign(std::size_t a, std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_memalign(a, n);
-}
-void* aligned_alloc(std::size_t a, std::size_t n) { return memalign(a, n); }
-int posix_memalign(void** out, std::size_t a, std::size_t n) {
-  void* p = memalign(a, n);
-  if (!p) return 12;  // ENOMEM
-  *out = p;
-  return 0;
-}
-}
+#include "../support/alloc_counter.hpp"
 
 namespace omnivert {
 namespace {
@@ -90,17 +49,17 @@ TEST(TrackerSteadyState, NoAllocationPerFrame) {
     const WheelIncrement inc{0.03, 0.02};
     // Warm-up: the largest frame and a full ring buffer.
     for (int f = 0; f < 30; ++f) tracker.add_frame(frames[static_cast<std::size_t>(f)], inc, &out);
-    const long before = g_allocations.load();
+    const long before = omnivert_test_allocations();
     for (int f = 30; f < 60; ++f) tracker.add_frame(frames[static_cast<std::size_t>(f)], inc, &out);
-    const long during = g_allocations.load() - before;
+    const long during = omnivert_test_allocations() - before;
     EXPECT_EQ(during, 0) << "mutual=" << mutual;
     EXPECT_GT(tracker.stats().matched_look_back, 0);  // the look-back path was exercised
   }
   // The counter works.
-  const long before = g_allocations.load();
+  const long before = omnivert_test_allocations();
   std::vector<int>* v = new std::vector<int>(100);
   delete v;
-  EXPECT_GE(g_allocations.load() - before, 2);
+  EXPECT_GE(omnivert_test_allocations() - before, 2);
 }
 
 }  // namespace
