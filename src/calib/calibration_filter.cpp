@@ -1,0 +1,107 @@
+#include "omnivert/calib/calibration_filter.hpp"
+
+#include <cmath>
+#include <set>
+#include <string>
+
+#include "omnivert/core/error.hpp"
+
+namespace omnivert::calib {
+
+namespace {
+Options checked(const Options& options) {
+  std::string why;
+  if (!options.IsValid(&why)) throw InputError("calibration options: " + why);
+  return options;
+}
+}  // namespace
+
+CalibrationFilter::CalibrationFilter(const Options& options)
+    : options_(checked(options)),
+      state_(options.prior, options.prior_sigma),
+      propagator_(options),
+      updater_(options),
+      initializer_(options) {}
+
+void CalibrationFilter::process(const FrameInput& frame) {
+  const std::string where = "frame " + std::to_string(frame_);
+  if (!std::isfinite(frame.d_right) || !std::isfinite(frame.d_left))
+    throw InputError(where + ": wheel travel is not a finite number");
+  std::set<int> seen;
+  for (const BearingObservation& o : frame.observations) {
+    if (!std::isfinite(o.beta))
+      throw InputError(where + ": bearing of track " + std::to_string(o.track_id) +
+                       " is not a finite number");
+    if (!seen.insert(o.track_id).second)
+      throw InputError(where + ": track " + std::to_string(o.track_id) +
+                       " appears twice in one frame");
+  }
+
+  FrameEstimate rec;
+  rec.frame = frame_;
+  // Prediction, eq. (29). (The first frame carries no travel; propagating zero is harmless.)
+  if (state_.num_features() > 0) propagator_.propagate(frame.d_right, frame.d_left, &state_);
+
+  // Updates of the tracks already in the state, eq. (30).
+  std::vector<const BearingObservation*> fresh;
+  for (const BearingObservation& o : frame.observations) {
+    const int slot = state_.find(o.track_id);
+    if (slot < 0) {
+      fresh.push_back(&o);
+      continue;
+    }
+    state_.mutable_slots()[slot].last_seen_frame = frame_;
+    const BearingUpdateResult r = updater_.update_bearing(slot, o.beta, &state_);
+    if (r.accepted) {
+      ++rec.num_updates;
+      ++state_.mutable_slots()[slot].num_updates;
+    } else {
+      ++rec.num_rejected;
+    }
+  }
+  // Tracks that start enter the state (their first bearing is used by the initialisation).
+  for (const BearingObservation* o : fresh) {
+    initializer_.initialize(o->track_id, o->beta, frame_, &state_);
+    ++rec.num_new;
+  }
+  // Inverse-distance blocks whose distance is now well known become (D, theta), eq. (28).
+  if (options_.convert_ratio > 0.0) {
+    for (int s = 0; s < state_.num_features(); ++s) {
+      if (state_.slots()[s].param != FeatureParam::kInverseDistance) continue;
+      const int i = FilterState::feature_index(s);
+      const double q = state_.x()(i);
+      if (std::sqrt(state_.P()(i, i)) < options_.convert_ratio * q) state_.convert_to_distance(s);
+    }
+  }
+  record_tracks();
+  // Tracks that ended leave the state (marginalisation).
+  for (int s = state_.num_features() - 1; s >= 0; --s)
+    if (frame_ - state_.slots()[s].last_seen_frame > options_.max_missed_frames)
+      state_.remove_feature(s);
+
+  rec.extrinsics = state_.extrinsics();
+  rec.covariance = state_.extrinsics_covariance();
+  rec.num_features = state_.num_features();
+  history_.push_back(rec);
+  ++frame_;
+}
+
+void CalibrationFilter::record_tracks() {
+  for (int s = 0; s < state_.num_features(); ++s) {
+    const FeatureSlot& slot = state_.slots()[s];
+    if (slot.last_seen_frame != frame_) continue;
+    TrackEstimate& t = tracks_[slot.track_id];
+    t.track_id = slot.track_id;
+    t.frame = frame_;
+    t.D_theta = state_.feature_distance_form(s, &t.covariance);
+    t.num_updates = slot.num_updates;
+  }
+}
+
+FilterResult run_filter(const CalibrationRun& run, const Options& options) {
+  CalibrationFilter filter(options);
+  for (const FrameInput& f : run.frames) filter.process(f);
+  return {filter.extrinsics(), filter.covariance(), filter.history(), filter.tracks()};
+}
+
+}  // namespace omnivert::calib
