@@ -42,8 +42,9 @@ void CalibrationFilter::process(const FrameInput& frame) {
   // Prediction, eq. (29). (The first frame carries no travel; propagating zero is harmless.)
   if (state_.num_features() > 0) propagator_.propagate(frame.d_right, frame.d_left, &state_);
 
-  // Updates of the tracks already in the state, eq. (30).
+  // Updates of the tracks already in the state, eq. (30), all bearings of the frame at once.
   std::vector<const BearingObservation*> fresh;
+  std::vector<BearingMeasurement> z;
   for (const BearingObservation& o : frame.observations) {
     const int slot = state_.find(o.track_id);
     if (slot < 0) {
@@ -51,10 +52,13 @@ void CalibrationFilter::process(const FrameInput& frame) {
       continue;
     }
     state_.mutable_slots()[slot].last_seen_frame = frame_;
-    const BearingUpdateResult r = updater_.update_bearing(slot, o.beta, &state_);
-    if (r.accepted) {
+    z.push_back({slot, o.beta});
+  }
+  const std::vector<BearingUpdateResult> results = updater_.update(z, &state_);
+  for (std::size_t k = 0; k < z.size(); ++k) {
+    if (results[k].accepted) {
       ++rec.num_updates;
-      ++state_.mutable_slots()[slot].num_updates;
+      ++state_.mutable_slots()[z[k].slot].num_updates;
     } else {
       ++rec.num_rejected;
     }

@@ -56,66 +56,75 @@ double chi2_quantile(double p, int dof) {
 Updater::Updater(const Options& options)
     : options_(options), gate_(chi2_quantile(options.gate_probability, 1)) {}
 
-double Updater::predict(const FilterState& state, const Eigen::VectorXd& x, int slot,
-                        Eigen::RowVectorXd* H) const {
-  const int i = FilterState::feature_index(slot);
+Eigen::VectorXd Updater::predict(const FilterState& state, const Eigen::VectorXd& x,
+                                 const std::vector<BearingMeasurement>& z,
+                                 Eigen::MatrixXd* H) const {
   const int e = state.extrinsics_index();
   const Extrinsics ex = Extrinsics::from_vec(x.segment<3>(e));
-  Row5 J;
-  // Eq. (30), the row of feature `slot`; H of appendix A.4 (chain rule for (q, theta)).
-  const double beta = state.slots()[slot].param == FeatureParam::kDistance
-                          ? predict_bearing(x(i), x(i + 1), ex, &J)
-                          : predict_bearing_inverse(x(i), x(i + 1), ex, &J);
-  H->setZero(state.dim());
-  (*H)(i) = J(0);
-  (*H)(i + 1) = J(1);
-  H->segment<3>(e) = J.tail<3>();
-  return beta;
+  const int m = static_cast<int>(z.size());
+  Eigen::VectorXd h(m);
+  H->setZero(m, state.dim());
+  for (int k = 0; k < m; ++k) {
+    const int i = FilterState::feature_index(z[k].slot);
+    Row5 J;
+    // Eq. (30), the row of this feature; H of appendix A.4 (chain rule for (q, theta)).
+    h(k) = state.slots()[z[k].slot].param == FeatureParam::kDistance
+               ? predict_bearing(x(i), x(i + 1), ex, &J)
+               : predict_bearing_inverse(x(i), x(i + 1), ex, &J);
+    (*H)(k, i) = J(0);
+    (*H)(k, i + 1) = J(1);
+    H->block<1, 3>(k, e) = J.tail<3>();
+  }
+  return h;
 }
 
-BearingUpdateResult Updater::update_bearing(int slot, double beta, FilterState* state) const {
-  BearingUpdateResult result;
-  const double R = options_.bearing_sigma * options_.bearing_sigma;
+std::vector<BearingUpdateResult> Updater::update(const std::vector<BearingMeasurement>& z_all,
+                                                 FilterState* state) const {
+  std::vector<BearingUpdateResult> results(z_all.size());
+  if (z_all.empty()) return results;
+  const double var = options_.bearing_sigma * options_.bearing_sigma;
   const Eigen::VectorXd x0 = state->x();
-  const Eigen::MatrixXd& P0 = state->P();
-  Eigen::RowVectorXd H;
-  const double h0 = predict(*state, x0, slot, &H);
-  const double r0 = angle_diff(beta, h0);  // wrapped innovation
-  const double S0 = (H * P0 * H.transpose())(0, 0) + R;
-  result.chi2 = r0 * r0 / S0;
-  if (!(result.chi2 <= gate_)) return result;  // chi-square gate (also rejects NaN)
+  const Eigen::MatrixXd P0 = state->P();
+
+  // Chi-square gate of each bearing on its own, at the prior.
+  Eigen::MatrixXd H;
+  const Eigen::VectorXd h0 = predict(*state, x0, z_all, &H);
+  std::vector<BearingMeasurement> z;
+  std::vector<int> used;
+  for (std::size_t k = 0; k < z_all.size(); ++k) {
+    const double r = angle_diff(z_all[k].beta, h0(k));
+    const double S = H.row(k).dot(P0 * H.row(k).transpose()) + var;
+    results[k].chi2 = r * r / S;
+    if (results[k].chi2 <= gate_) {  // also rejects NaN
+      z.push_back(z_all[k]);
+      used.push_back(static_cast<int>(k));
+    }
+  }
+  if (z.empty()) return results;
+  const int m = static_cast<int>(z.size());
+  const Eigen::MatrixXd R = Eigen::MatrixXd::Identity(m, m) * var;
 
   // Iterated EKF: x_{j+1} = x0 + K_j (z - h(x_j) - H_j (x0 - x_j)), K_j from H_j and P0.
   Eigen::VectorXd xj = x0;
-  double r = r0;
-  Eigen::VectorXd xn = x0;
   for (int it = 0; it < options_.update_iterations; ++it) {
-    if (it > 0) {
-      const double hj = predict(*state, xj, slot, &H);
-      r = angle_diff(beta, hj);
-    }
-    const Eigen::VectorXd PHt = P0 * H.transpose();
-    const double S = H.dot(PHt) + R;
-    const Eigen::VectorXd K = PHt / S;
-    xn = x0 + K * (r + H.dot(xj - x0));
-    if ((xn - xj).norm() < 1e-10) {
-      xj = xn;
-      break;
-    }
+    const Eigen::VectorXd hj = predict(*state, xj, z, &H);
+    Eigen::VectorXd r(m);
+    for (int k = 0; k < m; ++k) r(k) = angle_diff(z[k].beta, hj(k));  // wrapped innovation
+    const Eigen::MatrixXd PHt = P0 * H.transpose();
+    const Eigen::LLT<Eigen::MatrixXd> llt(H * PHt + R);
+    if (llt.info() != Eigen::Success) return results;
+    const Eigen::VectorXd xn = x0 + PHt * llt.solve(r + H * (xj - x0));
+    const double step = (xn - xj).norm();
     xj = xn;
+    if (step < 1e-10) break;
   }
-  // Covariance with the last linearisation, through the shared Joseph update.
-  if (options_.update_iterations > 1) {
-    predict(*state, xj, slot, &H);
-  }
-  Eigen::MatrixXd Hm = H;
-  Eigen::MatrixXd Rm(1, 1);
-  Rm(0, 0) = R;
-  if (!joseph_update(Hm, Rm, &state->mutable_P())) return result;
+  // Covariance at the last linearisation, through the shared Joseph update.
+  predict(*state, xj, z, &H);
+  if (!joseph_update(H, R, &state->mutable_P())) return results;
   state->mutable_x() = xj;
   state->normalise();
-  result.accepted = true;
-  return result;
+  for (int k : used) results[k].accepted = true;
+  return results;
 }
 
 }  // namespace omnivert::calib

