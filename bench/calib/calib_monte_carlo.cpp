@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "omnivert/calib/batch.hpp"
 #include "omnivert/calib/calibration_filter.hpp"
 #include "omnivert/calib/synthetic_run.hpp"
 #include "omnivert/calib/updater.hpp"
@@ -74,6 +75,7 @@ void print(const char* name, const Stats& s, const Eigen::Vector3d& crlb) {
 
 int main(int argc, char** argv) {
   int runs = 50, iterations = 3;
+  bool refine = false;
   double sigma_deg = 0.3, inflation = 5.0;
   std::string init = "inverse", trajectory = "paper";
   std::uint64_t seed = 1;
@@ -91,6 +93,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--inflation")) inflation = std::atof(next());
     else if (!std::strcmp(argv[i], "--iterations")) iterations = std::atoi(next());
     else if (!std::strcmp(argv[i], "--trajectory")) trajectory = next();
+    else if (!std::strcmp(argv[i], "--refine")) refine = true;
     else if (!std::strcmp(argv[i], "--seed")) seed = std::strtoull(next(), nullptr, 10);
     else {
       std::fprintf(stderr, "unknown argument %s\n", argv[i]);
@@ -108,19 +111,43 @@ int main(int argc, char** argv) {
   fo.update_iterations = iterations;
   fo.feature_init = init == "naive" ? FeatureInit::kNaive : FeatureInit::kInverseDistance;
 
-  Stats filt;
+  Stats filt, ref;
+  Eigen::Vector3d crlb_sq = Eigen::Vector3d::Zero();
+  double crlb_yaw_sq = 0, crlb_pos_sq = 0;
   Progress progress("monte carlo", runs);
   for (int r = 0; r < runs; ++r) {
     so.seed = seed + r;
     const SyntheticRun run = make_synthetic_run(so);
     const FilterResult fr = run_filter(run.run, fo);
     filt.add(fr.extrinsics, fr.covariance, run.truth);
+    // Cramer-Rao bound of this run: Fisher information at the truth.
+    BatchPoint truth;
+    truth.poses = run.true_poses;
+    truth.extrinsics = run.truth;
+    for (const auto& [id, j] : run.track_feature) truth.features[id] = run.features[j];
+    const ObservabilityReport obs = analyse_observability(run.run, fo, truth);
+    crlb_sq += Eigen::Vector3d(obs.phi.crlb, obs.rho.crlb, obs.psi.crlb).cwiseAbs2();
+    crlb_yaw_sq += obs.yaw.crlb * obs.yaw.crlb;
+    crlb_pos_sq += obs.x.crlb * obs.x.crlb + obs.y.crlb * obs.y.crlb;
+    if (refine) {
+      const RefinementResult rr =
+          refine_batch(run.run, fo, batch_point_from_filter(run.run, fo, fr));
+      if (rr.covariance_ok)
+        ref.add(rr.extrinsics, rr.covariance, run.truth);
+      else
+        ++ref.failures;
+    }
     progress.update(r + 1);
   }
   progress.finish();
   std::printf("trajectory %s, bearing noise %.2f deg, init %s, K inflation %.1f, iterations %d\n",
               trajectory.c_str(), sigma_deg, init.c_str(), inflation, iterations);
-  const Eigen::Vector3d crlb(1, 1, 1);
+  const Eigen::Vector3d crlb = (crlb_sq / runs).cwiseSqrt();
+  std::printf("CRLB (RMS over runs): phi %.3f deg  rho %.2f mm  psi %.3f deg  yaw %.4f deg  "
+              "position %.2f mm\n",
+              rad2deg(crlb(0)), 1e3 * crlb(1), rad2deg(crlb(2)), rad2deg(std::sqrt(crlb_yaw_sq / runs)),
+              1e3 * std::sqrt(crlb_pos_sq / runs));
   print("filter", filt, crlb);
+  if (refine) print("filter + refinement", ref, crlb);
   return 0;
 }

@@ -1,0 +1,300 @@
+#include "omnivert/calib/batch.hpp"
+
+#include <ceres/ceres.h>
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <sstream>
+
+#include "omnivert/calib/model.hpp"
+#include "omnivert/core/angles.hpp"
+#include "omnivert/core/error.hpp"
+
+namespace omnivert::calib {
+
+namespace {
+
+// Odometry factor between poses i and j = i + 1: eq. (14)-(15) inverted. The pose change
+// gives d_theta and, along the mid-step heading, d_rho; lateral motion must be zero.
+struct OdometryResidual {
+  double d_right, d_left, e, inv_sigma_r, inv_sigma_l, inv_sigma_lat;
+  template <typename T>
+  bool operator()(const T* pi, const T* pj, T* r) const {
+    const T dth = pj[2] - pi[2];
+    const T mid = pi[2] + 0.5 * dth;
+    const T dx = pj[0] - pi[0], dy = pj[1] - pi[1];
+    const T c = cos(mid), s = sin(mid);
+    const T d_rho = c * dx + s * dy;
+    const T lateral = -s * dx + c * dy;
+    const T dR = d_rho + 0.5 * e * dth;  // eq. (15) solved for the wheels
+    const T dL = d_rho - 0.5 * e * dth;
+    r[0] = (dR - d_right) * inv_sigma_r;
+    r[1] = (dL - d_left) * inv_sigma_l;
+    r[2] = lateral * inv_sigma_lat;
+    return true;
+  }
+};
+
+// Bearing factor: beta = atan2(y_f - y_C, x_f - x_C) - (theta_R + phi + psi), residual wrapped.
+struct BearingResidual {
+  double beta, inv_sigma;
+  template <typename T>
+  bool operator()(const T* pose, const T* f, const T* ex, T* r) const {
+    const T a = pose[2] + ex[0];
+    const T xc = pose[0] + ex[1] * cos(a);
+    const T yc = pose[1] + ex[1] * sin(a);
+    const T pred = atan2(f[1] - yc, f[0] - xc) - (pose[2] + ex[0] + ex[2]);
+    const T d = T(beta) - pred;
+    r[0] = atan2(sin(d), cos(d)) * inv_sigma;  // wrapped to (-pi, pi]
+    return true;
+  }
+};
+
+// The problem with its parameter storage.
+struct Built {
+  std::vector<std::array<double, 3>> poses;
+  std::map<int, std::array<double, 2>> features;
+  std::array<double, 3> ex{};
+  std::unique_ptr<ceres::Problem> problem;
+  int num_bearings = 0;
+};
+
+Built build(const CalibrationRun& run, const Options& options, const BatchPoint& at,
+            const BatchOptions& batch, bool robust) {
+  if (at.poses.size() != run.frames.size())
+    throw InputError("batch: the starting point has " + std::to_string(at.poses.size()) +
+                     " poses for " + std::to_string(run.frames.size()) + " frames");
+  Built b;
+  ceres::Problem::Options po;
+  b.problem = std::make_unique<ceres::Problem>(po);
+  b.poses.resize(at.poses.size());
+  for (std::size_t k = 0; k < at.poses.size(); ++k)
+    b.poses[k] = {at.poses[k](0), at.poses[k](1), at.poses[k](2)};
+  b.ex = {at.extrinsics.phi, at.extrinsics.rho, at.extrinsics.psi};
+
+  // Track lengths: only tracks long enough (and with a starting point) enter.
+  std::map<int, int> length;
+  for (const FrameInput& f : run.frames)
+    for (const BearingObservation& o : f.observations) ++length[o.track_id];
+  for (const auto& [id, n] : length) {
+    auto it = at.features.find(id);
+    if (n >= options.min_track_length && it != at.features.end() && it->second.allFinite())
+      b.features[id] = {it->second(0), it->second(1)};
+  }
+
+  for (auto& p : b.poses) b.problem->AddParameterBlock(p.data(), 3);
+  b.problem->SetParameterBlockConstant(b.poses[0].data());  // gauge: frame 0 is the origin
+  b.problem->AddParameterBlock(b.ex.data(), 3);
+
+  const double K = options.odometry_K * batch.odometry_inflation;
+  for (std::size_t k = 1; k < run.frames.size(); ++k) {
+    const FrameInput& f = run.frames[k];
+    const Mat2 Q =
+        chong_kleeman_covariance(f.d_right, f.d_left, K, options.odometry_variance_floor);
+    auto* cost = new ceres::AutoDiffCostFunction<OdometryResidual, 3, 3, 3>(new OdometryResidual{
+        f.d_right, f.d_left, options.wheel_base, 1.0 / std::sqrt(Q(0, 0)),
+        1.0 / std::sqrt(Q(1, 1)), 1.0 / batch.lateral_sigma});
+    b.problem->AddResidualBlock(cost, nullptr, b.poses[k - 1].data(), b.poses[k].data());
+  }
+  for (std::size_t k = 0; k < run.frames.size(); ++k) {
+    for (const BearingObservation& o : run.frames[k].observations) {
+      auto it = b.features.find(o.track_id);
+      if (it == b.features.end()) continue;
+      auto* cost = new ceres::AutoDiffCostFunction<BearingResidual, 1, 3, 2, 3>(
+          new BearingResidual{o.beta, 1.0 / options.bearing_sigma});
+      ceres::LossFunction* loss = robust ? new ceres::HuberLoss(batch.huber_sigmas) : nullptr;
+      b.problem->AddResidualBlock(cost, loss, b.poses[k].data(), it->second.data(), b.ex.data());
+      ++b.num_bearings;
+    }
+  }
+  return b;
+}
+
+BatchPoint point_of(const Built& b) {
+  BatchPoint p;
+  for (const auto& q : b.poses) p.poses.emplace_back(q[0], q[1], q[2]);
+  for (const auto& [id, f] : b.features) p.features[id] = Eigen::Vector2d(f[0], f[1]);
+  p.extrinsics = {wrap_angle(b.ex[0]), b.ex[1], wrap_angle(b.ex[2])};
+  return p;
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector3d> dead_reckoning(const CalibrationRun& run, double wheel_base) {
+  std::vector<Eigen::Vector3d> poses;
+  poses.reserve(run.frames.size());
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  for (std::size_t k = 0; k < run.frames.size(); ++k) {
+    if (k > 0) p = integrate_pose(p, run.frames[k].d_right, run.frames[k].d_left, wheel_base);
+    poses.push_back(p);
+  }
+  return poses;
+}
+
+BatchPoint batch_point_from_filter(const CalibrationRun& run, const Options& options,
+                                   const FilterResult& filter) {
+  BatchPoint b;
+  b.poses = dead_reckoning(run, options.wheel_base);
+  b.extrinsics = filter.extrinsics;
+  for (const auto& [id, t] : filter.tracks) {
+    if (t.frame < 0 || t.frame >= static_cast<int>(b.poses.size())) continue;
+    b.features[id] = feature_to_world(b.poses[t.frame], t.D_theta(0), t.D_theta(1));
+  }
+  return b;
+}
+
+RefinementResult refine_batch(const CalibrationRun& run, const Options& options,
+                              const BatchPoint& start, const BatchOptions& batch) {
+  std::string why;
+  if (!options.IsValid(&why)) throw InputError("calibration options: " + why);
+  Built b = build(run, options, start, batch, batch.robust);
+  RefinementResult res;
+  res.num_bearings = b.num_bearings;
+
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::SPARSE_SCHUR;  // poses/features eliminated, extrinsics kept
+  so.max_num_iterations = batch.max_iterations;
+  so.function_tolerance = 1e-10;
+  so.gradient_tolerance = 1e-12;
+  so.parameter_tolerance = 1e-12;
+  so.num_threads = 1;
+  so.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, b.problem.get(), &summary);
+  res.converged = summary.termination_type == ceres::CONVERGENCE;
+  res.initial_cost = summary.initial_cost;
+  res.final_cost = summary.final_cost;
+  res.iterations = static_cast<int>(summary.iterations.size());
+  res.report = summary.BriefReport();
+  res.solution = point_of(b);
+  res.extrinsics = res.solution.extrinsics;
+
+  // Covariance of (phi, rho, psi): the inverse of the Fisher information at the solution
+  // (of the problem without robust loss, as it is the Gaussian model's bound), marginal.
+  ceres::Covariance::Options co;
+  co.algorithm_type = ceres::DENSE_SVD;  // small problem; detects rank deficiency
+  co.min_reciprocal_condition_number = 1e-14;
+  co.null_space_rank = 0;
+  co.num_threads = 1;
+  ceres::Covariance cov(co);
+  std::vector<std::pair<const double*, const double*>> blocks = {{b.ex.data(), b.ex.data()}};
+  if (cov.Compute(blocks, b.problem.get())) {
+    double C[9];
+    cov.GetCovarianceBlock(b.ex.data(), b.ex.data(), C);
+    res.covariance = Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(C);
+    res.covariance_ok = res.covariance.allFinite();
+  }
+  return res;
+}
+
+ObservabilityReport analyse_observability(const CalibrationRun& run, const Options& options,
+                                          const BatchPoint& at, const BatchOptions& batch,
+                                          const ObservabilityOptions& obs) {
+  std::string why;
+  if (!options.IsValid(&why)) throw InputError("calibration options: " + why);
+  Built b = build(run, options, at, batch, /*robust=*/false);
+  // The Jacobian of the whitened residuals: Fisher information F = J^T J (the residuals are
+  // already divided by their sigmas). Frame 0 is not a variable (gauge).
+  ceres::Problem::EvaluateOptions eo;
+  for (std::size_t k = 1; k < b.poses.size(); ++k) eo.parameter_blocks.push_back(b.poses[k].data());
+  for (auto& [id, f] : b.features) eo.parameter_blocks.push_back(f.data());
+  eo.parameter_blocks.push_back(b.ex.data());
+  eo.apply_loss_function = false;
+  ceres::CRSMatrix crs;
+  b.problem->Evaluate(eo, nullptr, nullptr, nullptr, &crs);
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+  for (int r = 0; r < crs.num_rows; ++r)
+    for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k) J(r, crs.cols[k]) = crs.values[k];
+  const Eigen::MatrixXd F = J.transpose() * J;
+  const int n = static_cast<int>(F.rows()), no = n - 3;
+
+  // Marginal information of the extrinsics: Schur complement of the nuisance block
+  // (pseudo-inverse, so that features without parallax do not poison it).
+  const Eigen::MatrixXd Foo = F.topLeftCorner(no, no);
+  const Eigen::MatrixXd Foe = F.topRightCorner(no, 3);
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Foo);
+  const Eigen::VectorXd& lam = es.eigenvalues();
+  const double lmax = lam.cwiseAbs().maxCoeff();
+  Eigen::VectorXd inv = Eigen::VectorXd::Zero(no);
+  for (int i = 0; i < no; ++i)
+    if (lam(i) > 1e-14 * lmax) inv(i) = 1.0 / lam(i);
+  const Eigen::MatrixXd UtFoe = es.eigenvectors().transpose() * Foe;
+  Eigen::Matrix3d S = F.bottomRightCorner<3, 3>() - UtFoe.transpose() * inv.asDiagonal() * UtFoe;
+  S = 0.5 * (S + S.transpose()).eval();
+
+  ObservabilityReport rep;
+  rep.information = S;
+  // Scale by the thresholds so that "determined" is "[S~^-1]_ii < 1".
+  const Eigen::Vector3d thr(obs.max_sigma_angle, obs.max_sigma_rho, obs.max_sigma_angle);
+  const Eigen::Matrix3d St = thr.asDiagonal() * S * thr.asDiagonal();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> e3(St);
+  rep.eigenvalues = e3.eigenvalues();
+  const double emax = std::max(rep.eigenvalues.maxCoeff(), 0.0);
+  const double floor = obs.relative_eigenvalue_floor * std::max(emax, 1e-300);
+  rep.rank = 0;
+  for (int i = 0; i < 3; ++i) rep.rank += rep.eigenvalues(i) > floor ? 1 : 0;
+  rep.condition = rep.eigenvalues(0) > floor ? emax / rep.eigenvalues(0)
+                                             : std::numeric_limits<double>::infinity();
+  const double inf = std::numeric_limits<double>::infinity();
+  // Variance of v^T (phi, rho, psi) (v in unscaled units) = sum (v~ . u_k)^2 / lambda_k,
+  // infinite when v has a component along a (numerically) null eigenvector.
+  auto sigma_of = [&](const Eigen::Vector3d& v) {
+    const Eigen::Vector3d vt = v.cwiseProduct(thr);  // S^-1 = T S~^-1 T
+    double var = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const double c = vt.dot(e3.eigenvectors().col(k));
+      if (rep.eigenvalues(k) <= floor) {
+        if (std::abs(c) > 1e-6 * vt.norm()) return inf;
+        continue;
+      }
+      var += c * c / rep.eigenvalues(k);
+    }
+    return std::sqrt(var);
+  };
+  auto verdict = [&](const Eigen::Vector3d& v, double threshold) {
+    ParameterVerdict p;
+    p.crlb = sigma_of(v);
+    p.determined = p.crlb < threshold;
+    return p;
+  };
+  const Extrinsics& ex = at.extrinsics;
+  rep.phi = verdict({1, 0, 0}, obs.max_sigma_angle);
+  rep.rho = verdict({0, 1, 0}, obs.max_sigma_rho);
+  rep.psi = verdict({0, 0, 1}, obs.max_sigma_angle);
+  rep.yaw = verdict({1, 0, 1}, obs.max_sigma_angle);
+  rep.x = verdict({-ex.rho * std::sin(ex.phi), std::cos(ex.phi), 0}, obs.max_sigma_rho);
+  rep.y = verdict({ex.rho * std::cos(ex.phi), std::sin(ex.phi), 0}, obs.max_sigma_rho);
+  if (rep.rank == 3) {
+    rep.crlb_covariance = S.ldlt().solve(Eigen::Matrix3d::Identity());
+  } else {
+    rep.crlb_covariance.setConstant(inf);
+  }
+
+  std::ostringstream m;
+  if (rep.all_determined()) {
+    m << "phi, rho and psi are determined by this trajectory (Cramer-Rao bounds: phi "
+      << rad2deg(rep.phi.crlb) << " deg, rho " << 1e3 * rep.rho.crlb << " mm, psi "
+      << rad2deg(rep.psi.crlb) << " deg).";
+  } else {
+    std::vector<std::string> bad;
+    if (!rep.phi.determined) bad.push_back("phi");
+    if (!rep.rho.determined) bad.push_back("rho");
+    if (!rep.psi.determined) bad.push_back("psi");
+    for (std::size_t i = 0; i < bad.size(); ++i)
+      m << (i == 0 ? "" : (i + 1 == bad.size() ? " and " : ", ")) << bad[i];
+    m << (bad.size() == 1 ? " is" : " are") << " not determined by this trajectory";
+    if (rep.yaw.determined)
+      m << " (the camera yaw phi + psi is, to " << rad2deg(rep.yaw.crlb)
+        << " deg): the camera position is not seen from a rotating robot. Add a turn in "
+           "place near features (1-3 m away), or alternate straights and turns (Sec. 8.1).";
+    else
+      m << ", not even the camera yaw phi + psi: drive a straight line with vertical lines "
+           "around (a few meters away), then turn in place near them (Sec. 8.1).";
+  }
+  rep.message = m.str();
+  return rep;
+}
+
+}  // namespace omnivert::calib
