@@ -111,6 +111,10 @@ int main(int argc, char** argv) {
   fo.update_iterations = iterations;
   fo.feature_init = init == "naive" ? FeatureInit::kNaive : FeatureInit::kInverseDistance;
 
+  if (const char* c = std::getenv("PRIOR_AT_TRUTH")) {  // diagnostics: prior centred on truth
+    fo.prior = so.truth;
+    fo.prior_sigma = Eigen::Vector3d(std::atof(c), std::atof(c) / 8, std::atof(c));
+  }
   Stats filt, ref;
   Eigen::Vector3d crlb_sq = Eigen::Vector3d::Zero();
   double crlb_yaw_sq = 0, crlb_pos_sq = 0;
