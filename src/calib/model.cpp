@@ -163,3 +163,115 @@ Vec2 feature_from_world(const Eigen::Vector3d& robot_pose, const Vec2& feature) 
 }
 
 }  // namespace omnivert::calib
+
+namespace omnivert::calib {
+
+namespace {
+// R(a) and dR/da = R(a) S with S = [0 -1; 1 0].
+Mat2 rot(double a) {
+  Mat2 R;
+  R << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
+  return R;
+}
+const Mat2 kS = (Mat2() << 0, -1, 1, 0).finished();
+}  // namespace
+
+Vec2 propagate_point(const Vec2& p, double d_right, double d_left, double wheel_base,
+                     Mat2* J_out_p, Mat2* J_out_u) {
+  Mat2 J_step_wheels;
+  const Vec2 s = wheel_step(d_right, d_left, wheel_base, &J_step_wheels);
+  const double dr = s(0), dt = s(1);
+  const Vec2 h(std::cos(0.5 * dt), std::sin(0.5 * dt));
+  const Vec2 t = dr * h;  // eq. (14): translation along the mid-step heading
+  const Mat2 Rm = rot(-dt);
+  const Vec2 out = Rm * (p - t);
+  if (J_out_p) *J_out_p = Rm;
+  if (J_out_u) {
+    Mat2 J_out_step;
+    J_out_step.col(0) = -Rm * h;
+    J_out_step.col(1) = -Rm * kS * (p - t) - Rm * (0.5 * dr * kS * h);
+    *J_out_u = J_out_step * J_step_wheels;
+  }
+  return out;
+}
+
+Vec4 propagate_anchored(const Vec4& f, double d_right, double d_left, double wheel_base,
+                        Mat4* J_out_f, Mat42* J_out_u) {
+  Mat2 Ja, Jua;
+  Vec4 out;
+  out.head<2>() = propagate_point(f.head<2>(), d_right, d_left, wheel_base, &Ja, &Jua);
+  const double dt = (d_right - d_left) / wheel_base;  // eq. (15)
+  out(2) = f(2) - dt;
+  out(3) = f(3);
+  if (J_out_f) {
+    J_out_f->setIdentity();
+    J_out_f->topLeftCorner<2, 2>() = Ja;
+  }
+  if (J_out_u) {
+    J_out_u->setZero();
+    J_out_u->topRows<2>() = Jua;
+    J_out_u->row(2) << -1.0 / wheel_base, 1.0 / wheel_base;
+  }
+  return out;
+}
+
+double predict_bearing_point(const Vec2& p, const Vec3& cam, Eigen::Matrix<double, 1, 2>* J_beta_p,
+                             Row3* J_beta_cam) {
+  const Vec2 v = p - cam.head<2>();
+  const double n2 = v.squaredNorm();
+  const double beta = wrap_angle(std::atan2(v(1), v(0)) - cam(2));
+  const Eigen::Matrix<double, 1, 2> J_v(-v(1) / n2, v(0) / n2);
+  if (J_beta_p) *J_beta_p = J_v;
+  if (J_beta_cam) *J_beta_cam << -J_v(0), -J_v(1), -1.0;
+  return beta;
+}
+
+double predict_bearing_anchored(const Vec4& f, const Vec3& cam, Row4* J_beta_f,
+                                Row3* J_beta_cam) {
+  const Vec2 ac = f.head<2>() - cam.head<2>();
+  const Vec2 u(std::cos(f(2)), std::sin(f(2)));
+  const Vec2 v = f(3) * ac + u;
+  const double n2 = v.squaredNorm();
+  const double beta = wrap_angle(std::atan2(v(1), v(0)) - cam(2));
+  const Eigen::Matrix<double, 1, 2> J_v(-v(1) / n2, v(0) / n2);
+  if (J_beta_f) {
+    (*J_beta_f) << f(3) * J_v, J_v.dot(Vec2(-u(1), u(0))), J_v.dot(ac);
+  }
+  if (J_beta_cam) *J_beta_cam << -f(3) * J_v, -1.0;
+  return beta;
+}
+
+Vec2 anchored_to_point(const Vec4& f, Eigen::Matrix<double, 2, 4>* J_p_f) {
+  const Vec2 u(std::cos(f(2)), std::sin(f(2)));
+  if (J_p_f) {
+    J_p_f->leftCols<2>().setIdentity();
+    J_p_f->col(2) = Vec2(-u(1), u(0)) / f(3);
+    J_p_f->col(3) = -u / (f(3) * f(3));
+  }
+  return f.head<2>() + u / f(3);
+}
+
+Vec2 point_to_distance_form(const Vec2& p, Mat2* J_out_p) {
+  // p = (-D cos theta, D sin theta): D = |p|, theta = atan2(p_y, -p_x).
+  const double D2 = p.squaredNorm(), D = std::sqrt(D2);
+  if (J_out_p) *J_out_p << p(0) / D, p(1) / D, p(1) / D2, -p(0) / D2;
+  return {D, std::atan2(p(1), -p(0))};
+}
+
+Vec3 camera_pose_from_extrinsics(const Extrinsics& ex, Mat3* J_cam_ex) {
+  const double c = std::cos(ex.phi), s = std::sin(ex.phi);
+  if (J_cam_ex) *J_cam_ex << -ex.rho * s, c, 0, ex.rho * c, s, 0, 1, 0, 1;
+  return {ex.rho * c, ex.rho * s, wrap_angle(ex.phi + ex.psi)};
+}
+
+Extrinsics extrinsics_from_camera_pose(const Vec3& cam, Mat3* J_ex_cam) {
+  const double r2 = cam.head<2>().squaredNorm(), r = std::sqrt(r2);
+  const double phi = std::atan2(cam(1), cam(0));
+  if (J_ex_cam) {
+    *J_ex_cam << -cam(1) / r2, cam(0) / r2, 0, cam(0) / r, cam(1) / r, 0, cam(1) / r2,
+        -cam(0) / r2, 1;
+  }
+  return {phi, r, wrap_angle(cam(2) - phi)};
+}
+
+}  // namespace omnivert::calib

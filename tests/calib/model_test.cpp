@@ -3,6 +3,7 @@
 // direct geometry.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <functional>
 #include <random>
 
@@ -153,6 +154,95 @@ TEST_F(RandomStates, FeatureFromRayJacobiansAndRoundTrip) {
     Eigen::MatrixXd Jw = Jn;
     for (int i = 0; i < 5; ++i) Jw(1, i) = Jn(1, i);
     EXPECT_LT((J - Jw).cwiseAbs().maxCoeff(), 1e-5) << "trial " << trial;
+  }
+}
+
+TEST_F(RandomStates, InvariantParametrisationJacobians) {
+  for (int trial = 0; trial < 50; ++trial) {
+    const double dR = U(-0.05, 0.05), dL = U(-0.05, 0.05);
+    const Vec2 p(U(-6, 6), U(-6, 6));
+    const Vec4 f(U(-0.5, 0.5), U(-0.5, 0.5), U(-kPi, kPi), U(0.05, 1.0));
+    const Vec3 cam(U(-0.4, 0.4), U(-0.4, 0.4), U(-kPi, kPi));
+    Mat2 Jp, Jpu;
+    const Vec2 p1 = propagate_point(p, dR, dL, kE, &Jp, &Jpu);
+    auto fp = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd { return propagate_point(v, dR, dL, kE); };
+    auto fpu = [&](const Eigen::VectorXd& u) -> Eigen::VectorXd { return propagate_point(p, u(0), u(1), kE); };
+    EXPECT_LT((Jp - numeric_jacobian(fp, p)).cwiseAbs().maxCoeff(), kTol);
+    EXPECT_LT((Jpu - numeric_jacobian(fpu, Eigen::Vector2d(dR, dL))).cwiseAbs().maxCoeff(), kTol);
+    // The same motion as eq. (14) in the world: robot at pose, feature at world point.
+    const Eigen::Vector3d pose(U(-2, 2), U(-2, 2), U(-kPi, kPi));
+    const Eigen::Vector3d pose1 = integrate_pose(pose, dR, dL, kE);
+    const Vec2 world = pose.head<2>() + Eigen::Rotation2Dd(pose(2)) * p;
+    EXPECT_LT((pose1.head<2>() + Eigen::Rotation2Dd(pose1(2)) * p1 - world).norm(), 1e-12);
+    // ... and as eq. (29) up to its discretisation: eq. (29) moves along the heading at the
+    // start of the step, eq. (14) along the mid-step heading, an O(d_rho d_theta / 2 +
+    // d_rho^2 / D) difference.
+    const Vec2 Dt = point_to_distance_form(p);
+    const Vec2 Dt1 = point_to_distance_form(p1);
+    const Vec2 Dt29 = propagate_feature(Dt, dR, dL, kE);
+    const Vec2 st = wheel_step(dR, dL, kE);
+    EXPECT_NEAR(Dt1(0), Dt29(0),
+                std::abs(st(0) * st(1)) / 2 + st(0) * st(0) / Dt(0) + 1e-12);
+
+    Mat4 Jf;
+    Mat42 Jfu;
+    propagate_anchored(f, dR, dL, kE, &Jf, &Jfu);
+    auto ff = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd { return propagate_anchored(v, dR, dL, kE); };
+    auto ffu = [&](const Eigen::VectorXd& u) -> Eigen::VectorXd { return propagate_anchored(f, u(0), u(1), kE); };
+    EXPECT_LT((Jf - numeric_jacobian(ff, f)).cwiseAbs().maxCoeff(), kTol);
+    EXPECT_LT((Jfu - numeric_jacobian(ffu, Eigen::Vector2d(dR, dL))).cwiseAbs().maxCoeff(), kTol);
+
+    Eigen::Matrix<double, 1, 2> Jbp;
+    Row3 Jbc;
+    predict_bearing_point(p, cam, &Jbp, &Jbc);
+    Eigen::VectorXd xpc(5);
+    xpc << p, cam;
+    auto fb = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd {
+      return Eigen::VectorXd::Constant(1, predict_bearing_point(v.head<2>(), v.tail<3>()));
+    };
+    Eigen::Matrix<double, 1, 5> Jb;
+    Jb << Jbp, Jbc;
+    EXPECT_LT((Jb - numeric_jacobian(fb, xpc, true)).cwiseAbs().maxCoeff(), kTol);
+
+    Row4 Jaf;
+    Row3 Jac;
+    const double ba = predict_bearing_anchored(f, cam, &Jaf, &Jac);
+    EXPECT_NEAR(angle_diff(ba, predict_bearing_point(anchored_to_point(f), cam)), 0.0, 1e-9);
+    Eigen::VectorXd xfc(7);
+    xfc << f, cam;
+    auto fa = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd {
+      return Eigen::VectorXd::Constant(1, predict_bearing_anchored(v.head<4>(), v.tail<3>()));
+    };
+    Eigen::Matrix<double, 1, 7> Ja;
+    Ja << Jaf, Jac;
+    EXPECT_LT((Ja - numeric_jacobian(fa, xfc, true)).cwiseAbs().maxCoeff(), kTol);
+
+    Eigen::Matrix<double, 2, 4> Jpf;
+    anchored_to_point(f, &Jpf);
+    auto fap = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd { return anchored_to_point(v); };
+    EXPECT_LT((Jpf - numeric_jacobian(fap, f)).cwiseAbs().maxCoeff(), 1e-4);
+
+    Mat2 Jdp;
+    const Vec2 dt = point_to_distance_form(p, &Jdp);
+    auto fdp = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd { return point_to_distance_form(v); };
+    EXPECT_LT((Jdp - numeric_jacobian(fdp, p, false)).cwiseAbs().maxCoeff(), kTol);
+    // (D, theta) and the point agree on the bearing (eq. 27 vs atan2 form).
+    const Extrinsics ex = extrinsics_from_camera_pose(cam);
+    EXPECT_NEAR(angle_diff(predict_bearing(dt(0), dt(1), ex), predict_bearing_point(p, cam)), 0, 1e-12);
+
+    Mat3 Jce, Jec;
+    const Vec3 c2 = camera_pose_from_extrinsics(ex, &Jce);
+    extrinsics_from_camera_pose(cam, &Jec);
+    EXPECT_LT((c2 - cam).norm(), 1e-12);
+    auto fce = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd {
+      return camera_pose_from_extrinsics({v(0), v(1), v(2)});
+    };
+    auto fec = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd {
+      return extrinsics_from_camera_pose(v).vec();
+    };
+    EXPECT_LT((Jce - numeric_jacobian(fce, ex.vec(), true)).cwiseAbs().maxCoeff(), kTol);
+    EXPECT_LT((Jec - numeric_jacobian(fec, cam, true)).cwiseAbs().maxCoeff(), 1e-5);
+    EXPECT_LT((Jce * Jec - Mat3::Identity()).cwiseAbs().maxCoeff(), 1e-12);
   }
 }
 

@@ -62,4 +62,55 @@ Vec2 feature_from_ray(double q_c, double beta, const Extrinsics& ex, Mat2* J_out
 Vec2 feature_to_world(const Eigen::Vector3d& robot_pose, double D, double theta);
 Vec2 feature_from_world(const Eigen::Vector3d& robot_pose, const Vec2& feature);
 
+// ---------------------------------------------------------------------------------------
+// The invariant parametrisation (FeatureInit::kAnchoredInverseDepth). Features are points of
+// the robot frame, p = (p_x, p_y) (the same point as (D, theta): p = (-D cos theta,
+// D sin theta)), or, while their depth is poorly known, anchored inverse-depth points
+// (a_x, a_y, alpha, q): the point a + (cos alpha, sin alpha) / q, with the anchor a = the
+// camera centre when the track started, carried along in the robot frame. The extrinsics are
+// the camera position c = rho (cos phi, sin phi) and yaw eta = phi + psi. In these coordinates
+// the direction that straight motion cannot observe (move the camera and every feature by
+// the same vector, Sec. 8.1) is a constant vector, so the EKF's linearisation at changing
+// estimates cannot create information along it (the "first-estimates" inconsistency of
+// Huang, Mourikis and Roumeliotis 2008, measured in the paper's (D, theta) coordinates).
+
+using Vec3 = Eigen::Vector3d;
+using Vec4 = Eigen::Vector4d;
+using Mat3 = Eigen::Matrix3d;
+using Mat4 = Eigen::Matrix4d;
+using Mat42 = Eigen::Matrix<double, 4, 2>;
+using Row3 = Eigen::Matrix<double, 1, 3>;
+using Row4 = Eigen::Matrix<double, 1, 4>;
+
+// Eq. (14) seen from the robot: a world point's robot-frame coordinates after one odometry
+// step, p' = R(-d_theta) (p - d_rho (cos(d_theta / 2), sin(d_theta / 2))).
+// J_out_u columns (d_R, d_L).
+Vec2 propagate_point(const Vec2& p, double d_right, double d_left, double wheel_base,
+                     Mat2* J_out_p = nullptr, Mat2* J_out_u = nullptr);
+
+// Anchored inverse-depth point (a_x, a_y, alpha, q): the anchor moves as a point, alpha
+// turns with the robot (alpha' = alpha - d_theta), q is unchanged.
+Vec4 propagate_anchored(const Vec4& f, double d_right, double d_left, double wheel_base,
+                        Mat4* J_out_f = nullptr, Mat42* J_out_u = nullptr);
+
+// Bearing of robot-frame point p from a camera at c with yaw eta: atan2(p - c) - eta
+// (eq. 16-17 in the robot frame). J_beta_p (1x2), J_beta_cam w.r.t. (c_x, c_y, eta).
+double predict_bearing_point(const Vec2& p, const Vec3& cam, Eigen::Matrix<double, 1, 2>* J_beta_p = nullptr,
+                             Row3* J_beta_cam = nullptr);
+
+// Bearing of an anchored inverse-depth point: atan2(q (a - c) + (cos alpha, sin alpha)) - eta
+// (the direction of p - c scaled by q > 0, defined for q -> 0).
+double predict_bearing_anchored(const Vec4& f, const Vec3& cam, Row4* J_beta_f = nullptr,
+                                Row3* J_beta_cam = nullptr);
+
+// Anchored inverse-depth point -> robot-frame point, p = a + (cos alpha, sin alpha) / q.
+Vec2 anchored_to_point(const Vec4& f, Eigen::Matrix<double, 2, 4>* J_p_f = nullptr);
+
+// Robot-frame point <-> (D, theta) of eq. (19).
+Vec2 point_to_distance_form(const Vec2& p, Mat2* J_out_p = nullptr);
+
+// Camera pose (c_x, c_y, eta) <-> extrinsics (phi, rho, psi).
+Vec3 camera_pose_from_extrinsics(const Extrinsics& ex, Mat3* J_cam_ex = nullptr);
+Extrinsics extrinsics_from_camera_pose(const Vec3& cam, Mat3* J_ex_cam = nullptr);
+
 }  // namespace omnivert::calib
