@@ -3,7 +3,7 @@
 // Cramer-Rao bound, NEES against the chi-square interval. Filter alone and with the batch
 // refinement.
 //
-//   calib_monte_carlo [--runs 50] [--sigma-deg 0.3] [--init inverse|naive]
+//   calib_monte_carlo [--runs 50] [--sigma-deg 0.3] [--init anchored|inverse|naive]
 //                     [--inflation 5] [--iterations 3] [--trajectory paper|zigzag]
 //                     [--refine] [--seed 1]
 #include <Eigen/Cholesky>
@@ -77,7 +77,7 @@ int main(int argc, char** argv) {
   int runs = 50, iterations = 3;
   bool refine = false;
   double sigma_deg = 0.3, inflation = 5.0;
-  std::string init = "inverse", trajectory = "paper";
+  std::string init = "anchored", trajectory = "paper";
   std::uint64_t seed = 1;
   for (int i = 1; i < argc; ++i) {
     auto next = [&]() -> const char* {
@@ -109,12 +109,19 @@ int main(int argc, char** argv) {
   fo.odometry_inflation = inflation;
   fo.bearing_sigma = so.bearing_sigma;
   fo.update_iterations = iterations;
-  fo.feature_init = init == "naive" ? FeatureInit::kNaive : FeatureInit::kInverseDistance;
+  fo.feature_init = init == "naive"     ? FeatureInit::kNaive
+                    : init == "inverse" ? FeatureInit::kInverseDistance
+                                        : FeatureInit::kAnchoredInverseDepth;
 
   if (const char* c = std::getenv("PRIOR_AT_TRUTH")) {  // diagnostics: prior centred on truth
     fo.prior = so.truth;
     fo.prior_sigma = Eigen::Vector3d(std::atof(c), std::atof(c) / 8, std::atof(c));
   }
+  if (const char* c = std::getenv("PRIOR_SIGMA"))  // diagnostics
+    fo.prior_sigma = Eigen::Vector3d(std::atof(c), std::atof(c) / 8, std::atof(c));
+  if (const char* c = std::getenv("DMIN")) fo.min_feature_distance = std::atof(c);
+  if (const char* c = std::getenv("DMAX")) fo.max_feature_distance = std::atof(c);
+  if (const char* c = std::getenv("CONVERT")) fo.convert_ratio = std::atof(c);
   Stats filt, ref;
   Eigen::Vector3d crlb_sq = Eigen::Vector3d::Zero();
   double crlb_yaw_sq = 0, crlb_pos_sq = 0;
@@ -124,6 +131,9 @@ int main(int argc, char** argv) {
     const SyntheticRun run = make_synthetic_run(so);
     const FilterResult fr = run_filter(run.run, fo);
     filt.add(fr.extrinsics, fr.covariance, run.truth);
+    if (std::getenv("VERBOSE") && !filt.nees.empty())
+      std::printf("run %d: nees %.1f  phi %.4f rho %.4f psi %.4f\n", r, filt.nees.back(),
+                  fr.extrinsics.phi, fr.extrinsics.rho, fr.extrinsics.psi);
     // Cramer-Rao bound of this run: Fisher information at the truth.
     BatchPoint truth;
     truth.poses = run.true_poses;

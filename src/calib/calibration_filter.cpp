@@ -4,6 +4,7 @@
 #include <set>
 #include <string>
 
+#include "omnivert/calib/model.hpp"
 #include "omnivert/core/error.hpp"
 
 namespace omnivert::calib {
@@ -18,7 +19,10 @@ Options checked(const Options& options) {
 
 CalibrationFilter::CalibrationFilter(const Options& options)
     : options_(checked(options)),
-      state_(options.prior, options.prior_sigma),
+      state_(options.prior, options.prior_sigma,
+             options.feature_init == FeatureInit::kAnchoredInverseDepth
+                 ? ExtrinsicsParam::kCameraPose
+                 : ExtrinsicsParam::kPaper),
       propagator_(options),
       updater_(options),
       initializer_(options) {}
@@ -68,13 +72,28 @@ void CalibrationFilter::process(const FrameInput& frame) {
     initializer_.initialize(o->track_id, o->beta, frame_, &state_);
     ++rec.num_new;
   }
-  // Inverse-distance blocks whose distance is now well known become (D, theta), eq. (28).
+  // Inverse-depth blocks whose depth is now well known change to (D, theta) of eq. (28)
+  // (kInverseDistance) or to a robot-frame point (kAnchored).
   if (options_.convert_ratio > 0.0) {
     for (int s = 0; s < state_.num_features(); ++s) {
-      if (state_.slots()[s].param != FeatureParam::kInverseDistance) continue;
-      const int i = FilterState::feature_index(s);
-      const double q = state_.x()(i);
-      if (std::sqrt(state_.P()(i, i)) < options_.convert_ratio * q) state_.convert_to_distance(s);
+      const FeatureSlot& slot = state_.slots()[s];
+      if (slot.param == FeatureParam::kInverseDistance) {
+        const int i = slot.index;
+        const double q = state_.x()(i);
+        if (std::sqrt(state_.P()(i, i)) < options_.convert_ratio * q) {
+          const Eigen::Vector2d y(1.0 / q, state_.x()(i + 1));
+          const Eigen::Matrix2d J = (Eigen::Matrix2d() << -1.0 / (q * q), 0, 0, 1).finished();
+          state_.reparametrise(s, FeatureParam::kDistance, y, J);
+        }
+      } else if (slot.param == FeatureParam::kAnchored) {
+        const int i = slot.index;
+        const double q = state_.x()(i + 3);
+        if (std::sqrt(state_.P()(i + 3, i + 3)) < options_.convert_ratio * q) {
+          Eigen::Matrix<double, 2, 4> J;
+          const Eigen::Vector2d y = anchored_to_point(state_.x().segment<4>(i), &J);
+          state_.reparametrise(s, FeatureParam::kPoint, y, J);
+        }
+      }
     }
   }
   record_tracks();

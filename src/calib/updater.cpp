@@ -1,6 +1,7 @@
 #include "omnivert/calib/updater.hpp"
 
 #include <Eigen/Cholesky>
+#include <cassert>
 #include <cmath>
 #include <limits>
 
@@ -60,20 +61,47 @@ Eigen::VectorXd Updater::predict(const FilterState& state, const Eigen::VectorXd
                                  const std::vector<BearingMeasurement>& z,
                                  Eigen::MatrixXd* H) const {
   const int e = state.extrinsics_index();
-  const Extrinsics ex = Extrinsics::from_vec(x.segment<3>(e));
+  const bool paper = state.extrinsics_param() == ExtrinsicsParam::kPaper;
+  const Extrinsics ex = Extrinsics::from_vec(x.segment<3>(e));  // (phi, rho, psi) if paper
+  const Vec3 cam = x.segment<3>(e);                              // (c_x, c_y, eta) otherwise
   const int m = static_cast<int>(z.size());
   Eigen::VectorXd h(m);
   H->setZero(m, state.dim());
   for (int k = 0; k < m; ++k) {
-    const int i = FilterState::feature_index(z[k].slot);
-    Row5 J;
-    // Eq. (30), the row of this feature; H of appendix A.4 (chain rule for (q, theta)).
-    h(k) = state.slots()[z[k].slot].param == FeatureParam::kDistance
-               ? predict_bearing(x(i), x(i + 1), ex, &J)
-               : predict_bearing_inverse(x(i), x(i + 1), ex, &J);
-    (*H)(k, i) = J(0);
-    (*H)(k, i + 1) = J(1);
-    H->block<1, 3>(k, e) = J.tail<3>();
+    const FeatureSlot& s = state.slots()[z[k].slot];
+    const int i = s.index;
+    switch (s.param) {
+      case FeatureParam::kDistance:
+      case FeatureParam::kInverseDistance: {
+        assert(paper);
+        Row5 J;
+        // Eq. (30), the row of this feature; H of appendix A.4 (chain rule for (q, theta)).
+        h(k) = s.param == FeatureParam::kDistance ? predict_bearing(x(i), x(i + 1), ex, &J)
+                                                  : predict_bearing_inverse(x(i), x(i + 1), ex, &J);
+        (*H)(k, i) = J(0);
+        (*H)(k, i + 1) = J(1);
+        H->block<1, 3>(k, e) = J.tail<3>();
+        break;
+      }
+      case FeatureParam::kPoint: {
+        assert(!paper);
+        Eigen::Matrix<double, 1, 2> Jp;
+        Row3 Jc;
+        h(k) = predict_bearing_point(x.segment<2>(i), cam, &Jp, &Jc);
+        H->block<1, 2>(k, i) = Jp;
+        H->block<1, 3>(k, e) = Jc;
+        break;
+      }
+      case FeatureParam::kAnchored: {
+        assert(!paper);
+        Row4 Jf;
+        Row3 Jc;
+        h(k) = predict_bearing_anchored(x.segment<4>(i), cam, &Jf, &Jc);
+        H->block<1, 4>(k, i) = Jf;
+        H->block<1, 3>(k, e) = Jc;
+        break;
+      }
+    }
   }
   return h;
 }

@@ -58,6 +58,13 @@ enum class FeatureInit {
   // (q = 1/D, theta) while its distance is poorly known and converted to (D, theta) of
   // eq. (28) once sigma_D / D falls below `convert_ratio`.
   kInverseDistance,
+  // The invariant parametrisation (model.hpp): the feature enters as an anchored inverse-depth
+  // point (anchor = camera centre, azimuth of the ray, inverse depth q ~ the same prior as
+  // kInverseDistance) and becomes a robot-frame point once sigma_q / q < convert_ratio; the
+  // extrinsics are carried as the camera pose (c_x, c_y, phi + psi). Same measurements, same
+  // models (eq. 14-17, 31); the straight-motion unobservable direction is then a constant
+  // vector, which keeps the EKF from inventing information along it.
+  kAnchoredInverseDepth,
 };
 
 struct Options {
@@ -73,7 +80,7 @@ struct Options {
   Extrinsics prior{0.0, 0.2, 0.0};
   Eigen::Vector3d prior_sigma{0.8, 0.1, 0.8};  // [rad, m, rad]
   // Feature initialisation.
-  FeatureInit feature_init = FeatureInit::kInverseDistance;
+  FeatureInit feature_init = FeatureInit::kAnchoredInverseDepth;
   double naive_distance = 3.0;        // D0 [m] (kNaive)
   double naive_distance_sigma = 2.0;  // [m] (kNaive)
   double min_feature_distance = 1.0;  // [m] (kInverseDistance: 2-sigma range of the prior)
