@@ -122,6 +122,8 @@ int main(int argc, char** argv) {
   if (const char* c = std::getenv("DMIN")) fo.min_feature_distance = std::atof(c);
   if (const char* c = std::getenv("DMAX")) fo.max_feature_distance = std::atof(c);
   if (const char* c = std::getenv("CONVERT")) fo.convert_ratio = std::atof(c);
+  if (std::getenv("NO_SECOND_ORDER")) fo.second_order_noise = false;
+  if (const char* c = std::getenv("BOOT")) fo.bootstrap_rotation = std::atof(c);
   Stats filt, ref;
   Eigen::Vector3d crlb_sq = Eigen::Vector3d::Zero();
   double crlb_yaw_sq = 0, crlb_pos_sq = 0;

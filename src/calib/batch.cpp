@@ -298,3 +298,182 @@ ObservabilityReport analyse_observability(const CalibrationRun& run, const Optio
 }
 
 }  // namespace omnivert::calib
+
+namespace omnivert::calib {
+
+namespace {
+
+// Ext prior: (phi, rho, psi) ~ N(prior, diag(sigma^2)), angles wrapped.
+struct ExtrinsicsPrior {
+  Eigen::Vector3d mean, inv_sigma;
+  template <typename T>
+  bool operator()(const T* ex, T* r) const {
+    const T dphi = ex[0] - mean(0), dpsi = ex[2] - mean(2);
+    r[0] = atan2(sin(dphi), cos(dphi)) * inv_sigma(0);
+    r[1] = (ex[1] - mean(1)) * inv_sigma(1);
+    r[2] = atan2(sin(dpsi), cos(dpsi)) * inv_sigma(2);
+    return true;
+  }
+};
+
+// Inverse-depth prior of a track: 1 / |f - C| ~ N(q0, sigma_q^2), C the camera centre at the
+// track's first frame (the prior FeatureInitializer uses for tracks that start later).
+struct InverseDepthPrior {
+  double q0, inv_sigma;
+  template <typename T>
+  bool operator()(const T* pose, const T* f, const T* ex, T* r) const {
+    const T a = pose[2] + ex[0];
+    const T dx = f[0] - (pose[0] + ex[1] * cos(a));
+    const T dy = f[1] - (pose[1] + ex[1] * sin(a));
+    r[0] = (T(1.0) / sqrt(dx * dx + dy * dy) - q0) * inv_sigma;
+    return true;
+  }
+};
+
+}  // namespace
+
+bool bootstrap_filter_state(const CalibrationRun& window, const Options& options,
+                            FilterState* state, std::string* why) {
+  auto fail = [why](const std::string& m) {
+    if (why) *why = m;
+    return false;
+  };
+  const int W = static_cast<int>(window.frames.size());
+  if (W < 2) return fail("window too short");
+  const double q_lo = 1.0 / options.max_feature_distance;
+  const double q_hi = 1.0 / options.min_feature_distance;
+  const double q0 = 0.5 * (q_lo + q_hi), sigma_q = 0.25 * (q_hi - q_lo);
+
+  // Starting point: dead reckoning, the prior, each track on its first ray at depth 1/q0.
+  BatchPoint start;
+  start.poses = dead_reckoning(window, options.wheel_base);
+  start.extrinsics = options.prior;
+  std::map<int, int> first_frame, last_frame, count;
+  for (int k = 0; k < W; ++k)
+    for (const BearingObservation& o : window.frames[k].observations) {
+      if (!count[o.track_id]++) first_frame[o.track_id] = k;
+      last_frame[o.track_id] = k;
+      if (count[o.track_id] == 1) {
+        const Eigen::Vector3d& p = start.poses[k];
+        const Extrinsics& ex = options.prior;
+        const Vec2 C = p.head<2>() + ex.rho * Vec2(std::cos(p(2) + ex.phi), std::sin(p(2) + ex.phi));
+        const double dir = p(2) + ex.phi + ex.psi + o.beta;
+        start.features[o.track_id] = C + Vec2(std::cos(dir), std::sin(dir)) / q0;
+      }
+    }
+  Options opt = options;
+  opt.min_track_length = 2;
+  Built b = build(window, opt, start, BatchOptions{}, /*robust=*/false);
+  if (b.features.empty()) return fail("no track with two bearings in the window");
+  b.problem->AddResidualBlock(
+      new ceres::AutoDiffCostFunction<ExtrinsicsPrior, 3, 3>(new ExtrinsicsPrior{
+          options.prior.vec(), options.prior_sigma.cwiseInverse()}),
+      nullptr, b.ex.data());
+  for (auto& [id, f] : b.features)
+    b.problem->AddResidualBlock(
+        new ceres::AutoDiffCostFunction<InverseDepthPrior, 1, 3, 2, 3>(
+            new InverseDepthPrior{q0, 1.0 / sigma_q}),
+        nullptr, b.poses[first_frame[id]].data(), f.data(), b.ex.data());
+
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.max_num_iterations = 100;
+  so.num_threads = 1;
+  so.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, b.problem.get(), &summary);
+  if (!summary.IsSolutionUsable()) return fail("window solve failed: " + summary.BriefReport());
+
+  // Covariance of all window variables: inverse of J^T J (priors included).
+  ceres::Problem::EvaluateOptions eo;
+  std::vector<double*> blocks;
+  for (int k = 1; k < W; ++k) blocks.push_back(b.poses[k].data());
+  std::map<int, int> feature_col;
+  int col = 3 * (W - 1);
+  for (auto& [id, f] : b.features) {
+    blocks.push_back(f.data());
+    feature_col[id] = col;
+    col += 2;
+  }
+  blocks.push_back(b.ex.data());
+  const int ex_col = col;
+  eo.parameter_blocks = blocks;
+  ceres::CRSMatrix crs;
+  b.problem->Evaluate(eo, nullptr, nullptr, nullptr, &crs);
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+  for (int r = 0; r < crs.num_rows; ++r)
+    for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k) J(r, crs.cols[k]) = crs.values[k];
+  const Eigen::MatrixXd F = J.transpose() * J;
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(F);
+  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().array() > 0).all())
+    return fail("window information is singular");
+  const Eigen::MatrixXd Pv = ldlt.solve(Eigen::MatrixXd::Identity(F.rows(), F.cols()));
+
+  // Map to the filter's coordinates at the last window frame: camera pose (c, eta) and, per
+  // kept track, (a = c, alpha, q) with alpha, q the direction and inverse distance of the
+  // feature from the camera, in the robot frame.
+  const int last = W - 1;
+  std::vector<int> ids;
+  for (auto& [id, f] : b.features)
+    if (last - last_frame[id] <= options.max_missed_frames) ids.push_back(id);
+  const int nv = static_cast<int>(F.rows());
+  const int ns = 4 * static_cast<int>(ids.size()) + 3;
+  const int pose_col = 3 * (last - 1);  // pose of the last frame (W >= 2)
+  auto state_of = [&](const Eigen::VectorXd& v) {
+    Eigen::VectorXd s(ns);
+    const Extrinsics ex{v(ex_col), v(ex_col + 1), v(ex_col + 2)};
+    const Vec3 cam = camera_pose_from_extrinsics(ex);
+    const Eigen::Vector3d pose = v.segment<3>(pose_col);
+    const double c = std::cos(pose(2)), sn = std::sin(pose(2));
+    for (std::size_t i = 0; i < ids.size(); ++i) {
+      const Vec2 f = v.segment<2>(feature_col[ids[i]]);
+      const Vec2 d = f - pose.head<2>();
+      const Vec2 fr(c * d(0) + sn * d(1), -sn * d(0) + c * d(1));  // robot frame
+      const Vec2 v_c = fr - cam.head<2>();
+      s.segment<4>(4 * i) << cam(0), cam(1), std::atan2(v_c(1), v_c(0)), 1.0 / v_c.norm();
+    }
+    s.tail<3>() = cam;
+    return s;
+  };
+  Eigen::VectorXd v0(nv);
+  for (int k = 1; k < W; ++k) v0.segment<3>(3 * (k - 1)) = Eigen::Map<Eigen::Vector3d>(b.poses[k].data());
+  for (auto& [id, f] : b.features) v0.segment<2>(feature_col[id]) = Eigen::Map<Eigen::Vector2d>(f.data());
+  v0.segment<3>(ex_col) = Eigen::Map<Eigen::Vector3d>(b.ex.data());
+  const Eigen::VectorXd s0 = state_of(v0);
+  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(ns, nv);  // central differences (smooth maps)
+  std::vector<int> cols = {pose_col, pose_col + 1, pose_col + 2, ex_col, ex_col + 1, ex_col + 2};
+  for (int id : ids) {
+    cols.push_back(feature_col[id]);
+    cols.push_back(feature_col[id] + 1);
+  }
+  for (int c : cols) {
+    const double h = 1e-6;
+    Eigen::VectorXd vp = v0, vm = v0;
+    vp(c) += h;
+    vm(c) -= h;
+    Eigen::VectorXd d = state_of(vp) - state_of(vm);
+    for (std::size_t i = 0; i < ids.size(); ++i) d(4 * i + 2) = wrap_angle(d(4 * i + 2));
+    d(ns - 1) = wrap_angle(d(ns - 1));
+    T.col(c) = d / (2 * h);
+  }
+  const Eigen::MatrixXd Ps = T * Pv * T.transpose();
+  if (!s0.allFinite() || !Ps.allFinite()) return fail("window solution is not finite");
+
+  std::vector<FeatureSlot> slots;
+  for (int id : ids) {
+    FeatureSlot slot;
+    slot.track_id = id;
+    slot.param = FeatureParam::kAnchored;
+    slot.first_frame = first_frame[id];
+    slot.last_seen_frame = last_frame[id];
+    slot.num_updates = count[id];
+    slots.push_back(slot);
+  }
+  FilterState fresh(options.prior, options.prior_sigma, ExtrinsicsParam::kCameraPose);
+  fresh.reset(s0, Ps, slots);
+  fresh.normalise();
+  *state = std::move(fresh);
+  return true;
+}
+
+}  // namespace omnivert::calib

@@ -1,9 +1,11 @@
 #include "omnivert/calib/calibration_filter.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <string>
 
+#include "omnivert/calib/batch.hpp"
 #include "omnivert/calib/model.hpp"
 #include "omnivert/core/error.hpp"
 
@@ -25,7 +27,9 @@ CalibrationFilter::CalibrationFilter(const Options& options)
                  : ExtrinsicsParam::kPaper),
       propagator_(options),
       updater_(options),
-      initializer_(options) {}
+      initializer_(options),
+      bootstrapping_(options.feature_init == FeatureInit::kAnchoredInverseDepth &&
+                     options.bootstrap_rotation > 0.0) {}
 
 void CalibrationFilter::process(const FrameInput& frame) {
   const std::string where = "frame " + std::to_string(frame_);
@@ -41,6 +45,63 @@ void CalibrationFilter::process(const FrameInput& frame) {
                        " appears twice in one frame");
   }
 
+  // Delayed initialisation: the first bootstrap_frames frames are solved as a batch
+  // (bootstrap_filter_state), the filter starts from that.
+  if (bootstrapping_) {
+    window_.frames.push_back(frame);
+    FrameEstimate rec;
+    rec.frame = frame_;
+    rec.extrinsics = state_.extrinsics();
+    rec.covariance = state_.extrinsics_covariance();
+    const int n = static_cast<int>(window_.frames.size());
+    window_heading_ += (frame.d_right - frame.d_left) / options_.wheel_base;  // eq. (15)
+    if (n > 1) window_max_turn_ = std::max(window_max_turn_, std::abs(window_heading_));
+    if ((n < options_.bootstrap_min_frames || window_max_turn_ < options_.bootstrap_rotation) &&
+        n < options_.bootstrap_max_frames) {
+      history_.push_back(rec);
+      ++frame_;
+      return;
+    }
+    end_bootstrap(rec);
+    return;
+  }
+  step(frame);
+}
+
+void CalibrationFilter::finish() {
+  if (!bootstrapping_ || window_.frames.empty()) return;
+  --frame_;
+  FrameEstimate rec = history_.back();
+  history_.pop_back();
+  end_bootstrap(rec);
+}
+
+void CalibrationFilter::end_bootstrap(FrameEstimate rec) {
+  {
+    bootstrapping_ = false;
+    std::string why;
+    if (bootstrap_filter_state(window_, options_, &state_, &why)) {
+      rec.extrinsics = state_.extrinsics();
+      rec.covariance = state_.extrinsics_covariance();
+      rec.num_features = state_.num_features();
+      rec.num_new = state_.num_features();
+      history_.push_back(rec);
+      record_tracks();
+      ++frame_;
+      window_.frames.clear();
+      return;
+    }
+    // The window could not be solved: run the plain filter over it.
+    const int first = frame_ - static_cast<int>(window_.frames.size()) + 1;
+    history_.resize(first);
+    frame_ = first;
+    CalibrationRun w = std::move(window_);
+    window_.frames.clear();
+    for (const FrameInput& f : w.frames) step(f);
+  }
+}
+
+void CalibrationFilter::step(const FrameInput& frame) {
   FrameEstimate rec;
   rec.frame = frame_;
   // Prediction, eq. (29). (The first frame carries no travel; propagating zero is harmless.)
@@ -112,7 +173,7 @@ void CalibrationFilter::process(const FrameInput& frame) {
 void CalibrationFilter::record_tracks() {
   for (int s = 0; s < state_.num_features(); ++s) {
     const FeatureSlot& slot = state_.slots()[s];
-    if (slot.last_seen_frame != frame_) continue;
+    if (slot.last_seen_frame != frame_ && tracks_.count(slot.track_id)) continue;
     TrackEstimate& t = tracks_[slot.track_id];
     t.track_id = slot.track_id;
     t.frame = frame_;
@@ -124,6 +185,7 @@ void CalibrationFilter::record_tracks() {
 FilterResult run_filter(const CalibrationRun& run, const Options& options) {
   CalibrationFilter filter(options);
   for (const FrameInput& f : run.frames) filter.process(f);
+  filter.finish();
   return {filter.extrinsics(), filter.covariance(), filter.history(), filter.tracks()};
 }
 

@@ -1,6 +1,5 @@
 #include "omnivert/calib/feature_initializer.hpp"
 
-#include <cstdlib>
 
 #include "omnivert/calib/model.hpp"
 #include "omnivert/core/angles.hpp"
@@ -20,10 +19,8 @@ int FeatureInitializer::initialize(int track_id, double beta, int frame,
   slot.last_seen_frame = frame;
   const double q_lo = 1.0 / options_.max_feature_distance;
   const double q_hi = 1.0 / options_.min_feature_distance;
-  double q0 = 0.5 * (q_lo + q_hi);
-  double sigma_q = 0.25 * (q_hi - q_lo);  // the range is +-2 sigma
-  if (const char* c = std::getenv("Q0")) q0 = std::atof(c);
-  if (const char* c = std::getenv("SQ")) sigma_q = std::atof(c);
+  const double q0 = 0.5 * (q_lo + q_hi);
+  const double sigma_q = 0.25 * (q_hi - q_lo);  // the range is +-2 sigma
   Eigen::VectorXd y;
   Eigen::MatrixXd G_ex;      // d y / d (extrinsics block)
   Eigen::MatrixXd G_n;       // d y / d (prior variable, beta)

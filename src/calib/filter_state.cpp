@@ -150,6 +150,15 @@ void FilterState::reparametrise(int slot, FeatureParam param, const Eigen::Vecto
   reindex();
 }
 
+void FilterState::reset(const Eigen::VectorXd& x, const Eigen::MatrixXd& P,
+                        std::vector<FeatureSlot> slots) {
+  x_ = x;
+  P_ = 0.5 * (P + P.transpose());
+  slots_ = std::move(slots);
+  reindex();
+  assert(x_.size() == P_.rows() && (slots_.empty() || slots_.back().index + slots_.back().size == dim() - 3));
+}
+
 void FilterState::normalise() {
   for (const FeatureSlot& s : slots_) {
     const int i = s.index;

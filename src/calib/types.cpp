@@ -53,6 +53,9 @@ bool Options::IsValid(std::string* why) const {
     return fail(why, "min_feature_distance must exceed the camera offset rho");
   if (!std::isfinite(convert_ratio) || convert_ratio < 0.0)
     return fail(why, "convert_ratio must be >= 0 (0: never convert)");
+  if (!std::isfinite(bootstrap_rotation)) return fail(why, "bootstrap_rotation must be finite");
+  if (bootstrap_min_frames < 2 || bootstrap_max_frames < bootstrap_min_frames)
+    return fail(why, "need 2 <= bootstrap_min_frames <= bootstrap_max_frames");
   if (update_iterations < 1) return fail(why, "update_iterations must be >= 1");
   if (!(gate_probability > 0.0 && gate_probability <= 1.0))
     return fail(why, "gate_probability must be in (0, 1]");

@@ -106,6 +106,44 @@ Eigen::VectorXd Updater::predict(const FilterState& state, const Eigen::VectorXd
   return h;
 }
 
+double Updater::second_order_variance(const FilterState& state, const BearingMeasurement& z) const {
+  // Gaussian second-order filter (Bar-Shalom, Li, Kirubarajan 2001, Sec. 10.3): the
+  // variance that the curvature of h adds to the prediction, 1/2 tr(Hxx P Hxx P), over the
+  // variables the bearing depends on (its feature block and the extrinsics). Large while a
+  // depth or the camera pose is poorly known, vanishing as they converge; without it the
+  // first updates (small parallax, depth and yaw both uncertain) are overconfident.
+  const FeatureSlot& s = state.slots()[z.slot];
+  std::vector<int> idx;
+  for (int i = 0; i < s.size; ++i) idx.push_back(s.index + i);
+  for (int i = 0; i < 3; ++i) idx.push_back(state.extrinsics_index() + i);
+  const int d = static_cast<int>(idx.size());
+  const std::vector<BearingMeasurement> one = {z};
+  Eigen::MatrixXd Hdummy;
+  auto h = [&](const Eigen::VectorXd& x) { return predict(state, x, one, &Hdummy)(0); };
+  const double step = 1e-4;
+  const Eigen::VectorXd& x0 = state.x();
+  Eigen::MatrixXd Hxx(d, d);
+  for (int a = 0; a < d; ++a) {
+    for (int b = a; b < d; ++b) {
+      auto at = [&](double sa, double sb) {
+        Eigen::VectorXd x = x0;
+        x(idx[a]) += sa * step;
+        x(idx[b]) += sb * step;
+        return h(x);
+      };
+      const double h0 = h(x0);
+      const double v = angle_diff(at(1, 1), h0) - angle_diff(at(1, -1), h0) -
+                       angle_diff(at(-1, 1), h0) + angle_diff(at(-1, -1), h0);
+      Hxx(a, b) = Hxx(b, a) = v / (4.0 * step * step);
+    }
+  }
+  Eigen::MatrixXd Pb(d, d);
+  for (int a = 0; a < d; ++a)
+    for (int b = 0; b < d; ++b) Pb(a, b) = state.P()(idx[a], idx[b]);
+  const Eigen::MatrixXd M = Hxx * Pb;
+  return 0.5 * (M * M).trace();
+}
+
 std::vector<BearingUpdateResult> Updater::update(const std::vector<BearingMeasurement>& z_all,
                                                  FilterState* state) const {
   std::vector<BearingUpdateResult> results(z_all.size());
@@ -119,18 +157,23 @@ std::vector<BearingUpdateResult> Updater::update(const std::vector<BearingMeasur
   const Eigen::VectorXd h0 = predict(*state, x0, z_all, &H);
   std::vector<BearingMeasurement> z;
   std::vector<int> used;
+  std::vector<double> r_var;
   for (std::size_t k = 0; k < z_all.size(); ++k) {
+    const double rk =
+        var + (options_.second_order_noise ? second_order_variance(*state, z_all[k]) : 0.0);
     const double r = angle_diff(z_all[k].beta, h0(k));
-    const double S = H.row(k).dot(P0 * H.row(k).transpose()) + var;
+    const double S = H.row(k).dot(P0 * H.row(k).transpose()) + rk;
     results[k].chi2 = r * r / S;
     if (results[k].chi2 <= gate_) {  // also rejects NaN
       z.push_back(z_all[k]);
       used.push_back(static_cast<int>(k));
+      r_var.push_back(rk);
     }
   }
   if (z.empty()) return results;
   const int m = static_cast<int>(z.size());
-  const Eigen::MatrixXd R = Eigen::MatrixXd::Identity(m, m) * var;
+  Eigen::MatrixXd R = Eigen::MatrixXd::Zero(m, m);
+  for (int k = 0; k < m; ++k) R(k, k) = r_var[k];
 
   // Iterated EKF: x_{j+1} = x0 + K_j (z - h(x_j) - H_j (x0 - x_j)), K_j from H_j and P0.
   Eigen::VectorXd xj = x0;

@@ -63,6 +63,20 @@ struct RefinementResult {
 RefinementResult refine_batch(const CalibrationRun& run, const Options& options,
                               const BatchPoint& start, const BatchOptions& batch = {});
 
+// Delayed initialisation of the filter (FeatureInit::kAnchoredInverseDepth with
+// options.bootstrap_frames > 0): the first frames are solved as a small batch maximum a
+// posteriori problem (the prior on phi, rho, psi, an inverse-depth prior N(q0, sigma_q^2)
+// along each track's first ray, odometry, bearings; Levenberg-Marquardt relinearises), and
+// the filter starts at the last of them from that solution and its covariance (inverse of
+// the Fisher information with the priors), carried to the filter's coordinates (camera pose;
+// each track as an anchored inverse-depth point anchored at the camera) through central
+// differences. This removes the early-update inconsistency measured in NOTES Sec. 5 and in
+// docs/calib.md: one linearisation per frame while depth and camera yaw are both unknown.
+// Tracks with fewer than 2 bearings in the window are left out (they enter afterwards).
+// Returns false (state untouched, reason in *why) when the window cannot be solved.
+bool bootstrap_filter_state(const CalibrationRun& window, const Options& options,
+                            FilterState* state, std::string* why = nullptr);
+
 // Verdict on one parameter (or combination) of the extrinsics.
 struct ParameterVerdict {
   bool determined = false;

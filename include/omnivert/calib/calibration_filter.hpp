@@ -7,6 +7,7 @@
 //
 //   CalibrationFilter filter(options);
 //   for (const FrameInput& f : frames) filter.process(f);
+//   filter.finish();
 //   Extrinsics ex = filter.extrinsics();  Eigen::Matrix3d C = filter.covariance();
 
 #include <map>
@@ -49,6 +50,9 @@ class CalibrationFilter {
   // One image frame. Throws InputError on non-finite wheel travel or bearings, or a track id
   // repeated within the frame.
   void process(const FrameInput& frame);
+  // End of the run: solves a pending bootstrap window (a run that never turned). Call once
+  // after the last frame before reading the estimate.
+  void finish();
 
   Extrinsics extrinsics() const { return state_.extrinsics(); }
   Eigen::Matrix3d covariance() const { return state_.extrinsics_covariance(); }
@@ -59,6 +63,8 @@ class CalibrationFilter {
   const Options& options() const { return options_; }
 
  private:
+  void step(const FrameInput& frame);
+  void end_bootstrap(FrameEstimate rec);
   void record_tracks();
   Options options_;
   FilterState state_;
@@ -68,6 +74,10 @@ class CalibrationFilter {
   int frame_ = 0;
   std::vector<FrameEstimate> history_;
   std::map<int, TrackEstimate> tracks_;
+  bool bootstrapping_ = false;
+  CalibrationRun window_;
+  double window_heading_ = 0.0;
+  double window_max_turn_ = 0.0;
 };
 
 // Runs the filter over a whole run.

@@ -71,6 +71,8 @@ class FilterState {
                      const Eigen::MatrixXd& J);
   // Keeps angles in (-pi, pi] and P symmetric; keeps distances positive.
   void normalise();
+  // Replaces the whole state (used by the bootstrap window); slots' index/size are recomputed.
+  void reset(const Eigen::VectorXd& x, const Eigen::MatrixXd& P, std::vector<FeatureSlot> slots);
 
  private:
   void reindex();

@@ -47,6 +47,8 @@ class Updater {
   // Predicted bearings and Jacobian (m x dim) at state x.
   Eigen::VectorXd predict(const FilterState& state, const Eigen::VectorXd& x,
                           const std::vector<BearingMeasurement>& z, Eigen::MatrixXd* H) const;
+  // Variance added by the curvature of h (second-order filter), see the source.
+  double second_order_variance(const FilterState& state, const BearingMeasurement& z) const;
   Options options_;
   double gate_;
 };
