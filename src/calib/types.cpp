@@ -56,6 +56,8 @@ bool Options::IsValid(std::string* why) const {
   if (!std::isfinite(bootstrap_rotation)) return fail(why, "bootstrap_rotation must be finite");
   if (bootstrap_min_frames < 2 || bootstrap_max_frames < bootstrap_min_frames)
     return fail(why, "need 2 <= bootstrap_min_frames <= bootstrap_max_frames");
+  if (!finite_positive(bootstrap_depth_prior_scale))
+    return fail(why, "bootstrap_depth_prior_scale must be > 0");
   if (update_iterations < 1) return fail(why, "update_iterations must be >= 1");
   if (!(gate_probability > 0.0 && gate_probability <= 1.0))
     return fail(why, "gate_probability must be in (0, 1]");

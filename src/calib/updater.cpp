@@ -26,32 +26,50 @@ bool joseph_update(const Eigen::MatrixXd& H, const Eigen::MatrixXd& R, Eigen::Ma
   return true;
 }
 
+
 namespace {
-// Inverse of the standard normal CDF by bisection on erfc (called rarely).
-double normal_quantile(double p) {
-  double lo = -40.0, hi = 40.0;
-  for (int i = 0; i < 200; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    const double cdf = 0.5 * std::erfc(-mid / std::sqrt(2.0));
-    (cdf < p ? lo : hi) = mid;
+// Regularised lower incomplete gamma P(a, x): series for x < a + 1, continued fraction
+// otherwise (Numerical Recipes, Sec. 6.2).
+double gamma_p(double a, double x) {
+  if (x <= 0.0) return 0.0;
+  const double lg = std::lgamma(a);
+  if (x < a + 1.0) {
+    double term = 1.0 / a, sum = term;
+    for (int n = 1; n < 1000; ++n) {
+      term *= x / (a + n);
+      sum += term;
+      if (std::abs(term) < 1e-16 * std::abs(sum)) break;
+    }
+    return sum * std::exp(-x + a * std::log(x) - lg);
   }
-  return 0.5 * (lo + hi);
+  const double tiny = 1e-300;
+  double b = x + 1.0 - a, c = 1.0 / tiny, d = 1.0 / b, h = d;
+  for (int i = 1; i < 1000; ++i) {
+    const double an = -i * (i - a);
+    b += 2.0;
+    d = an * d + b;
+    if (std::abs(d) < tiny) d = tiny;
+    c = b + an / c;
+    if (std::abs(c) < tiny) c = tiny;
+    d = 1.0 / d;
+    const double del = d * c;
+    h *= del;
+    if (std::abs(del - 1.0) < 1e-16) break;
+  }
+  return 1.0 - std::exp(-x + a * std::log(x) - lg) * h;
 }
 }  // namespace
 
 double chi2_quantile(double p, int dof) {
   if (p >= 1.0) return std::numeric_limits<double>::infinity();
-  if (p <= 0.0) return 0.0;
-  if (dof == 1) {
-    const double z = normal_quantile(0.5 * (1.0 + p));
-    return z * z;
+  if (p <= 0.0 || dof < 1) return 0.0;
+  // Bisection on the CDF P(dof / 2, x / 2) (monotone), to 1e-12 relative.
+  double lo = 0.0, hi = dof + 20.0 * std::sqrt(2.0 * dof) + 50.0;
+  for (int i = 0; i < 200 && hi - lo > 1e-12 * hi; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (gamma_p(0.5 * dof, 0.5 * mid) < p ? lo : hi) = mid;
   }
-  if (dof == 2) return -2.0 * std::log1p(-p);
-  const double k = dof;
-  const double z = normal_quantile(p);
-  const double a = 2.0 / (9.0 * k);
-  const double t = 1.0 - a + z * std::sqrt(a);
-  return k * t * t * t;
+  return 0.5 * (lo + hi);
 }
 
 Updater::Updater(const Options& options)

@@ -97,6 +97,7 @@ struct Options {
   double bootstrap_rotation = 1.0;  // [rad] (measured: 0.1 / 0.3 / 1.0, docs/calib.md)
   int bootstrap_min_frames = 5;
   int bootstrap_max_frames = 300;
+  double bootstrap_depth_prior_scale = 100.0;  // window's inverse-depth prior sigma, x sigma_q
   // Updates.
   bool second_order_noise = true;     // add 1/2 tr(Hxx P Hxx P) to each bearing's variance
   int update_iterations = 3;          // 1: plain EKF; >1: iterated EKF (Gauss-Newton)

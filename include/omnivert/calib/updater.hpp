@@ -17,8 +17,8 @@ namespace omnivert::calib {
 bool joseph_update(const Eigen::MatrixXd& H, const Eigen::MatrixXd& R, Eigen::MatrixXd* P,
                    Eigen::MatrixXd* K = nullptr);
 
-// Quantile of the chi-square distribution (exact for 1 and 2 degrees of freedom,
-// Wilson-Hilferty otherwise; relative error < 1e-3 for dof >= 3 at the usual levels).
+// Quantile of the chi-square distribution with dof degrees of freedom (bisection on the
+// regularised incomplete gamma function; accurate to ~1e-10).
 double chi2_quantile(double p, int dof);
 
 struct BearingMeasurement {
