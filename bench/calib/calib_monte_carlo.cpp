@@ -5,7 +5,13 @@
 //
 //   calib_monte_carlo [--runs 50] [--sigma-deg 0.3] [--init anchored|inverse|naive]
 //                     [--inflation 5] [--iterations 3] [--trajectory paper|zigzag]
-//                     [--refine] [--seed 1]
+//                     [--bootstrap RAD] [--refine] [--seed 1]
+// --init anchored (default): anchored inverse depth + camera-pose extrinsics, with the batch
+//   window up to the first turn (--bootstrap, rad of rotation; 0: no window);
+// --init inverse: the paper's state eq. (28) with undelayed inverse-distance features;
+// --init naive: NOTES Sec. 5's naive initialisation.
+// Diagnostics (environment): PRIOR_AT_TRUTH=s (prior centred on truth, sigma s), PRIOR_SIGMA=s,
+// DMIN/DMAX (feature distance prior), CONVERT (convert_ratio), NO_SECOND_ORDER, VERBOSE.
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
@@ -76,6 +82,7 @@ void print(const char* name, const Stats& s, const Eigen::Vector3d& crlb) {
 int main(int argc, char** argv) {
   int runs = 50, iterations = 3;
   bool refine = false;
+  double bootstrap = Options{}.bootstrap_rotation;
   double sigma_deg = 0.3, inflation = 5.0;
   std::string init = "anchored", trajectory = "paper";
   std::uint64_t seed = 1;
@@ -94,6 +101,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--iterations")) iterations = std::atoi(next());
     else if (!std::strcmp(argv[i], "--trajectory")) trajectory = next();
     else if (!std::strcmp(argv[i], "--refine")) refine = true;
+    else if (!std::strcmp(argv[i], "--bootstrap")) bootstrap = std::atof(next());
     else if (!std::strcmp(argv[i], "--seed")) seed = std::strtoull(next(), nullptr, 10);
     else {
       std::fprintf(stderr, "unknown argument %s\n", argv[i]);
@@ -123,7 +131,7 @@ int main(int argc, char** argv) {
   if (const char* c = std::getenv("DMAX")) fo.max_feature_distance = std::atof(c);
   if (const char* c = std::getenv("CONVERT")) fo.convert_ratio = std::atof(c);
   if (std::getenv("NO_SECOND_ORDER")) fo.second_order_noise = false;
-  if (const char* c = std::getenv("BOOT")) fo.bootstrap_rotation = std::atof(c);
+  fo.bootstrap_rotation = bootstrap;
   Stats filt, ref;
   Eigen::Vector3d crlb_sq = Eigen::Vector3d::Zero();
   double crlb_yaw_sq = 0, crlb_pos_sq = 0;
@@ -156,8 +164,10 @@ int main(int argc, char** argv) {
     progress.update(r + 1);
   }
   progress.finish();
-  std::printf("trajectory %s, bearing noise %.2f deg, init %s, K inflation %.1f, iterations %d\n",
-              trajectory.c_str(), sigma_deg, init.c_str(), inflation, iterations);
+  std::printf("trajectory %s, bearing noise %.2f deg, init %s, bootstrap %.2f rad, K inflation "
+              "%.1f, iterations %d, runs %d from seed %llu\n",
+              trajectory.c_str(), sigma_deg, init.c_str(), bootstrap, inflation, iterations, runs,
+              static_cast<unsigned long long>(seed));
   const Eigen::Vector3d crlb = (crlb_sq / runs).cwiseSqrt();
   std::printf("CRLB (RMS over runs): phi %.3f deg  rho %.2f mm  psi %.3f deg  yaw %.4f deg  "
               "position %.2f mm\n",

@@ -95,3 +95,64 @@ TEST(Observability, BoundShrinksWithBearingNoiseAndRicherMotion) {
 
 }  // namespace
 }  // namespace omnivert::calib
+
+#include <fstream>
+#include <sstream>
+
+#include "omnivert/calib/calibrate.hpp"
+
+namespace omnivert::calib {
+namespace {
+
+std::string slurp(const std::string& p) {
+  std::ifstream f(p);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+TEST(Calibrate, PaperRunEndToEndWritesExtrinsics) {
+  SyntheticRunOptions so;
+  so.seed = 21;
+  const SyntheticRun run = make_synthetic_run(so);
+  const CalibrationResult r = calibrate(run.run, options_for(so), {.refine = true});
+  EXPECT_TRUE(r.observable()) << r.observability.message;
+  ASSERT_TRUE(r.refinement.covariance_ok);
+  for (int i = 0; i < 3; ++i) {
+    const double err = i == 1 ? r.extrinsics.rho - run.truth.rho
+                              : angle_diff(r.extrinsics.vec()(i), run.truth.vec()(i));
+    EXPECT_LT(std::abs(err), 4.0 * std::sqrt(r.covariance(i, i))) << i;
+  }
+  const std::string path = testing::TempDir() + "/extrinsics.yaml";
+  write_extrinsics_yaml(path, r);
+  const std::string y = slurp(path);
+  for (const char* key : {"phi:", "rho:", "psi:", "sigma_phi:", "sigma_rho:", "sigma_psi:",
+                          "covariance:", "x:", "y:", "yaw:", "T_base_cam:", "observable: true",
+                          "crlb_phi:", "crlb_rho:", "crlb_psi:"})
+    EXPECT_NE(y.find(key), std::string::npos) << key;
+  EXPECT_EQ(y.find("nan"), std::string::npos);
+  const std::string csv = testing::TempDir() + "/states.csv";
+  write_states_csv(csv, r.filter.history);
+  EXPECT_NE(slurp(csv).find("frame,phi,rho,psi"), std::string::npos);
+}
+
+TEST(Calibrate, StraightRunIsReportedNotObservable) {
+  SyntheticRunOptions so;
+  so.trajectory = Trajectory::kStraight;
+  const SyntheticRun run = make_synthetic_run(so);
+  const CalibrationResult r = calibrate(run.run, options_for(so));
+  EXPECT_FALSE(r.observable());
+  const std::string path = testing::TempDir() + "/extrinsics_straight.yaml";
+  write_extrinsics_yaml(path, r);
+  const std::string y = slurp(path);
+  EXPECT_NE(y.find("observable: false"), std::string::npos);
+  // At the dead-reckoned trajectory (noisy headings) the bound is finite but useless.
+  EXPECT_GT(r.observability.rho.crlb, 0.05);
+  EXPECT_GT(r.observability.phi.crlb, deg2rad(10.0));
+  EXPECT_NE(y.find("turn in place"), std::string::npos);
+  // The filter stays at its prior for what it cannot see (sigma_rho ~ prior 0.1 m).
+  EXPECT_GT(std::sqrt(r.covariance(1, 1)), 0.09);
+}
+
+}  // namespace
+}  // namespace omnivert::calib
