@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "omnivert/calib/model.hpp"
+#include "omnivert/calib/updater.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
 
@@ -59,7 +60,28 @@ struct Built {
   std::array<double, 3> ex{};
   std::unique_ptr<ceres::Problem> problem;
   int num_bearings = 0;
+  std::vector<ceres::ResidualBlockId> bearing_blocks;
 };
+
+// Removes the bearings whose whitened residual exceeds `threshold` (the filter's chi-square
+// gate, in sigmas) at the current solution. Returns how many.
+int reject_outliers(Built* b, double threshold) {
+  int n = 0;
+  std::vector<ceres::ResidualBlockId> kept;
+  for (ceres::ResidualBlockId id : b->bearing_blocks) {
+    double r = 0.0, cost = 0.0;
+    b->problem->EvaluateResidualBlock(id, /*apply_loss_function=*/false, &cost, &r, nullptr);
+    if (!(std::abs(r) <= threshold)) {
+      b->problem->RemoveResidualBlock(id);
+      ++n;
+    } else {
+      kept.push_back(id);
+    }
+  }
+  b->bearing_blocks = std::move(kept);
+  b->num_bearings -= n;
+  return n;
+}
 
 Built build(const CalibrationRun& run, const Options& options, const BatchPoint& at,
             const BatchOptions& batch, bool robust) {
@@ -105,7 +127,8 @@ Built build(const CalibrationRun& run, const Options& options, const BatchPoint&
       auto* cost = new ceres::AutoDiffCostFunction<BearingResidual, 1, 3, 2, 3>(
           new BearingResidual{o.beta, 1.0 / options.bearing_sigma});
       ceres::LossFunction* loss = robust ? new ceres::HuberLoss(batch.huber_sigmas) : nullptr;
-      b.problem->AddResidualBlock(cost, loss, b.poses[k].data(), it->second.data(), b.ex.data());
+      b.bearing_blocks.push_back(b.problem->AddResidualBlock(cost, loss, b.poses[k].data(),
+                                                             it->second.data(), b.ex.data()));
       ++b.num_bearings;
     }
   }
@@ -163,6 +186,15 @@ RefinementResult refine_batch(const CalibrationRun& run, const Options& options,
   so.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
   ceres::Solve(so, b.problem.get(), &summary);
+  // Outlying bearings (false matches) out, at the filter's gate, then solve again.
+  const double gate = std::sqrt(chi2_quantile(options.gate_probability, 1));
+  for (int round = 0; round < 3; ++round) {
+    const int n = reject_outliers(&b, gate);
+    res.num_rejected += n;
+    if (n == 0) break;
+    ceres::Solve(so, b.problem.get(), &summary);
+  }
+  res.num_bearings = b.num_bearings;
   res.converged = summary.termination_type == ceres::CONVERGENCE;
   res.initial_cost = summary.initial_cost;
   res.final_cost = summary.final_cost;
@@ -385,6 +417,11 @@ bool bootstrap_filter_state(const CalibrationRun& window, const Options& options
   so.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
   ceres::Solve(so, b.problem.get(), &summary);
+  const double gate = std::sqrt(chi2_quantile(options.gate_probability, 1));
+  for (int round = 0; round < 3; ++round) {
+    if (reject_outliers(&b, gate) == 0) break;
+    ceres::Solve(so, b.problem.get(), &summary);
+  }
   if (!summary.IsSolutionUsable()) return fail("window solve failed: " + summary.BriefReport());
 
   // Covariance of all window variables: inverse of J^T J (priors included).

@@ -115,15 +115,25 @@ TEST(CalibrationFilter, OutlierBearingIsGated) {
   SyntheticRunOptions so;
   so.seed = 7;
   SyntheticRun run = make_synthetic_run(so);
-  run.run.frames[80].observations[2].beta += deg2rad(25.0);  // a false match
+  // False matches: one in the bootstrap window (frame 30), two after it (filter's gate).
+  run.run.frames[30].observations[4].beta += deg2rad(25.0);
+  run.run.frames[100].observations[2].beta += deg2rad(25.0);
+  run.run.frames[105].observations[6].beta -= deg2rad(10.0);
   const Options o = options_for(so);
   CalibrationFilter f(o);
   for (const FrameInput& fr : run.run.frames) f.process(fr);
   f.finish();
-  EXPECT_GE(f.history()[80].num_rejected, 1);
+  EXPECT_GE(f.history()[100].num_rejected, 1);
+  EXPECT_GE(f.history()[105].num_rejected, 1);
   const Eigen::Vector3d e = error(f.extrinsics(), run.truth);
-  EXPECT_LT(std::abs(rad2deg(e(0))), 2.0);
-  EXPECT_LT(std::abs(e(1)), 0.006);
+  const Eigen::Matrix3d C = f.covariance();
+  for (int i = 0; i < 3; ++i) EXPECT_LT(std::abs(e(i)), 3.5 * std::sqrt(C(i, i))) << i;
+  // The refinement drops the three as well.
+  const FilterResult fr{f.extrinsics(), f.covariance(), f.history(), f.tracks()};
+  const RefinementResult rr = refine_batch(run.run, o, batch_point_from_filter(run.run, o, fr));
+  EXPECT_GE(rr.num_rejected, 3);
+  const Eigen::Vector3d er = error(rr.extrinsics, run.truth);
+  for (int i = 0; i < 3; ++i) EXPECT_LT(std::abs(er(i)), 3.5 * std::sqrt(rr.covariance(i, i))) << i;
 }
 
 TEST(CalibrationFilter, TracksEnterAndLeave) {

@@ -54,12 +54,15 @@ struct RefinementResult {
   double initial_cost = 0.0;
   double final_cost = 0.0;
   int iterations = 0;
-  int num_bearings = 0;
+  int num_bearings = 0;   // bearings used
+  int num_rejected = 0;   // bearings removed as outliers (|residual| > the filter's gate)
   std::string report;  // Ceres' brief report
 };
 
 // Batch maximum-likelihood refinement over the whole run (Ceres, Levenberg-Marquardt),
 // started from `start`, with the covariance of (phi, rho, psi) from ceres::Covariance.
+// Bearings whose residual exceeds the filter's chi-square gate (options.gate_probability)
+// at the solution are removed and the problem solved again (up to three rounds).
 RefinementResult refine_batch(const CalibrationRun& run, const Options& options,
                               const BatchPoint& start, const BatchOptions& batch = {});
 
@@ -73,6 +76,7 @@ RefinementResult refine_batch(const CalibrationRun& run, const Options& options,
 // differences. This removes the early-update inconsistency measured in NOTES Sec. 5 and in
 // docs/calib.md: one linearisation per frame while depth and camera yaw are both unknown.
 // Tracks with fewer than 2 bearings in the window are left out (they enter afterwards).
+// Outlying bearings are removed as in refine_batch.
 // Returns false (state untouched, reason in *why) when the window cannot be solved.
 bool bootstrap_filter_state(const CalibrationRun& window, const Options& options,
                             FilterState* state, std::string* why = nullptr);

@@ -94,7 +94,7 @@ struct Options {
   // not. The window ends at the first frame whose dead-reckoned heading differs from the
   // window's first by bootstrap_rotation, or after bootstrap_max_frames frames (or at
   // finish()). bootstrap_rotation <= 0: no window (the undelayed anchored initialisation).
-  double bootstrap_rotation = 1.0;  // [rad] (measured: 0.1 / 0.3 / 1.0, docs/calib.md)
+  double bootstrap_rotation = 1.5;  // [rad] (measured: 0.1 ... 2.0, docs/calib.md)
   int bootstrap_min_frames = 5;
   int bootstrap_max_frames = 300;
   double bootstrap_depth_prior_scale = 100.0;  // window's inverse-depth prior sigma, x sigma_q
