@@ -38,8 +38,8 @@ struct Stats {
   std::vector<Eigen::Vector3d> err;
   int failures = 0;
   void add(const Extrinsics& est, const Eigen::Matrix3d& cov, const Extrinsics& truth) {
-    Eigen::Vector3d e(angle_diff(est.phi, truth.phi), est.rho - truth.rho,
-                      angle_diff(est.psi, truth.psi));
+    Eigen::Vector3d e(
+        angle_diff(est.phi, truth.phi), est.rho - truth.rho, angle_diff(est.psi, truth.psi));
     if (!e.allFinite() || !cov.allFinite()) {
       ++failures;
       return;
@@ -69,11 +69,20 @@ void print(const char* name, const Stats& s, const Eigen::Vector3d& crlb) {
   const double lo = chi2_quantile(0.025, 3 * n) / n, hi = chi2_quantile(0.975, 3 * n) / n;
   std::printf("%-22s runs %3d (failed %d)\n", name, n, s.failures);
   std::printf("  median |position error| %.2f mm   median |yaw error| %.3f deg\n",
-              median(s.pos_mm), median(s.yaw_deg));
-  std::printf("  RMS phi %.3f deg (%.2f x CRLB)  rho %.2f mm (%.2f x CRLB)  psi %.3f deg (%.2f x CRLB)\n",
-              rad2deg(rms(0)), rms(0) / crlb(0), 1e3 * rms(1), rms(1) / crlb(1), rad2deg(rms(2)),
-              rms(2) / crlb(2));
-  std::printf("  mean NEES %.2f   95%% interval [%.2f, %.2f]  -> %s\n", mean_nees, lo, hi,
+              median(s.pos_mm),
+              median(s.yaw_deg));
+  std::printf(
+      "  RMS phi %.3f deg (%.2f x CRLB)  rho %.2f mm (%.2f x CRLB)  psi %.3f deg (%.2f x CRLB)\n",
+      rad2deg(rms(0)),
+      rms(0) / crlb(0),
+      1e3 * rms(1),
+      rms(1) / crlb(1),
+      rad2deg(rms(2)),
+      rms(2) / crlb(2));
+  std::printf("  mean NEES %.2f   95%% interval [%.2f, %.2f]  -> %s\n",
+              mean_nees,
+              lo,
+              hi,
               (mean_nees >= lo && mean_nees <= hi) ? "consistent" : "INCONSISTENT");
 }
 
@@ -94,15 +103,24 @@ int main(int argc, char** argv) {
       }
       return argv[++i];
     };
-    if (!std::strcmp(argv[i], "--runs")) runs = std::atoi(next());
-    else if (!std::strcmp(argv[i], "--sigma-deg")) sigma_deg = std::atof(next());
-    else if (!std::strcmp(argv[i], "--init")) init = next();
-    else if (!std::strcmp(argv[i], "--inflation")) inflation = std::atof(next());
-    else if (!std::strcmp(argv[i], "--iterations")) iterations = std::atoi(next());
-    else if (!std::strcmp(argv[i], "--trajectory")) trajectory = next();
-    else if (!std::strcmp(argv[i], "--refine")) refine = true;
-    else if (!std::strcmp(argv[i], "--bootstrap")) bootstrap = std::atof(next());
-    else if (!std::strcmp(argv[i], "--seed")) seed = std::strtoull(next(), nullptr, 10);
+    if (!std::strcmp(argv[i], "--runs"))
+      runs = std::atoi(next());
+    else if (!std::strcmp(argv[i], "--sigma-deg"))
+      sigma_deg = std::atof(next());
+    else if (!std::strcmp(argv[i], "--init"))
+      init = next();
+    else if (!std::strcmp(argv[i], "--inflation"))
+      inflation = std::atof(next());
+    else if (!std::strcmp(argv[i], "--iterations"))
+      iterations = std::atoi(next());
+    else if (!std::strcmp(argv[i], "--trajectory"))
+      trajectory = next();
+    else if (!std::strcmp(argv[i], "--refine"))
+      refine = true;
+    else if (!std::strcmp(argv[i], "--bootstrap"))
+      bootstrap = std::atof(next());
+    else if (!std::strcmp(argv[i], "--seed"))
+      seed = std::strtoull(next(), nullptr, 10);
     else {
       std::fprintf(stderr, "unknown argument %s\n", argv[i]);
       return 2;
@@ -142,8 +160,12 @@ int main(int argc, char** argv) {
     const FilterResult fr = run_filter(run.run, fo);
     filt.add(fr.extrinsics, fr.covariance, run.truth);
     if (std::getenv("VERBOSE") && !filt.nees.empty())
-      std::printf("run %d: nees %.1f  phi %.4f rho %.4f psi %.4f\n", r, filt.nees.back(),
-                  fr.extrinsics.phi, fr.extrinsics.rho, fr.extrinsics.psi);
+      std::printf("run %d: nees %.1f  phi %.4f rho %.4f psi %.4f\n",
+                  r,
+                  filt.nees.back(),
+                  fr.extrinsics.phi,
+                  fr.extrinsics.rho,
+                  fr.extrinsics.psi);
     // Cramer-Rao bound of this run: Fisher information at the truth.
     BatchPoint truth;
     truth.poses = run.true_poses;
@@ -164,15 +186,26 @@ int main(int argc, char** argv) {
     progress.update(r + 1);
   }
   progress.finish();
-  std::printf("trajectory %s, bearing noise %.2f deg, init %s, bootstrap %.2f rad, K inflation "
-              "%.1f, iterations %d, runs %d from seed %llu\n",
-              trajectory.c_str(), sigma_deg, init.c_str(), bootstrap, inflation, iterations, runs,
-              static_cast<unsigned long long>(seed));
+  std::printf(
+      "trajectory %s, bearing noise %.2f deg, init %s, bootstrap %.2f rad, K inflation "
+      "%.1f, iterations %d, runs %d from seed %llu\n",
+      trajectory.c_str(),
+      sigma_deg,
+      init.c_str(),
+      bootstrap,
+      inflation,
+      iterations,
+      runs,
+      static_cast<unsigned long long>(seed));
   const Eigen::Vector3d crlb = (crlb_sq / runs).cwiseSqrt();
-  std::printf("CRLB (RMS over runs): phi %.3f deg  rho %.2f mm  psi %.3f deg  yaw %.4f deg  "
-              "position %.2f mm\n",
-              rad2deg(crlb(0)), 1e3 * crlb(1), rad2deg(crlb(2)), rad2deg(std::sqrt(crlb_yaw_sq / runs)),
-              1e3 * std::sqrt(crlb_pos_sq / runs));
+  std::printf(
+      "CRLB (RMS over runs): phi %.3f deg  rho %.2f mm  psi %.3f deg  yaw %.4f deg  "
+      "position %.2f mm\n",
+      rad2deg(crlb(0)),
+      1e3 * crlb(1),
+      rad2deg(crlb(2)),
+      rad2deg(std::sqrt(crlb_yaw_sq / runs)),
+      1e3 * std::sqrt(crlb_pos_sq / runs));
   print("filter", filt, crlb);
   if (refine) print("filter + refinement", ref, crlb);
   return 0;

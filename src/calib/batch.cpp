@@ -83,8 +83,11 @@ int reject_outliers(Built* b, double threshold) {
   return n;
 }
 
-Built build(const CalibrationRun& run, const Options& options, const BatchPoint& at,
-            const BatchOptions& batch, bool robust) {
+Built build(const CalibrationRun& run,
+            const Options& options,
+            const BatchPoint& at,
+            const BatchOptions& batch,
+            bool robust) {
   if (at.poses.size() != run.frames.size())
     throw InputError("batch: the starting point has " + std::to_string(at.poses.size()) +
                      " poses for " + std::to_string(run.frames.size()) + " frames");
@@ -115,9 +118,13 @@ Built build(const CalibrationRun& run, const Options& options, const BatchPoint&
     const FrameInput& f = run.frames[k];
     const Mat2 Q =
         chong_kleeman_covariance(f.d_right, f.d_left, K, options.odometry_variance_floor);
-    auto* cost = new ceres::AutoDiffCostFunction<OdometryResidual, 3, 3, 3>(new OdometryResidual{
-        f.d_right, f.d_left, options.wheel_base, 1.0 / std::sqrt(Q(0, 0)),
-        1.0 / std::sqrt(Q(1, 1)), 1.0 / batch.lateral_sigma});
+    auto* cost = new ceres::AutoDiffCostFunction<OdometryResidual, 3, 3, 3>(
+        new OdometryResidual{f.d_right,
+                             f.d_left,
+                             options.wheel_base,
+                             1.0 / std::sqrt(Q(0, 0)),
+                             1.0 / std::sqrt(Q(1, 1)),
+                             1.0 / batch.lateral_sigma});
     b.problem->AddResidualBlock(cost, nullptr, b.poses[k - 1].data(), b.poses[k].data());
   }
   for (std::size_t k = 0; k < run.frames.size(); ++k) {
@@ -127,8 +134,8 @@ Built build(const CalibrationRun& run, const Options& options, const BatchPoint&
       auto* cost = new ceres::AutoDiffCostFunction<BearingResidual, 1, 3, 2, 3>(
           new BearingResidual{o.beta, 1.0 / options.bearing_sigma});
       ceres::LossFunction* loss = robust ? new ceres::HuberLoss(batch.huber_sigmas) : nullptr;
-      b.bearing_blocks.push_back(b.problem->AddResidualBlock(cost, loss, b.poses[k].data(),
-                                                             it->second.data(), b.ex.data()));
+      b.bearing_blocks.push_back(b.problem->AddResidualBlock(
+          cost, loss, b.poses[k].data(), it->second.data(), b.ex.data()));
       ++b.num_bearings;
     }
   }
@@ -156,7 +163,8 @@ std::vector<Eigen::Vector3d> dead_reckoning(const CalibrationRun& run, double wh
   return poses;
 }
 
-BatchPoint batch_point_from_filter(const CalibrationRun& run, const Options& options,
+BatchPoint batch_point_from_filter(const CalibrationRun& run,
+                                   const Options& options,
                                    const FilterResult& filter) {
   BatchPoint b;
   b.poses = dead_reckoning(run, options.wheel_base);
@@ -168,8 +176,10 @@ BatchPoint batch_point_from_filter(const CalibrationRun& run, const Options& opt
   return b;
 }
 
-RefinementResult refine_batch(const CalibrationRun& run, const Options& options,
-                              const BatchPoint& start, const BatchOptions& batch) {
+RefinementResult refine_batch(const CalibrationRun& run,
+                              const Options& options,
+                              const BatchPoint& start,
+                              const BatchOptions& batch) {
   std::string why;
   if (!options.IsValid(&why)) throw InputError("calibration options: " + why);
   Built b = build(run, options, start, batch, batch.robust);
@@ -221,8 +231,10 @@ RefinementResult refine_batch(const CalibrationRun& run, const Options& options,
   return res;
 }
 
-ObservabilityReport analyse_observability(const CalibrationRun& run, const Options& options,
-                                          const BatchPoint& at, const BatchOptions& batch,
+ObservabilityReport analyse_observability(const CalibrationRun& run,
+                                          const Options& options,
+                                          const BatchPoint& at,
+                                          const BatchOptions& batch,
                                           const ObservabilityOptions& obs) {
   std::string why;
   if (!options.IsValid(&why)) throw InputError("calibration options: " + why);
@@ -367,8 +379,10 @@ struct InverseDepthPrior {
 
 }  // namespace
 
-bool bootstrap_filter_state(const CalibrationRun& window, const Options& options,
-                            FilterState* state, std::string* why) {
+bool bootstrap_filter_state(const CalibrationRun& window,
+                            const Options& options,
+                            FilterState* state,
+                            std::string* why) {
   auto fail = [why](const std::string& m) {
     if (why) *why = m;
     return false;
@@ -391,7 +405,8 @@ bool bootstrap_filter_state(const CalibrationRun& window, const Options& options
       if (count[o.track_id] == 1) {
         const Eigen::Vector3d& p = start.poses[k];
         const Extrinsics& ex = options.prior;
-        const Vec2 C = p.head<2>() + ex.rho * Vec2(std::cos(p(2) + ex.phi), std::sin(p(2) + ex.phi));
+        const Vec2 C =
+            p.head<2>() + ex.rho * Vec2(std::cos(p(2) + ex.phi), std::sin(p(2) + ex.phi));
         const double dir = p(2) + ex.phi + ex.psi + o.beta;
         start.features[o.track_id] = C + Vec2(std::cos(dir), std::sin(dir)) / q0;
       }
@@ -401,14 +416,18 @@ bool bootstrap_filter_state(const CalibrationRun& window, const Options& options
   Built b = build(window, opt, start, BatchOptions{}, /*robust=*/false);
   if (b.features.empty()) return fail("no track with two bearings in the window");
   b.problem->AddResidualBlock(
-      new ceres::AutoDiffCostFunction<ExtrinsicsPrior, 3, 3>(new ExtrinsicsPrior{
-          options.prior.vec(), options.prior_sigma.cwiseInverse()}),
-      nullptr, b.ex.data());
+      new ceres::AutoDiffCostFunction<ExtrinsicsPrior, 3, 3>(
+          new ExtrinsicsPrior{options.prior.vec(), options.prior_sigma.cwiseInverse()}),
+      nullptr,
+      b.ex.data());
   for (auto& [id, f] : b.features)
     b.problem->AddResidualBlock(
         new ceres::AutoDiffCostFunction<InverseDepthPrior, 1, 3, 2, 3>(
             new InverseDepthPrior{q0, 1.0 / (options.bootstrap_depth_prior_scale * sigma_q)}),
-        nullptr, b.poses[first_frame[id]].data(), f.data(), b.ex.data());
+        nullptr,
+        b.poses[first_frame[id]].data(),
+        f.data(),
+        b.ex.data());
 
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_QR;
@@ -476,8 +495,10 @@ bool bootstrap_filter_state(const CalibrationRun& window, const Options& options
     return s;
   };
   Eigen::VectorXd v0(nv);
-  for (int k = 1; k < W; ++k) v0.segment<3>(3 * (k - 1)) = Eigen::Map<Eigen::Vector3d>(b.poses[k].data());
-  for (auto& [id, f] : b.features) v0.segment<2>(feature_col[id]) = Eigen::Map<Eigen::Vector2d>(f.data());
+  for (int k = 1; k < W; ++k)
+    v0.segment<3>(3 * (k - 1)) = Eigen::Map<Eigen::Vector3d>(b.poses[k].data());
+  for (auto& [id, f] : b.features)
+    v0.segment<2>(feature_col[id]) = Eigen::Map<Eigen::Vector2d>(f.data());
   v0.segment<3>(ex_col) = Eigen::Map<Eigen::Vector3d>(b.ex.data());
   const Eigen::VectorXd s0 = state_of(v0);
   Eigen::MatrixXd T = Eigen::MatrixXd::Zero(ns, nv);  // central differences (smooth maps)

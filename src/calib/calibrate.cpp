@@ -12,7 +12,8 @@
 
 namespace omnivert::calib {
 
-CalibrationResult calibrate(const CalibrationRun& run, const Options& options,
+CalibrationResult calibrate(const CalibrationRun& run,
+                            const Options& options,
                             const CalibrateOptions& co) {
   CalibrationResult r;
   r.filter = run_filter(run, options);
@@ -102,8 +103,8 @@ void write_states_csv(const std::string& path, const std::vector<FrameEstimate>&
     s << h.frame << "," << num(h.extrinsics.phi) << "," << num(h.extrinsics.rho) << ","
       << num(h.extrinsics.psi);
     for (int i = 0; i < 3; ++i) s << "," << num(std::sqrt(std::max(h.covariance(i, i), 0.0)));
-    s << "," << h.num_features << "," << h.num_updates << "," << h.num_rejected << ","
-      << h.num_new << "\n";
+    s << "," << h.num_features << "," << h.num_updates << "," << h.num_rejected << "," << h.num_new
+      << "\n";
   }
   commit_file(path, s.str());
 }

@@ -21,7 +21,8 @@ Options checked(const Options& options) {
 
 CalibrationFilter::CalibrationFilter(const Options& options)
     : options_(checked(options)),
-      state_(options.prior, options.prior_sigma,
+      state_(options.prior,
+             options.prior_sigma,
              options.feature_init == FeatureInit::kAnchoredInverseDepth
                  ? ExtrinsicsParam::kCameraPose
                  : ExtrinsicsParam::kPaper),

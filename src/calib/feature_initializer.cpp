@@ -1,13 +1,11 @@
 #include "omnivert/calib/feature_initializer.hpp"
 
-
 #include "omnivert/calib/model.hpp"
 #include "omnivert/core/angles.hpp"
 
 namespace omnivert::calib {
 
-int FeatureInitializer::initialize(int track_id, double beta, int frame,
-                                   FilterState* state) const {
+int FeatureInitializer::initialize(int track_id, double beta, int frame, FilterState* state) const {
   const Extrinsics ex = state->extrinsics();
   const int n = state->dim();
   const int e = state->extrinsics_index();
@@ -22,9 +20,9 @@ int FeatureInitializer::initialize(int track_id, double beta, int frame,
   const double q0 = 0.5 * (q_lo + q_hi);
   const double sigma_q = 0.25 * (q_hi - q_lo);  // the range is +-2 sigma
   Eigen::VectorXd y;
-  Eigen::MatrixXd G_ex;      // d y / d (extrinsics block)
-  Eigen::MatrixXd G_n;       // d y / d (prior variable, beta)
-  Eigen::Vector2d var_n;     // variances of (prior variable, beta)
+  Eigen::MatrixXd G_ex;   // d y / d (extrinsics block)
+  Eigen::MatrixXd G_n;    // d y / d (prior variable, beta)
+  Eigen::Vector2d var_n;  // variances of (prior variable, beta)
   switch (options_.feature_init) {
     case FeatureInit::kNaive: {
       // NOTES Sec. 5 "naive": far-feature approximation of eq. (27),
@@ -63,8 +61,8 @@ int FeatureInitializer::initialize(int track_id, double beta, int frame,
   }
   const Eigen::MatrixXd& P = state->P();
   const Eigen::MatrixXd P_yx = G_ex * P.middleRows(e, 3);
-  const Eigen::MatrixXd P_yy = G_ex * P.block(e, e, 3, 3) * G_ex.transpose() +
-                               G_n * var_n.asDiagonal() * G_n.transpose();
+  const Eigen::MatrixXd P_yy =
+      G_ex * P.block(e, e, 3, 3) * G_ex.transpose() + G_n * var_n.asDiagonal() * G_n.transpose();
   (void)n;
   state->add_feature(slot, y, P_yx, P_yy);
   return state->num_features() - 1;

@@ -11,7 +11,8 @@ namespace omnivert::calib {
 
 int feature_param_size(FeatureParam p) { return p == FeatureParam::kAnchored ? 4 : 2; }
 
-FilterState::FilterState(const Extrinsics& prior, const Eigen::Vector3d& prior_sigma,
+FilterState::FilterState(const Extrinsics& prior,
+                         const Eigen::Vector3d& prior_sigma,
                          ExtrinsicsParam param)
     : ext_param_(param) {
   const Eigen::Matrix3d P0 = prior_sigma.array().square().matrix().asDiagonal();
@@ -87,8 +88,10 @@ void FilterState::reindex() {
   }
 }
 
-void FilterState::add_feature(FeatureSlot slot, const Eigen::VectorXd& xf,
-                              const Eigen::MatrixXd& P_fx, const Eigen::MatrixXd& P_ff) {
+void FilterState::add_feature(FeatureSlot slot,
+                              const Eigen::VectorXd& xf,
+                              const Eigen::MatrixXd& P_fx,
+                              const Eigen::MatrixXd& P_ff) {
   const int n = dim();
   const int k = static_cast<int>(xf.size());
   assert(P_fx.rows() == k && P_fx.cols() == n);
@@ -131,7 +134,9 @@ void FilterState::remove_feature(int slot) {
   reindex();
 }
 
-void FilterState::reparametrise(int slot, FeatureParam param, const Eigen::VectorXd& y,
+void FilterState::reparametrise(int slot,
+                                FeatureParam param,
+                                const Eigen::VectorXd& y,
                                 const Eigen::MatrixXd& J) {
   const int n = dim();
   const int a = slots_[slot].index, k = slots_[slot].size;
@@ -150,13 +155,15 @@ void FilterState::reparametrise(int slot, FeatureParam param, const Eigen::Vecto
   reindex();
 }
 
-void FilterState::reset(const Eigen::VectorXd& x, const Eigen::MatrixXd& P,
+void FilterState::reset(const Eigen::VectorXd& x,
+                        const Eigen::MatrixXd& P,
                         std::vector<FeatureSlot> slots) {
   x_ = x;
   P_ = 0.5 * (P + P.transpose());
   slots_ = std::move(slots);
   reindex();
-  assert(x_.size() == P_.rows() && (slots_.empty() || slots_.back().index + slots_.back().size == dim() - 3));
+  assert(x_.size() == P_.rows() &&
+         (slots_.empty() || slots_.back().index + slots_.back().size == dim() - 3));
 }
 
 void FilterState::normalise() {

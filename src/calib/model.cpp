@@ -12,7 +12,9 @@ Vec2 wheel_step(double d_right, double d_left, double wheel_base, Mat2* J_step_w
   return {0.5 * (d_right + d_left), (d_right - d_left) / wheel_base};
 }
 
-Eigen::Vector3d integrate_pose(const Eigen::Vector3d& pose, double d_right, double d_left,
+Eigen::Vector3d integrate_pose(const Eigen::Vector3d& pose,
+                               double d_right,
+                               double d_left,
                                double wheel_base) {
   // Eq. (14): the heading at mid-step.
   const Vec2 s = wheel_step(d_right, d_left, wheel_base);
@@ -20,8 +22,8 @@ Eigen::Vector3d integrate_pose(const Eigen::Vector3d& pose, double d_right, doub
   return {pose(0) + s(0) * std::cos(mid), pose(1) + s(0) * std::sin(mid), pose(2) + s(1)};
 }
 
-Vec2 propagate_feature(const Vec2& x, double d_right, double d_left, double wheel_base,
-                       Mat2* J_out_x, Mat2* J_out_u) {
+Vec2 propagate_feature(
+    const Vec2& x, double d_right, double d_left, double wheel_base, Mat2* J_out_x, Mat2* J_out_u) {
   const double D = x(0), th = x(1);
   Mat2 J_step_wheels;
   const Vec2 s = wheel_step(d_right, d_left, wheel_base, &J_step_wheels);
@@ -42,8 +44,8 @@ Vec2 propagate_feature(const Vec2& x, double d_right, double d_left, double whee
   return out;
 }
 
-Vec2 propagate_feature_inverse(const Vec2& x, double d_right, double d_left, double wheel_base,
-                               Mat2* J_out_x, Mat2* J_out_u) {
+Vec2 propagate_feature_inverse(
+    const Vec2& x, double d_right, double d_left, double wheel_base, Mat2* J_out_x, Mat2* J_out_u) {
   // Eq. (29) with q = 1/D: D' = D + d_rho cos(theta) gives q' = q / (1 + q d_rho cos(theta)),
   // and theta' = theta + d_theta - d_rho q sin(theta). Defined at q = 0 (feature at infinity).
   const double q = x(0), th = x(1);
@@ -98,7 +100,8 @@ double predict_bearing_inverse(double q, double theta, const Extrinsics& ex, Row
   return beta;
 }
 
-double bearing_from_geometry(const Eigen::Vector3d& robot_pose, const Vec2& feature,
+double bearing_from_geometry(const Eigen::Vector3d& robot_pose,
+                             const Vec2& feature,
                              const Extrinsics& ex) {
   const double a = robot_pose(2) + ex.phi;
   const double xc = robot_pose(0) + ex.rho * std::cos(a);
@@ -115,8 +118,8 @@ Mat2 chong_kleeman_covariance(double d_right, double d_left, double K, double fl
   return Q;
 }
 
-Vec2 feature_from_ray(double q_c, double beta, const Extrinsics& ex, Mat2* J_out_in,
-                      Mat23* J_out_ex) {
+Vec2 feature_from_ray(
+    double q_c, double beta, const Extrinsics& ex, Mat2* J_out_in, Mat23* J_out_ex) {
   // Camera centre c = rho (cos phi, sin phi); ray direction u at gamma = beta + phi + psi in
   // the robot frame; the feature p = c + u / q_c; then D = |p| and, since the feature sits at
   // (-D cos theta, D sin theta) in the robot frame, theta = atan2(p_y, -p_x).
@@ -176,8 +179,8 @@ Mat2 rot(double a) {
 const Mat2 kS = (Mat2() << 0, -1, 1, 0).finished();
 }  // namespace
 
-Vec2 propagate_point(const Vec2& p, double d_right, double d_left, double wheel_base,
-                     Mat2* J_out_p, Mat2* J_out_u) {
+Vec2 propagate_point(
+    const Vec2& p, double d_right, double d_left, double wheel_base, Mat2* J_out_p, Mat2* J_out_u) {
   Mat2 J_step_wheels;
   const Vec2 s = wheel_step(d_right, d_left, wheel_base, &J_step_wheels);
   const double dr = s(0), dt = s(1);
@@ -195,8 +198,12 @@ Vec2 propagate_point(const Vec2& p, double d_right, double d_left, double wheel_
   return out;
 }
 
-Vec4 propagate_anchored(const Vec4& f, double d_right, double d_left, double wheel_base,
-                        Mat4* J_out_f, Mat42* J_out_u) {
+Vec4 propagate_anchored(const Vec4& f,
+                        double d_right,
+                        double d_left,
+                        double wheel_base,
+                        Mat4* J_out_f,
+                        Mat42* J_out_u) {
   Mat2 Ja, Jua;
   Vec4 out;
   out.head<2>() = propagate_point(f.head<2>(), d_right, d_left, wheel_base, &Ja, &Jua);
@@ -215,7 +222,9 @@ Vec4 propagate_anchored(const Vec4& f, double d_right, double d_left, double whe
   return out;
 }
 
-double predict_bearing_point(const Vec2& p, const Vec3& cam, Eigen::Matrix<double, 1, 2>* J_beta_p,
+double predict_bearing_point(const Vec2& p,
+                             const Vec3& cam,
+                             Eigen::Matrix<double, 1, 2>* J_beta_p,
                              Row3* J_beta_cam) {
   const Vec2 v = p - cam.head<2>();
   const double n2 = v.squaredNorm();
@@ -226,8 +235,7 @@ double predict_bearing_point(const Vec2& p, const Vec3& cam, Eigen::Matrix<doubl
   return beta;
 }
 
-double predict_bearing_anchored(const Vec4& f, const Vec3& cam, Row4* J_beta_f,
-                                Row3* J_beta_cam) {
+double predict_bearing_anchored(const Vec4& f, const Vec3& cam, Row4* J_beta_f, Row3* J_beta_cam) {
   const Vec2 ac = f.head<2>() - cam.head<2>();
   const Vec2 u(std::cos(f(2)), std::sin(f(2)));
   const Vec2 v = f(3) * ac + u;
@@ -268,8 +276,8 @@ Extrinsics extrinsics_from_camera_pose(const Vec3& cam, Mat3* J_ex_cam) {
   const double r2 = cam.head<2>().squaredNorm(), r = std::sqrt(r2);
   const double phi = std::atan2(cam(1), cam(0));
   if (J_ex_cam) {
-    *J_ex_cam << -cam(1) / r2, cam(0) / r2, 0, cam(0) / r, cam(1) / r, 0, cam(1) / r2,
-        -cam(0) / r2, 1;
+    *J_ex_cam << -cam(1) / r2, cam(0) / r2, 0, cam(0) / r, cam(1) / r, 0, cam(1) / r2, -cam(0) / r2,
+        1;
   }
   return {phi, r, wrap_angle(cam(2) - phi)};
 }

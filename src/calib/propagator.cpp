@@ -47,7 +47,8 @@ void Propagator::propagate(double d_right, double d_left, FilterState* state) co
     }
   }
   // Eq. (31) with the inflated K.
-  const Mat2 Q = chong_kleeman_covariance(d_right, d_left,
+  const Mat2 Q = chong_kleeman_covariance(d_right,
+                                          d_left,
                                           options_.odometry_K * options_.odometry_inflation,
                                           options_.odometry_variance_floor);
   Eigen::MatrixXd& P = state->mutable_P();

@@ -47,8 +47,7 @@ SyntheticRun make_synthetic_run(const SyntheticRunOptions& o) {
     case Trajectory::kZigzag:
       for (int leg = 0; leg < o.zigzag_legs; ++leg) {
         add_straight(o.straight_length / o.zigzag_legs, o.step, &steps);
-        add_turn(leg % 2 == 0 ? o.zigzag_turn : -o.zigzag_turn, o.turn_step, o.wheel_base,
-                 &steps);
+        add_turn(leg % 2 == 0 ? o.zigzag_turn : -o.zigzag_turn, o.turn_step, o.wheel_base, &steps);
       }
       break;
     case Trajectory::kStraight:
@@ -60,18 +59,21 @@ SyntheticRun make_synthetic_run(const SyntheticRunOptions& o) {
   out.truth = o.truth;
   out.true_poses.push_back(Eigen::Vector3d::Zero());
   for (const Step& s : steps)
-    out.true_poses.push_back(integrate_pose(out.true_poses.back(), s.d_right, s.d_left,
+    out.true_poses.push_back(integrate_pose(out.true_poses.back(),
+                                            s.d_right,
+                                            s.d_left,
                                             o.wheel_base));  // Eq. (14)
 
   // Features: a random point of the path, a random direction, a distance in
   // [min_distance, max_distance]; kept if no robot position comes closer than min_distance.
   for (int attempts = 0; static_cast<int>(out.features.size()) < o.num_features; ++attempts) {
     if (attempts > 100000) throw InputError("synthetic run: cannot place the features");
-    const auto k = static_cast<std::size_t>(uniform(rng) * out.true_poses.size()) %
-                   out.true_poses.size();
+    const auto k =
+        static_cast<std::size_t>(uniform(rng) * out.true_poses.size()) % out.true_poses.size();
     const double a = kTwoPi * uniform(rng);
     const double d = o.min_distance + (o.max_distance - o.min_distance) * uniform(rng);
-    const Eigen::Vector2d f = out.true_poses[k].head<2>() + d * Eigen::Vector2d(std::cos(a), std::sin(a));
+    const Eigen::Vector2d f =
+        out.true_poses[k].head<2>() + d * Eigen::Vector2d(std::cos(a), std::sin(a));
     bool ok = true;
     for (const auto& p : out.true_poses) ok = ok && (p.head<2>() - f).norm() >= o.min_distance;
     if (ok) out.features.push_back(f);

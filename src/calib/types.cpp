@@ -7,9 +7,7 @@
 
 namespace omnivert::calib {
 
-Eigen::Vector2d Extrinsics::position() const {
-  return {rho * std::cos(phi), rho * std::sin(phi)};
-}
+Eigen::Vector2d Extrinsics::position() const { return {rho * std::cos(phi), rho * std::sin(phi)}; }
 
 double Extrinsics::yaw() const { return wrap_angle(phi + psi); }
 

@@ -10,7 +10,9 @@
 
 namespace omnivert::calib {
 
-bool joseph_update(const Eigen::MatrixXd& H, const Eigen::MatrixXd& R, Eigen::MatrixXd* P,
+bool joseph_update(const Eigen::MatrixXd& H,
+                   const Eigen::MatrixXd& R,
+                   Eigen::MatrixXd* P,
                    Eigen::MatrixXd* K_out) {
   const Eigen::MatrixXd PHt = (*P) * H.transpose();
   const Eigen::MatrixXd S = H * PHt + R;
@@ -25,7 +27,6 @@ bool joseph_update(const Eigen::MatrixXd& H, const Eigen::MatrixXd& R, Eigen::Ma
   if (K_out) *K_out = K;
   return true;
 }
-
 
 namespace {
 // Regularised lower incomplete gamma P(a, x): series for x < a + 1, continued fraction
@@ -75,13 +76,14 @@ double chi2_quantile(double p, int dof) {
 Updater::Updater(const Options& options)
     : options_(options), gate_(chi2_quantile(options.gate_probability, 1)) {}
 
-Eigen::VectorXd Updater::predict(const FilterState& state, const Eigen::VectorXd& x,
+Eigen::VectorXd Updater::predict(const FilterState& state,
+                                 const Eigen::VectorXd& x,
                                  const std::vector<BearingMeasurement>& z,
                                  Eigen::MatrixXd* H) const {
   const int e = state.extrinsics_index();
   const bool paper = state.extrinsics_param() == ExtrinsicsParam::kPaper;
   const Extrinsics ex = Extrinsics::from_vec(x.segment<3>(e));  // (phi, rho, psi) if paper
-  const Vec3 cam = x.segment<3>(e);                              // (c_x, c_y, eta) otherwise
+  const Vec3 cam = x.segment<3>(e);                             // (c_x, c_y, eta) otherwise
   const int m = static_cast<int>(z.size());
   Eigen::VectorXd h(m);
   H->setZero(m, state.dim());

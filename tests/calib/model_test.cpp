@@ -18,7 +18,8 @@ constexpr double kTol = 1e-6;  // absolute, on Jacobian entries of order 1
 
 // Central differences of f: R^n -> R^m, step h, wrapping angle outputs when asked.
 Eigen::MatrixXd numeric_jacobian(const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& f,
-                                 const Eigen::VectorXd& x, bool wrap_output = false) {
+                                 const Eigen::VectorXd& x,
+                                 bool wrap_output = false) {
   const double h = 1e-6;
   const Eigen::VectorXd f0 = f(x);
   Eigen::MatrixXd J(f0.size(), x.size());
@@ -118,10 +119,12 @@ TEST_F(RandomStates, ObservationAgreesWithGeometry) {
   for (int trial = 0; trial < 200; ++trial) {
     const Extrinsics ex{U(-kPi, kPi), U(0.0, 0.5), U(-kPi, kPi)};
     const Eigen::Vector3d pose(U(-5, 5), U(-5, 5), U(-kPi, kPi));
-    const Eigen::Vector2d f = pose.head<2>() + U(1.0, 8.0) * Eigen::Vector2d(std::cos(U(0, 7)), std::sin(U(0, 7)));
+    const Eigen::Vector2d f =
+        pose.head<2>() + U(1.0, 8.0) * Eigen::Vector2d(std::cos(U(0, 7)), std::sin(U(0, 7)));
     const Vec2 Dt = feature_from_world(pose, f);
     EXPECT_NEAR(angle_diff(predict_bearing(Dt(0), Dt(1), ex), bearing_from_geometry(pose, f, ex)),
-                0.0, 1e-12);
+                0.0,
+                1e-12);
     EXPECT_LT((feature_to_world(pose, Dt(0), Dt(1)) - f).norm(), 1e-12);
   }
   // A hand case: robot at origin facing +x, camera at the origin (rho = 0), feature at (0, 2):
@@ -165,8 +168,12 @@ TEST_F(RandomStates, InvariantParametrisationJacobians) {
     const Vec3 cam(U(-0.4, 0.4), U(-0.4, 0.4), U(-kPi, kPi));
     Mat2 Jp, Jpu;
     const Vec2 p1 = propagate_point(p, dR, dL, kE, &Jp, &Jpu);
-    auto fp = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd { return propagate_point(v, dR, dL, kE); };
-    auto fpu = [&](const Eigen::VectorXd& u) -> Eigen::VectorXd { return propagate_point(p, u(0), u(1), kE); };
+    auto fp = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd {
+      return propagate_point(v, dR, dL, kE);
+    };
+    auto fpu = [&](const Eigen::VectorXd& u) -> Eigen::VectorXd {
+      return propagate_point(p, u(0), u(1), kE);
+    };
     EXPECT_LT((Jp - numeric_jacobian(fp, p)).cwiseAbs().maxCoeff(), kTol);
     EXPECT_LT((Jpu - numeric_jacobian(fpu, Eigen::Vector2d(dR, dL))).cwiseAbs().maxCoeff(), kTol);
     // The same motion as eq. (14) in the world: robot at pose, feature at world point.
@@ -181,14 +188,17 @@ TEST_F(RandomStates, InvariantParametrisationJacobians) {
     const Vec2 Dt1 = point_to_distance_form(p1);
     const Vec2 Dt29 = propagate_feature(Dt, dR, dL, kE);
     const Vec2 st = wheel_step(dR, dL, kE);
-    EXPECT_NEAR(Dt1(0), Dt29(0),
-                std::abs(st(0) * st(1)) / 2 + st(0) * st(0) / Dt(0) + 1e-12);
+    EXPECT_NEAR(Dt1(0), Dt29(0), std::abs(st(0) * st(1)) / 2 + st(0) * st(0) / Dt(0) + 1e-12);
 
     Mat4 Jf;
     Mat42 Jfu;
     propagate_anchored(f, dR, dL, kE, &Jf, &Jfu);
-    auto ff = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd { return propagate_anchored(v, dR, dL, kE); };
-    auto ffu = [&](const Eigen::VectorXd& u) -> Eigen::VectorXd { return propagate_anchored(f, u(0), u(1), kE); };
+    auto ff = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd {
+      return propagate_anchored(v, dR, dL, kE);
+    };
+    auto ffu = [&](const Eigen::VectorXd& u) -> Eigen::VectorXd {
+      return propagate_anchored(f, u(0), u(1), kE);
+    };
     EXPECT_LT((Jf - numeric_jacobian(ff, f)).cwiseAbs().maxCoeff(), kTol);
     EXPECT_LT((Jfu - numeric_jacobian(ffu, Eigen::Vector2d(dR, dL))).cwiseAbs().maxCoeff(), kTol);
 
@@ -224,11 +234,14 @@ TEST_F(RandomStates, InvariantParametrisationJacobians) {
 
     Mat2 Jdp;
     const Vec2 dt = point_to_distance_form(p, &Jdp);
-    auto fdp = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd { return point_to_distance_form(v); };
+    auto fdp = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd {
+      return point_to_distance_form(v);
+    };
     EXPECT_LT((Jdp - numeric_jacobian(fdp, p, false)).cwiseAbs().maxCoeff(), kTol);
     // (D, theta) and the point agree on the bearing (eq. 27 vs atan2 form).
     const Extrinsics ex = extrinsics_from_camera_pose(cam);
-    EXPECT_NEAR(angle_diff(predict_bearing(dt(0), dt(1), ex), predict_bearing_point(p, cam)), 0, 1e-12);
+    EXPECT_NEAR(
+        angle_diff(predict_bearing(dt(0), dt(1), ex), predict_bearing_point(p, cam)), 0, 1e-12);
 
     Mat3 Jce, Jec;
     const Vec3 c2 = camera_pose_from_extrinsics(ex, &Jce);

@@ -43,8 +43,7 @@ TEST(Observability, StraightRunDeterminesOnlyTheYaw) {
   EXPECT_NE(r.message.find("rho"), std::string::npos);
   // The refinement's covariance says the same: rho is not determined (metres, or none).
   const RefinementResult rr = refine_batch(run.run, options_for(so), truth_point(run));
-  EXPECT_TRUE(!rr.covariance_ok || std::sqrt(rr.covariance(1, 1)) > 0.1)
-      << rr.covariance;
+  EXPECT_TRUE(!rr.covariance_ok || std::sqrt(rr.covariance(1, 1)) > 0.1) << rr.covariance;
 }
 
 TEST(Observability, PaperSetupMatchesNotesCramerRaoBound) {
@@ -126,9 +125,21 @@ TEST(Calibrate, PaperRunEndToEndWritesExtrinsics) {
   const std::string path = testing::TempDir() + "/extrinsics.yaml";
   write_extrinsics_yaml(path, r);
   const std::string y = slurp(path);
-  for (const char* key : {"phi:", "rho:", "psi:", "sigma_phi:", "sigma_rho:", "sigma_psi:",
-                          "covariance:", "x:", "y:", "yaw:", "T_base_cam:", "observable: true",
-                          "crlb_phi:", "crlb_rho:", "crlb_psi:"})
+  for (const char* key : {"phi:",
+                          "rho:",
+                          "psi:",
+                          "sigma_phi:",
+                          "sigma_rho:",
+                          "sigma_psi:",
+                          "covariance:",
+                          "x:",
+                          "y:",
+                          "yaw:",
+                          "T_base_cam:",
+                          "observable: true",
+                          "crlb_phi:",
+                          "crlb_rho:",
+                          "crlb_psi:"})
     EXPECT_NE(y.find(key), std::string::npos) << key;
   EXPECT_EQ(y.find("nan"), std::string::npos);
   const std::string csv = testing::TempDir() + "/states.csv";

@@ -22,7 +22,7 @@ namespace omnivert::calib {
 
 // A point of the batch problem.
 struct BatchPoint {
-  std::vector<Eigen::Vector3d> poses;   // one per frame, poses[0] = (0, 0, 0)
+  std::vector<Eigen::Vector3d> poses;       // one per frame, poses[0] = (0, 0, 0)
   std::map<int, Eigen::Vector2d> features;  // track id -> world point
   Extrinsics extrinsics;
 };
@@ -42,7 +42,8 @@ std::vector<Eigen::Vector3d> dead_reckoning(const CalibrationRun& run, double wh
 
 // A starting point from a filter run: dead-reckoned poses, each track's last filter estimate
 // (D, theta) placed in the world from its frame's pose, the filter's extrinsics.
-BatchPoint batch_point_from_filter(const CalibrationRun& run, const Options& options,
+BatchPoint batch_point_from_filter(const CalibrationRun& run,
+                                   const Options& options,
                                    const FilterResult& filter);
 
 struct RefinementResult {
@@ -54,17 +55,19 @@ struct RefinementResult {
   double initial_cost = 0.0;
   double final_cost = 0.0;
   int iterations = 0;
-  int num_bearings = 0;   // bearings used
-  int num_rejected = 0;   // bearings removed as outliers (|residual| > the filter's gate)
-  std::string report;  // Ceres' brief report
+  int num_bearings = 0;  // bearings used
+  int num_rejected = 0;  // bearings removed as outliers (|residual| > the filter's gate)
+  std::string report;    // Ceres' brief report
 };
 
 // Batch maximum-likelihood refinement over the whole run (Ceres, Levenberg-Marquardt),
 // started from `start`, with the covariance of (phi, rho, psi) from ceres::Covariance.
 // Bearings whose residual exceeds the filter's chi-square gate (options.gate_probability)
 // at the solution are removed and the problem solved again (up to three rounds).
-RefinementResult refine_batch(const CalibrationRun& run, const Options& options,
-                              const BatchPoint& start, const BatchOptions& batch = {});
+RefinementResult refine_batch(const CalibrationRun& run,
+                              const Options& options,
+                              const BatchPoint& start,
+                              const BatchOptions& batch = {});
 
 // Delayed initialisation of the filter (FeatureInit::kAnchoredInverseDepth with
 // options.bootstrap_frames > 0): the first frames are solved as a small batch maximum a
@@ -78,8 +81,10 @@ RefinementResult refine_batch(const CalibrationRun& run, const Options& options,
 // Tracks with fewer than 2 bearings in the window are left out (they enter afterwards).
 // Outlying bearings are removed as in refine_batch.
 // Returns false (state untouched, reason in *why) when the window cannot be solved.
-bool bootstrap_filter_state(const CalibrationRun& window, const Options& options,
-                            FilterState* state, std::string* why = nullptr);
+bool bootstrap_filter_state(const CalibrationRun& window,
+                            const Options& options,
+                            FilterState* state,
+                            std::string* why = nullptr);
 
 // Verdict on one parameter (or combination) of the extrinsics.
 struct ParameterVerdict {
@@ -88,9 +93,9 @@ struct ParameterVerdict {
 };
 
 struct ObservabilityOptions {
-  double max_sigma_angle = 0.035;  // [rad] (2 degrees) an angle with a larger bound is
-                                   // reported as not determined
-  double max_sigma_rho = 0.02;     // [m]
+  double max_sigma_angle = 0.035;            // [rad] (2 degrees) an angle with a larger bound is
+                                             // reported as not determined
+  double max_sigma_rho = 0.02;               // [m]
   double relative_eigenvalue_floor = 1e-12;  // eigenvalues below floor * max count as zero
 };
 
@@ -98,20 +103,22 @@ struct ObservabilityOptions {
 // problem at `at`, marginalised onto (phi, rho, psi) (Schur complement).
 struct ObservabilityReport {
   ParameterVerdict phi, rho, psi;
-  ParameterVerdict yaw;         // phi + psi
-  ParameterVerdict x, y;        // camera position rho (cos phi, sin phi)
+  ParameterVerdict yaw;                                   // phi + psi
+  ParameterVerdict x, y;                                  // camera position rho (cos phi, sin phi)
   Eigen::Matrix3d information = Eigen::Matrix3d::Zero();  // marginal Fisher information
   Eigen::Vector3d eigenvalues = Eigen::Vector3d::Zero();  // of the information scaled by
                                                           // the thresholds (dimensionless)
-  int rank = 0;                 // numerical rank of the marginal information
-  double condition = 0.0;       // its condition number (scaled), infinity when singular
+  int rank = 0;            // numerical rank of the marginal information
+  double condition = 0.0;  // its condition number (scaled), infinity when singular
   Eigen::Matrix3d crlb_covariance = Eigen::Matrix3d::Zero();  // inverse information
   bool all_determined() const { return phi.determined && rho.determined && psi.determined; }
-  std::string message;          // what is (not) determined and the motion that would fix it
+  std::string message;  // what is (not) determined and the motion that would fix it
 };
 
-ObservabilityReport analyse_observability(const CalibrationRun& run, const Options& options,
-                                          const BatchPoint& at, const BatchOptions& batch = {},
+ObservabilityReport analyse_observability(const CalibrationRun& run,
+                                          const Options& options,
+                                          const BatchPoint& at,
+                                          const BatchOptions& batch = {},
                                           const ObservabilityOptions& obs = {});
 
 }  // namespace omnivert::calib

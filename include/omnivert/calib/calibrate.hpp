@@ -27,7 +27,7 @@ struct CalibrateOptions {
 struct CalibrationResult {
   FilterResult filter;
   bool refined = false;
-  RefinementResult refinement;   // valid when refined
+  RefinementResult refinement;  // valid when refined
   ObservabilityReport observability;
   // The answer: the refinement's when refined and its covariance exists, else the filter's.
   Extrinsics extrinsics;
@@ -36,7 +36,8 @@ struct CalibrationResult {
 };
 
 // Throws InputError on invalid options or input (non-finite values, repeated track ids).
-CalibrationResult calibrate(const CalibrationRun& run, const Options& options,
+CalibrationResult calibrate(const CalibrationRun& run,
+                            const Options& options,
                             const CalibrateOptions& calibrate_options = {});
 
 // DIR/extrinsics.yaml of issue 5: phi, rho, psi, sigma_phi, sigma_rho, sigma_psi, covariance

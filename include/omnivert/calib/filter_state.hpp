@@ -37,7 +37,8 @@ class FilterState {
  public:
   // The prior is given in (phi, rho, psi); with kCameraPose it is carried to (c_x, c_y, eta)
   // through the Jacobian of the map at the prior mean.
-  FilterState(const Extrinsics& prior, const Eigen::Vector3d& prior_sigma,
+  FilterState(const Extrinsics& prior,
+              const Eigen::Vector3d& prior_sigma,
               ExtrinsicsParam param = ExtrinsicsParam::kPaper);
 
   int dim() const { return static_cast<int>(x_.size()); }
@@ -61,13 +62,17 @@ class FilterState {
 
   // Stochastic augmentation: appends a feature block with value xf, covariance P_ff and
   // cross-covariance P_fx (size x dim(), against the current state).
-  void add_feature(FeatureSlot slot, const Eigen::VectorXd& xf, const Eigen::MatrixXd& P_fx,
+  void add_feature(FeatureSlot slot,
+                   const Eigen::VectorXd& xf,
+                   const Eigen::MatrixXd& P_fx,
                    const Eigen::MatrixXd& P_ff);
   // Marginalisation: removes the feature's rows and columns.
   void remove_feature(int slot);
   // Changes a block's parametrisation: x_block <- y (new size m), P <- T P T^T with T the
   // identity except J (m x size) on the block.
-  void reparametrise(int slot, FeatureParam param, const Eigen::VectorXd& y,
+  void reparametrise(int slot,
+                     FeatureParam param,
+                     const Eigen::VectorXd& y,
                      const Eigen::MatrixXd& J);
   // Keeps angles in (-pi, pi] and P symmetric; keeps distances positive.
   void normalise();

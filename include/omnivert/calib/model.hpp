@@ -22,17 +22,27 @@ using Mat23 = Eigen::Matrix<double, 2, 3>;
 Vec2 wheel_step(double d_right, double d_left, double wheel_base, Mat2* J_step_wheels = nullptr);
 
 // Eq. (14): pose (x, y, theta) after one odometry step (midpoint heading).
-Eigen::Vector3d integrate_pose(const Eigen::Vector3d& pose, double d_right, double d_left,
+Eigen::Vector3d integrate_pose(const Eigen::Vector3d& pose,
+                               double d_right,
+                               double d_left,
                                double wheel_base);
 
 // Eq. (29), one feature block: (D, theta) -> (D', theta') for wheel travel (d_R, d_L).
 // J_out_x is A^i of eq. (32), J_out_u is B^i (columns d_R, d_L).
-Vec2 propagate_feature(const Vec2& x, double d_right, double d_left, double wheel_base,
-                       Mat2* J_out_x = nullptr, Mat2* J_out_u = nullptr);
+Vec2 propagate_feature(const Vec2& x,
+                       double d_right,
+                       double d_left,
+                       double wheel_base,
+                       Mat2* J_out_x = nullptr,
+                       Mat2* J_out_u = nullptr);
 
 // The same block in inverse distance (q = 1/D, theta): the chain rule around eq. (29).
-Vec2 propagate_feature_inverse(const Vec2& x, double d_right, double d_left, double wheel_base,
-                               Mat2* J_out_x = nullptr, Mat2* J_out_u = nullptr);
+Vec2 propagate_feature_inverse(const Vec2& x,
+                               double d_right,
+                               double d_left,
+                               double wheel_base,
+                               Mat2* J_out_x = nullptr,
+                               Mat2* J_out_u = nullptr);
 
 // Eq. (27)/(30): predicted bearing of a feature (D, theta) seen by a camera with extrinsics
 // ex, wrapped to (-pi, pi]. J_beta_x = [H1, H2, H3, H4, -1] of appendix A.4, i.e. the
@@ -40,12 +50,15 @@ Vec2 propagate_feature_inverse(const Vec2& x, double d_right, double d_left, dou
 double predict_bearing(double D, double theta, const Extrinsics& ex, Row5* J_beta_x = nullptr);
 
 // Eq. (27) with the feature in inverse distance (q, theta); J w.r.t. (q, theta, phi, rho, psi).
-double predict_bearing_inverse(double q, double theta, const Extrinsics& ex,
+double predict_bearing_inverse(double q,
+                               double theta,
+                               const Extrinsics& ex,
                                Row5* J_beta_x = nullptr);
 
 // The same bearing from plain geometry: the robot at pose (x_R, y_R, theta_R), a feature at
 // world point f: beta = atan2(y_f - y_C, x_f - x_C) - (theta_R + phi + psi) (NOTES Sec. 1).
-double bearing_from_geometry(const Eigen::Vector3d& robot_pose, const Vec2& feature,
+double bearing_from_geometry(const Eigen::Vector3d& robot_pose,
+                             const Vec2& feature,
                              const Extrinsics& ex);
 
 // Eq. (31): covariance of the wheel travels (d_R, d_L): diag(K |d_R|, K |d_L|) + floor.
@@ -54,7 +67,10 @@ Mat2 chong_kleeman_covariance(double d_right, double d_left, double K, double fl
 // Feature initialisation from one bearing: the camera ray beta with the inverse distance
 // q_c along it (from the camera centre). Returns (q = 1/D, theta) of the robot-centric
 // state. J_out_in w.r.t. (q_c, beta) and J_out_ex w.r.t. (phi, rho, psi).
-Vec2 feature_from_ray(double q_c, double beta, const Extrinsics& ex, Mat2* J_out_in = nullptr,
+Vec2 feature_from_ray(double q_c,
+                      double beta,
+                      const Extrinsics& ex,
+                      Mat2* J_out_in = nullptr,
                       Mat23* J_out_ex = nullptr);
 
 // World position of a feature (D, theta) seen from robot pose (x_R, y_R, theta_R), and the
@@ -85,22 +101,34 @@ using Row4 = Eigen::Matrix<double, 1, 4>;
 // Eq. (14) seen from the robot: a world point's robot-frame coordinates after one odometry
 // step, p' = R(-d_theta) (p - d_rho (cos(d_theta / 2), sin(d_theta / 2))).
 // J_out_u columns (d_R, d_L).
-Vec2 propagate_point(const Vec2& p, double d_right, double d_left, double wheel_base,
-                     Mat2* J_out_p = nullptr, Mat2* J_out_u = nullptr);
+Vec2 propagate_point(const Vec2& p,
+                     double d_right,
+                     double d_left,
+                     double wheel_base,
+                     Mat2* J_out_p = nullptr,
+                     Mat2* J_out_u = nullptr);
 
 // Anchored inverse-depth point (a_x, a_y, alpha, q): the anchor moves as a point, alpha
 // turns with the robot (alpha' = alpha - d_theta), q is unchanged.
-Vec4 propagate_anchored(const Vec4& f, double d_right, double d_left, double wheel_base,
-                        Mat4* J_out_f = nullptr, Mat42* J_out_u = nullptr);
+Vec4 propagate_anchored(const Vec4& f,
+                        double d_right,
+                        double d_left,
+                        double wheel_base,
+                        Mat4* J_out_f = nullptr,
+                        Mat42* J_out_u = nullptr);
 
 // Bearing of robot-frame point p from a camera at c with yaw eta: atan2(p - c) - eta
 // (eq. 16-17 in the robot frame). J_beta_p (1x2), J_beta_cam w.r.t. (c_x, c_y, eta).
-double predict_bearing_point(const Vec2& p, const Vec3& cam, Eigen::Matrix<double, 1, 2>* J_beta_p = nullptr,
+double predict_bearing_point(const Vec2& p,
+                             const Vec3& cam,
+                             Eigen::Matrix<double, 1, 2>* J_beta_p = nullptr,
                              Row3* J_beta_cam = nullptr);
 
 // Bearing of an anchored inverse-depth point: atan2(q (a - c) + (cos alpha, sin alpha)) - eta
 // (the direction of p - c scaled by q > 0, defined for q -> 0).
-double predict_bearing_anchored(const Vec4& f, const Vec3& cam, Row4* J_beta_f = nullptr,
+double predict_bearing_anchored(const Vec4& f,
+                                const Vec3& cam,
+                                Row4* J_beta_f = nullptr,
                                 Row3* J_beta_cam = nullptr);
 
 // Anchored inverse-depth point -> robot-frame point, p = a + (cos alpha, sin alpha) / q.

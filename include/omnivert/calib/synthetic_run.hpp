@@ -22,19 +22,19 @@ enum class Trajectory {
 
 struct SyntheticRunOptions {
   Trajectory trajectory = Trajectory::kPaper;
-  double straight_length = 2.3;                 // [m]
-  double step = 0.038;                          // travel per frame on straights [m]
-  double turn_angle = 3.14159265358979323846;   // kPaper [rad]
-  double turn_step = 0.06;                      // rotation per frame in turns [rad]
+  double straight_length = 2.3;                // [m]
+  double step = 0.038;                         // travel per frame on straights [m]
+  double turn_angle = 3.14159265358979323846;  // kPaper [rad]
+  double turn_step = 0.06;                     // rotation per frame in turns [rad]
   int zigzag_legs = 4;
-  double zigzag_turn = 1.5707963267948966;      // [rad]
+  double zigzag_turn = 1.5707963267948966;  // [rad]
   int num_features = 10;
-  double min_distance = 1.5;                    // features' distance from the path [m]
+  double min_distance = 1.5;  // features' distance from the path [m]
   double max_distance = 6.0;
-  double wheel_base = 0.5;                      // e [m]
-  double odometry_K = 1e-5;                     // true K of eq. (31) [m]
+  double wheel_base = 0.5;                                      // e [m]
+  double odometry_K = 1e-5;                                     // true K of eq. (31) [m]
   double bearing_sigma = 0.3 * 3.14159265358979323846 / 180.0;  // [rad]
-  Extrinsics truth{-0.34, 0.23, 0.33};          // the paper's estimate (Sec. 9.2)
+  Extrinsics truth{-0.34, 0.23, 0.33};                          // the paper's estimate (Sec. 9.2)
   // Each track is cut into pieces (new track ids) with this probability per frame; 0: every
   // feature is one track over the whole run (the camera sees all around).
   double break_probability = 0.0;
@@ -42,10 +42,10 @@ struct SyntheticRunOptions {
 };
 
 struct SyntheticRun {
-  CalibrationRun run;                         // what the filter sees
-  std::vector<Eigen::Vector3d> true_poses;    // per frame (x, y, theta), frame 0 at origin
-  std::vector<Eigen::Vector2d> features;      // world points
-  std::map<int, int> track_feature;           // track id -> index in features
+  CalibrationRun run;                       // what the filter sees
+  std::vector<Eigen::Vector3d> true_poses;  // per frame (x, y, theta), frame 0 at origin
+  std::vector<Eigen::Vector2d> features;    // world points
+  std::map<int, int> track_feature;         // track id -> index in features
   Extrinsics truth;
 };
 

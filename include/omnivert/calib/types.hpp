@@ -71,8 +71,8 @@ struct Options {
   // Robot.
   double wheel_base = 0.5;  // e of eq. (15) [m]
   // Chong-Kleeman odometry model, eq. (31): var(d) = K |d| (+ variance_floor), per wheel.
-  double odometry_K = 1e-5;             // [m]
-  double odometry_inflation = 5.0;      // the paper multiplies K by five for robustness
+  double odometry_K = 1e-5;                // [m]
+  double odometry_inflation = 5.0;         // the paper multiplies K by five for robustness
   double odometry_variance_floor = 1e-12;  // [m^2], keeps the noise positive at rest
   // Camera.
   double bearing_sigma = 0.3 * 3.14159265358979323846 / 180.0;  // [rad]
@@ -81,11 +81,11 @@ struct Options {
   Eigen::Vector3d prior_sigma{0.8, 0.1, 0.8};  // [rad, m, rad]
   // Feature initialisation.
   FeatureInit feature_init = FeatureInit::kAnchoredInverseDepth;
-  double naive_distance = 3.0;        // D0 [m] (kNaive)
-  double naive_distance_sigma = 2.0;  // [m] (kNaive)
-  double min_feature_distance = 1.0;  // [m] (kInverseDistance: 2-sigma range of the prior)
-  double max_feature_distance = 20.0; // [m]
-  double convert_ratio = 0.05;        // sigma_D / D below which (q, theta) -> (D, theta); 0: never
+  double naive_distance = 3.0;         // D0 [m] (kNaive)
+  double naive_distance_sigma = 2.0;   // [m] (kNaive)
+  double min_feature_distance = 1.0;   // [m] (kInverseDistance: 2-sigma range of the prior)
+  double max_feature_distance = 20.0;  // [m]
+  double convert_ratio = 0.05;         // sigma_D / D below which (q, theta) -> (D, theta); 0: never
   // Delayed initialisation (kAnchoredInverseDepth only): the frames up to the first turn are
   // solved as a batch and the filter starts from that solution (bootstrap_filter_state).
   // While the robot drives straight the camera position is unobservable (Sec. 8.1) and the
@@ -99,11 +99,11 @@ struct Options {
   int bootstrap_max_frames = 300;
   double bootstrap_depth_prior_scale = 100.0;  // window's inverse-depth prior sigma, x sigma_q
   // Updates.
-  bool second_order_noise = true;     // add 1/2 tr(Hxx P Hxx P) to each bearing's variance
-  int update_iterations = 3;          // 1: plain EKF; >1: iterated EKF (Gauss-Newton)
-  double gate_probability = 0.999;    // chi-square gate of each bearing (1 dof); 1: no gate
-  int max_missed_frames = 20;         // a track not seen for this many frames has ended
-  int min_track_length = 3;           // batch/observability: shorter tracks are ignored
+  bool second_order_noise = true;   // add 1/2 tr(Hxx P Hxx P) to each bearing's variance
+  int update_iterations = 3;        // 1: plain EKF; >1: iterated EKF (Gauss-Newton)
+  double gate_probability = 0.999;  // chi-square gate of each bearing (1 dof); 1: no gate
+  int max_missed_frames = 20;       // a track not seen for this many frames has ended
+  int min_track_length = 3;         // batch/observability: shorter tracks are ignored
 
   // True when usable; otherwise false with the reason in *why (may be null).
   bool IsValid(std::string* why) const;

@@ -14,7 +14,9 @@ namespace omnivert::calib {
 // any gain): with S = H P H^T + R factored by Cholesky, K = P H^T S^-1,
 //   P <- (I - K H) P (I - K H)^T + K R K^T.
 // Writes the gain to *K when asked. Returns false (P untouched) if S is not positive definite.
-bool joseph_update(const Eigen::MatrixXd& H, const Eigen::MatrixXd& R, Eigen::MatrixXd* P,
+bool joseph_update(const Eigen::MatrixXd& H,
+                   const Eigen::MatrixXd& R,
+                   Eigen::MatrixXd* P,
                    Eigen::MatrixXd* K = nullptr);
 
 // Quantile of the chi-square distribution with dof degrees of freedom (bisection on the
@@ -45,8 +47,10 @@ class Updater {
 
  private:
   // Predicted bearings and Jacobian (m x dim) at state x.
-  Eigen::VectorXd predict(const FilterState& state, const Eigen::VectorXd& x,
-                          const std::vector<BearingMeasurement>& z, Eigen::MatrixXd* H) const;
+  Eigen::VectorXd predict(const FilterState& state,
+                          const Eigen::VectorXd& x,
+                          const std::vector<BearingMeasurement>& z,
+                          Eigen::MatrixXd* H) const;
   // Variance added by the curvature of h (second-order filter), see the source.
   double second_order_variance(const FilterState& state, const BearingMeasurement& z) const;
   Options options_;
