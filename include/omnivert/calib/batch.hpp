@@ -1,0 +1,124 @@
+#pragma once
+// The batch (whole-run) formulation of the calibration problem, shared by the maximum
+// likelihood refinement (Ceres) and the observability / Cramer-Rao analysis:
+//   unknowns: robot poses (x, y, theta) of frames 1..N (frame 0 is the origin: the gauge),
+//             features as world points (x_f, y_f), extrinsics (phi, rho, psi);
+//   factors:  odometry between consecutive frames, eq. (14)-(15), with the Chong-Kleeman
+//             covariance of the wheel travels, eq. (31); a bearing per observation,
+//             beta = atan2(y_f - y_C, x_f - x_C) - (theta_R + phi + psi) (eq. 16-17).
+// The odometry factor has three residuals: the two wheel travels implied by the pose change
+// (eq. 14-15 inverted) against the encoders, and the lateral slip, which a differential drive
+// cannot do (sigma `lateral_sigma`).
+
+#include <limits>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "omnivert/calib/calibration_filter.hpp"
+#include "omnivert/calib/types.hpp"
+
+namespace omnivert::calib {
+
+// A point of the batch problem.
+struct BatchPoint {
+  std::vector<Eigen::Vector3d> poses;       // one per frame, poses[0] = (0, 0, 0)
+  std::map<int, Eigen::Vector2d> features;  // track id -> world point
+  Extrinsics extrinsics;
+};
+
+struct BatchOptions {
+  double odometry_inflation = 1.0;  // the batch uses K * this (the filter's inflation is a
+                                    // robustness device of the EKF, not of the ML problem)
+  double lateral_sigma = 1e-4;      // [m] per step
+  bool robust = false;              // Huber loss on bearings
+  double huber_sigmas = 3.0;        // Huber threshold in bearing sigmas
+  int max_iterations = 100;
+  // Only tracks with at least options.min_track_length bearings enter the batch.
+};
+
+// Dead-reckoned poses, eq. (14), from the encoder increments.
+std::vector<Eigen::Vector3d> dead_reckoning(const CalibrationRun& run, double wheel_base);
+
+// A starting point from a filter run: dead-reckoned poses, each track's last filter estimate
+// (D, theta) placed in the world from its frame's pose, the filter's extrinsics.
+BatchPoint batch_point_from_filter(const CalibrationRun& run,
+                                   const Options& options,
+                                   const FilterResult& filter);
+
+struct RefinementResult {
+  bool converged = false;
+  BatchPoint solution;
+  Extrinsics extrinsics;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  bool covariance_ok = false;  // false when the problem is rank deficient (not observable)
+  double initial_cost = 0.0;
+  double final_cost = 0.0;
+  int iterations = 0;
+  int num_bearings = 0;  // bearings used
+  int num_rejected = 0;  // bearings removed as outliers (|residual| > the filter's gate)
+  std::string report;    // Ceres' brief report
+};
+
+// Batch maximum-likelihood refinement over the whole run (Ceres, Levenberg-Marquardt),
+// started from `start`, with the covariance of (phi, rho, psi) from ceres::Covariance.
+// Bearings whose residual exceeds the filter's chi-square gate (options.gate_probability)
+// at the solution are removed and the problem solved again (up to three rounds).
+RefinementResult refine_batch(const CalibrationRun& run,
+                              const Options& options,
+                              const BatchPoint& start,
+                              const BatchOptions& batch = {});
+
+// Delayed initialisation of the filter (FeatureInit::kAnchoredInverseDepth with
+// options.bootstrap_frames > 0): the first frames are solved as a small batch maximum a
+// posteriori problem (the prior on phi, rho, psi, an inverse-depth prior N(q0, sigma_q^2)
+// along each track's first ray, odometry, bearings; Levenberg-Marquardt relinearises), and
+// the filter starts at the last of them from that solution and its covariance (inverse of
+// the Fisher information with the priors), carried to the filter's coordinates (camera pose;
+// each track as an anchored inverse-depth point anchored at the camera) through central
+// differences. This removes the early-update inconsistency measured in NOTES Sec. 5 and in
+// docs/calib.md: one linearisation per frame while depth and camera yaw are both unknown.
+// Tracks with fewer than 2 bearings in the window are left out (they enter afterwards).
+// Outlying bearings are removed as in refine_batch.
+// Returns false (state untouched, reason in *why) when the window cannot be solved.
+bool bootstrap_filter_state(const CalibrationRun& window,
+                            const Options& options,
+                            FilterState* state,
+                            std::string* why = nullptr);
+
+// Verdict on one parameter (or combination) of the extrinsics.
+struct ParameterVerdict {
+  bool determined = false;
+  double crlb = 0.0;  // Cramer-Rao standard deviation (infinity when not determined)
+};
+
+struct ObservabilityOptions {
+  double max_sigma_angle = 0.035;            // [rad] (2 degrees) an angle with a larger bound is
+                                             // reported as not determined
+  double max_sigma_rho = 0.02;               // [m]
+  double relative_eigenvalue_floor = 1e-12;  // eigenvalues below floor * max count as zero
+};
+
+// Sec. 8.1 for a recorded trajectory, from the Fisher information J^T Sigma^-1 J of the batch
+// problem at `at`, marginalised onto (phi, rho, psi) (Schur complement).
+struct ObservabilityReport {
+  ParameterVerdict phi, rho, psi;
+  ParameterVerdict yaw;                                   // phi + psi
+  ParameterVerdict x, y;                                  // camera position rho (cos phi, sin phi)
+  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();  // marginal Fisher information
+  Eigen::Vector3d eigenvalues = Eigen::Vector3d::Zero();  // of the information scaled by
+                                                          // the thresholds (dimensionless)
+  int rank = 0;            // numerical rank of the marginal information
+  double condition = 0.0;  // its condition number (scaled), infinity when singular
+  Eigen::Matrix3d crlb_covariance = Eigen::Matrix3d::Zero();  // inverse information
+  bool all_determined() const { return phi.determined && rho.determined && psi.determined; }
+  std::string message;  // what is (not) determined and the motion that would fix it
+};
+
+ObservabilityReport analyse_observability(const CalibrationRun& run,
+                                          const Options& options,
+                                          const BatchPoint& at,
+                                          const BatchOptions& batch = {},
+                                          const ObservabilityOptions& obs = {});
+
+}  // namespace omnivert::calib

@@ -1,0 +1,53 @@
+#pragma once
+// The whole calibration of a recorded run, what `omnivert calibrate` calls:
+//   filter (Sec. 8.2) -> observability and Cramer-Rao bounds (Sec. 8.1) -> optional batch
+//   maximum-likelihood refinement (Ceres) -> outputs.
+//
+//   omnivert::calib::CalibrationRun run;          // one FrameInput per image
+//   omnivert::calib::Options options;             // wheel base, K, bearing sigma, prior...
+//   auto result = omnivert::calib::calibrate(run, options, {.refine = true});
+//   if (!result.observability.all_determined() && !force) -> print message, exit code 3
+//   omnivert::calib::write_extrinsics_yaml(dir + "/extrinsics.yaml", result);
+//   omnivert::calib::write_states_csv(dir + "/states.csv", result.filter.history);
+
+#include <string>
+
+#include "omnivert/calib/batch.hpp"
+#include "omnivert/calib/calibration_filter.hpp"
+#include "omnivert/calib/types.hpp"
+
+namespace omnivert::calib {
+
+struct CalibrateOptions {
+  bool refine = false;
+  BatchOptions batch;
+  ObservabilityOptions observability;
+};
+
+struct CalibrationResult {
+  FilterResult filter;
+  bool refined = false;
+  RefinementResult refinement;  // valid when refined
+  ObservabilityReport observability;
+  // The answer: the refinement's when refined and its covariance exists, else the filter's.
+  Extrinsics extrinsics;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  bool observable() const { return observability.all_determined(); }
+};
+
+// Throws InputError on invalid options or input (non-finite values, repeated track ids).
+CalibrationResult calibrate(const CalibrationRun& run,
+                            const Options& options,
+                            const CalibrateOptions& calibrate_options = {});
+
+// DIR/extrinsics.yaml of issue 5: phi, rho, psi, sigma_phi, sigma_rho, sigma_psi, covariance
+// (3x3, row-major), x, y, yaw (= phi + psi), T_base_cam (4x4), observable, crlb_phi,
+// crlb_rho, crlb_psi (.inf when not determined), plus source (filter / refinement) and
+// message. Written to a temporary file and renamed, so a partial file never looks complete.
+// Throws InputError when the file cannot be written.
+void write_extrinsics_yaml(const std::string& path, const CalibrationResult& result);
+
+// DIR/states.csv: one row per frame, the filter's estimate and sigmas (Fig. 25's data).
+void write_states_csv(const std::string& path, const std::vector<FrameEstimate>& history);
+
+}  // namespace omnivert::calib

@@ -1,0 +1,92 @@
+#pragma once
+// The self-calibration EKF of paper Sec. 8.2 (Martinelli et al. 2006 extended to many
+// features): feed it one FrameInput per image; it propagates with the wheel travels
+// (eq. 29, 31), updates with the bearings of the tracks it knows (eq. 30), adds the tracks
+// that start (FeatureInitializer) and marginalises the tracks that ended (not seen for
+// options.max_missed_frames frames).
+//
+//   CalibrationFilter filter(options);
+//   for (const FrameInput& f : frames) filter.process(f);
+//   filter.finish();
+//   Extrinsics ex = filter.extrinsics();  Eigen::Matrix3d C = filter.covariance();
+
+#include <map>
+#include <vector>
+
+#include "omnivert/calib/feature_initializer.hpp"
+#include "omnivert/calib/filter_state.hpp"
+#include "omnivert/calib/propagator.hpp"
+#include "omnivert/calib/types.hpp"
+#include "omnivert/calib/updater.hpp"
+
+namespace omnivert::calib {
+
+// Per-frame record (for states.csv and the convergence plot, Fig. 25).
+struct FrameEstimate {
+  int frame = 0;
+  Extrinsics extrinsics;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  int num_features = 0;  // in the state after this frame
+  int num_updates = 0;   // bearings used
+  int num_rejected = 0;  // bearings refused by the chi-square gate
+  int num_new = 0;       // tracks that entered
+};
+
+// The last estimate of a track while it was in the state: (D, theta) relative to the robot
+// at frame `frame`.
+struct TrackEstimate {
+  int track_id = -1;
+  int frame = -1;
+  Eigen::Vector2d D_theta = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
+  int num_updates = 0;
+};
+
+class CalibrationFilter {
+ public:
+  // Throws omnivert::InputError when !options.IsValid().
+  explicit CalibrationFilter(const Options& options);
+
+  // One image frame. Throws InputError on non-finite wheel travel or bearings, or a track id
+  // repeated within the frame.
+  void process(const FrameInput& frame);
+  // End of the run: solves a pending bootstrap window (a run that never turned). Call once
+  // after the last frame before reading the estimate.
+  void finish();
+
+  Extrinsics extrinsics() const { return state_.extrinsics(); }
+  Eigen::Matrix3d covariance() const { return state_.extrinsics_covariance(); }
+  const FilterState& state() const { return state_; }
+  const std::vector<FrameEstimate>& history() const { return history_; }
+  const std::map<int, TrackEstimate>& tracks() const { return tracks_; }
+  int frames_processed() const { return frame_; }
+  const Options& options() const { return options_; }
+
+ private:
+  void step(const FrameInput& frame);
+  void end_bootstrap(FrameEstimate rec);
+  void record_tracks();
+  Options options_;
+  FilterState state_;
+  Propagator propagator_;
+  Updater updater_;
+  FeatureInitializer initializer_;
+  int frame_ = 0;
+  std::vector<FrameEstimate> history_;
+  std::map<int, TrackEstimate> tracks_;
+  bool bootstrapping_ = false;
+  CalibrationRun window_;
+  double window_heading_ = 0.0;
+  double window_max_turn_ = 0.0;
+};
+
+// Runs the filter over a whole run.
+struct FilterResult {
+  Extrinsics extrinsics;
+  Eigen::Matrix3d covariance;
+  std::vector<FrameEstimate> history;
+  std::map<int, TrackEstimate> tracks;
+};
+FilterResult run_filter(const CalibrationRun& run, const Options& options);
+
+}  // namespace omnivert::calib

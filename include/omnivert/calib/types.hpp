@@ -1,0 +1,112 @@
+#pragma once
+// Inputs and options of the camera-to-odometry self-calibration (paper Sec. 7-8).
+//
+// Conventions (NOTES Sec. 1): robot frame x forward, y left, z up; the camera centre is at
+// rho (cos phi, sin phi) in the robot frame and the camera x-axis is rotated by phi + psi
+// from the robot x-axis, so T_base_cam = [Rz(phi + psi) | (rho cos phi, rho sin phi, 0)].
+// A bearing beta is counter-clockwise from the camera x-axis, in radians.
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+namespace omnivert::calib {
+
+// The three extrinsic parameters of Fig. 19.
+struct Extrinsics {
+  double phi = 0.0;  // direction of the camera centre in the robot frame [rad]
+  double rho = 0.2;  // distance of the camera centre from the robot origin [m]
+  double psi = 0.0;  // camera yaw minus phi [rad]
+
+  Eigen::Vector3d vec() const { return {phi, rho, psi}; }
+  static Extrinsics from_vec(const Eigen::Vector3d& v) { return {v(0), v(1), v(2)}; }
+  // Camera centre in the robot frame, rho (cos phi, sin phi).
+  Eigen::Vector2d position() const;
+  // Camera yaw in the robot frame, phi + psi (wrapped).
+  double yaw() const;
+  // 4x4 homogeneous T_base_cam (z = 0).
+  Eigen::Matrix4d T_base_cam() const;
+};
+
+// One bearing of a tracked vertical line in one image.
+struct BearingObservation {
+  int track_id = -1;  // the tracker's id; the same line keeps its id along its track
+  double beta = 0.0;  // bearing in the camera frame [rad], any range (wrapped internally)
+};
+
+// What the CLI feeds per image frame: the wheel travel since the previous frame (zero for
+// the first frame) and the bearings seen in this frame.
+struct FrameInput {
+  double d_right = 0.0;  // right wheel travel since the previous frame [m]
+  double d_left = 0.0;   // left wheel travel since the previous frame [m]
+  std::vector<BearingObservation> observations;
+};
+
+// A whole recorded run (what the batch refinement and the observability analysis need).
+struct CalibrationRun {
+  std::vector<FrameInput> frames;
+};
+
+// How a new feature enters the filter state.
+enum class FeatureInit {
+  // The "naive" initialisation of NOTES Sec. 5: D from a fixed prior (D0 +- sigma_D0),
+  // theta from the far-feature approximation beta ~ pi - theta - phi - psi (eq. 25).
+  kNaive,
+  // Undelayed inverse-distance initialisation (Civera, Davison, Montiel 2008, adapted to the
+  // robot-centric state of eq. 28): the ray of the first bearing from the camera centre with
+  // a Gaussian prior on the inverse distance along it; the feature is kept as
+  // (q = 1/D, theta) while its distance is poorly known and converted to (D, theta) of
+  // eq. (28) once sigma_D / D falls below `convert_ratio`.
+  kInverseDistance,
+  // The invariant parametrisation (model.hpp): the feature enters as an anchored inverse-depth
+  // point (anchor = camera centre, azimuth of the ray, inverse depth q ~ the same prior as
+  // kInverseDistance) and becomes a robot-frame point once sigma_q / q < convert_ratio; the
+  // extrinsics are carried as the camera pose (c_x, c_y, phi + psi). Same measurements, same
+  // models (eq. 14-17, 31); the straight-motion unobservable direction is then a constant
+  // vector, which keeps the EKF from inventing information along it.
+  kAnchoredInverseDepth,
+};
+
+struct Options {
+  // Robot.
+  double wheel_base = 0.5;  // e of eq. (15) [m]
+  // Chong-Kleeman odometry model, eq. (31): var(d) = K |d| (+ variance_floor), per wheel.
+  double odometry_K = 1e-5;                // [m]
+  double odometry_inflation = 5.0;         // the paper multiplies K by five for robustness
+  double odometry_variance_floor = 1e-12;  // [m^2], keeps the noise positive at rest
+  // Camera.
+  double bearing_sigma = 0.3 * 3.14159265358979323846 / 180.0;  // [rad]
+  // Prior on (phi, rho, psi): the paper's hand measurement with wide sigmas.
+  Extrinsics prior{0.0, 0.2, 0.0};
+  Eigen::Vector3d prior_sigma{0.8, 0.1, 0.8};  // [rad, m, rad]
+  // Feature initialisation.
+  FeatureInit feature_init = FeatureInit::kAnchoredInverseDepth;
+  double naive_distance = 3.0;         // D0 [m] (kNaive)
+  double naive_distance_sigma = 2.0;   // [m] (kNaive)
+  double min_feature_distance = 1.0;   // [m] (kInverseDistance: 2-sigma range of the prior)
+  double max_feature_distance = 20.0;  // [m]
+  double convert_ratio = 0.05;         // sigma_D / D below which (q, theta) -> (D, theta); 0: never
+  // Delayed initialisation (kAnchoredInverseDepth only): the frames up to the first turn are
+  // solved as a batch and the filter starts from that solution (bootstrap_filter_state).
+  // While the robot drives straight the camera position is unobservable (Sec. 8.1) and the
+  // feature depths and camera yaw are entangled; an EKF linearised once per frame there
+  // becomes overconfident (measured: mean NEES in the hundreds), a relinearised batch does
+  // not. The window ends at the first frame whose dead-reckoned heading differs from the
+  // window's first by bootstrap_rotation, or after bootstrap_max_frames frames (or at
+  // finish()). bootstrap_rotation <= 0: no window (the undelayed anchored initialisation).
+  double bootstrap_rotation = 1.5;  // [rad] (measured: 0.1 ... 2.0, docs/calib.md)
+  int bootstrap_min_frames = 5;
+  int bootstrap_max_frames = 300;
+  double bootstrap_depth_prior_scale = 100.0;  // window's inverse-depth prior sigma, x sigma_q
+  // Updates.
+  bool second_order_noise = true;   // add 1/2 tr(Hxx P Hxx P) to each bearing's variance
+  int update_iterations = 3;        // 1: plain EKF; >1: iterated EKF (Gauss-Newton)
+  double gate_probability = 0.999;  // chi-square gate of each bearing (1 dof); 1: no gate
+  int max_missed_frames = 20;       // a track not seen for this many frames has ended
+  int min_track_length = 3;         // batch/observability: shorter tracks are ignored
+
+  // True when usable; otherwise false with the reason in *why (may be null).
+  bool IsValid(std::string* why) const;
+};
+
+}  // namespace omnivert::calib

@@ -1,0 +1,60 @@
+#pragma once
+// EKF update of the self-calibration filter with bearings, eq. (30), and the one function
+// through which every covariance update goes.
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "omnivert/calib/filter_state.hpp"
+#include "omnivert/calib/types.hpp"
+
+namespace omnivert::calib {
+
+// The shared covariance update (Joseph form, which keeps P symmetric positive definite for
+// any gain): with S = H P H^T + R factored by Cholesky, K = P H^T S^-1,
+//   P <- (I - K H) P (I - K H)^T + K R K^T.
+// Writes the gain to *K when asked. Returns false (P untouched) if S is not positive definite.
+bool joseph_update(const Eigen::MatrixXd& H,
+                   const Eigen::MatrixXd& R,
+                   Eigen::MatrixXd* P,
+                   Eigen::MatrixXd* K = nullptr);
+
+// Quantile of the chi-square distribution with dof degrees of freedom (bisection on the
+// regularised incomplete gamma function; accurate to ~1e-10).
+double chi2_quantile(double p, int dof);
+
+struct BearingMeasurement {
+  int slot = -1;      // feature slot in the state
+  double beta = 0.0;  // measured bearing [rad]
+};
+
+struct BearingUpdateResult {
+  bool accepted = false;
+  double chi2 = 0.0;  // normalised innovation squared at the prior estimate
+};
+
+class Updater {
+ public:
+  explicit Updater(const Options& options);
+  // Updates the state with all bearings of one frame at once (eq. 30: one stacked h, one
+  // linearisation point for the frame, so that sequential scalar updates cannot gain
+  // information along directions the frame does not observe). Innovations are wrapped; a
+  // bearing whose normalised innovation (on its own) exceeds the chi-square gate is rejected
+  // and the others are used. With update_iterations > 1 this is the iterated EKF
+  // (Gauss-Newton on the same prior). Returns one result per measurement.
+  std::vector<BearingUpdateResult> update(const std::vector<BearingMeasurement>& z,
+                                          FilterState* state) const;
+
+ private:
+  // Predicted bearings and Jacobian (m x dim) at state x.
+  Eigen::VectorXd predict(const FilterState& state,
+                          const Eigen::VectorXd& x,
+                          const std::vector<BearingMeasurement>& z,
+                          Eigen::MatrixXd* H) const;
+  // Variance added by the curvature of h (second-order filter), see the source.
+  double second_order_variance(const FilterState& state, const BearingMeasurement& z) const;
+  Options options_;
+  double gate_;
+};
+
+}  // namespace omnivert::calib

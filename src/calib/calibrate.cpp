@@ -1,0 +1,112 @@
+#include "omnivert/calib/calibrate.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+
+#include "omnivert/core/angles.hpp"
+#include "omnivert/core/error.hpp"
+
+namespace omnivert::calib {
+
+CalibrationResult calibrate(const CalibrationRun& run,
+                            const Options& options,
+                            const CalibrateOptions& co) {
+  CalibrationResult r;
+  r.filter = run_filter(run, options);
+  r.extrinsics = r.filter.extrinsics;
+  r.covariance = r.filter.covariance;
+  BatchPoint at = batch_point_from_filter(run, options, r.filter);
+  if (co.refine) {
+    r.refinement = refine_batch(run, options, at, co.batch);
+    r.refined = true;
+    if (r.refinement.covariance_ok) {
+      r.extrinsics = r.refinement.extrinsics;
+      r.covariance = r.refinement.covariance;
+    }
+    at = r.refinement.solution;
+  }
+  // Sec. 8.1 at the best estimate of the trajectory, the features and the extrinsics.
+  r.observability = analyse_observability(run, options, at, co.batch, co.observability);
+  return r;
+}
+
+namespace {
+std::string num(double v) {
+  if (std::isnan(v)) return ".nan";
+  if (std::isinf(v)) return v > 0 ? ".inf" : "-.inf";
+  std::ostringstream s;
+  s << std::setprecision(10) << v;
+  return s.str();
+}
+
+void commit_file(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::trunc);
+    if (!f) throw InputError(path, 0, "cannot write the file");
+    f << text;
+    f.flush();
+    if (!f) throw InputError(path, 0, "cannot write the file");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    throw InputError(path, 0, "cannot move the written file into place");
+  }
+}
+}  // namespace
+
+void write_extrinsics_yaml(const std::string& path, const CalibrationResult& r) {
+  const Extrinsics& e = r.extrinsics;
+  const Eigen::Matrix3d& C = r.covariance;
+  const bool cov_ok = C.allFinite() && e.vec().allFinite();
+  std::ostringstream y;
+  y << "# Camera-to-odometry extrinsics (omnivert calibrate). Camera centre at\n"
+       "# rho (cos phi, sin phi) in the robot frame, camera x-axis rotated by phi + psi.\n";
+  y << "phi: " << num(e.phi) << "\nrho: " << num(e.rho) << "\npsi: " << num(e.psi) << "\n";
+  for (int i = 0; i < 3; ++i) {
+    static const char* names[] = {"sigma_phi", "sigma_rho", "sigma_psi"};
+    y << names[i] << ": " << num(cov_ok ? std::sqrt(C(i, i)) : NAN) << "\n";
+  }
+  y << "covariance: [";
+  for (int i = 0; i < 9; ++i) y << (i ? ", " : "") << num(cov_ok ? C(i / 3, i % 3) : NAN);
+  y << "]\n";
+  const Eigen::Vector2d p = e.position();
+  y << "x: " << num(p(0)) << "\ny: " << num(p(1)) << "\nyaw: " << num(e.yaw()) << "\n";
+  const Eigen::Matrix4d T = e.T_base_cam();
+  y << "T_base_cam:\n";
+  for (int i = 0; i < 4; ++i) {
+    y << "  - [";
+    for (int j = 0; j < 4; ++j) y << (j ? ", " : "") << num(T(i, j));
+    y << "]\n";
+  }
+  const ObservabilityReport& o = r.observability;
+  y << "observable: " << (o.all_determined() ? "true" : "false") << "\n";
+  y << "crlb_phi: " << num(o.phi.crlb) << "\ncrlb_rho: " << num(o.rho.crlb)
+    << "\ncrlb_psi: " << num(o.psi.crlb) << "\ncrlb_yaw: " << num(o.yaw.crlb) << "\n";
+  y << "source: " << (r.refined && r.refinement.covariance_ok ? "refinement" : "filter") << "\n";
+  std::string msg = o.message;
+  for (char& c : msg)
+    if (c == '"') c = '\'';
+  y << "message: \"" << msg << "\"\n";
+  commit_file(path, y.str());
+}
+
+void write_states_csv(const std::string& path, const std::vector<FrameEstimate>& history) {
+  std::ostringstream s;
+  s << "frame,phi,rho,psi,sigma_phi,sigma_rho,sigma_psi,features,updates,rejected,new\n";
+  s << std::setprecision(10);
+  for (const FrameEstimate& h : history) {
+    s << h.frame << "," << num(h.extrinsics.phi) << "," << num(h.extrinsics.rho) << ","
+      << num(h.extrinsics.psi);
+    for (int i = 0; i < 3; ++i) s << "," << num(std::sqrt(std::max(h.covariance(i, i), 0.0)));
+    s << "," << h.num_features << "," << h.num_updates << "," << h.num_rejected << "," << h.num_new
+      << "\n";
+  }
+  commit_file(path, s.str());
+}
+
+}  // namespace omnivert::calib

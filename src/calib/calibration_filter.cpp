@@ -1,0 +1,193 @@
+#include "omnivert/calib/calibration_filter.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <string>
+
+#include "omnivert/calib/batch.hpp"
+#include "omnivert/calib/model.hpp"
+#include "omnivert/core/error.hpp"
+
+namespace omnivert::calib {
+
+namespace {
+Options checked(const Options& options) {
+  std::string why;
+  if (!options.IsValid(&why)) throw InputError("calibration options: " + why);
+  return options;
+}
+}  // namespace
+
+CalibrationFilter::CalibrationFilter(const Options& options)
+    : options_(checked(options)),
+      state_(options.prior,
+             options.prior_sigma,
+             options.feature_init == FeatureInit::kAnchoredInverseDepth
+                 ? ExtrinsicsParam::kCameraPose
+                 : ExtrinsicsParam::kPaper),
+      propagator_(options),
+      updater_(options),
+      initializer_(options),
+      bootstrapping_(options.feature_init == FeatureInit::kAnchoredInverseDepth &&
+                     options.bootstrap_rotation > 0.0) {}
+
+void CalibrationFilter::process(const FrameInput& frame) {
+  const std::string where = "frame " + std::to_string(frame_);
+  if (!std::isfinite(frame.d_right) || !std::isfinite(frame.d_left))
+    throw InputError(where + ": wheel travel is not a finite number");
+  std::set<int> seen;
+  for (const BearingObservation& o : frame.observations) {
+    if (!std::isfinite(o.beta))
+      throw InputError(where + ": bearing of track " + std::to_string(o.track_id) +
+                       " is not a finite number");
+    if (!seen.insert(o.track_id).second)
+      throw InputError(where + ": track " + std::to_string(o.track_id) +
+                       " appears twice in one frame");
+  }
+
+  // Delayed initialisation: the first bootstrap_frames frames are solved as a batch
+  // (bootstrap_filter_state), the filter starts from that.
+  if (bootstrapping_) {
+    window_.frames.push_back(frame);
+    FrameEstimate rec;
+    rec.frame = frame_;
+    rec.extrinsics = state_.extrinsics();
+    rec.covariance = state_.extrinsics_covariance();
+    const int n = static_cast<int>(window_.frames.size());
+    window_heading_ += (frame.d_right - frame.d_left) / options_.wheel_base;  // eq. (15)
+    if (n > 1) window_max_turn_ = std::max(window_max_turn_, std::abs(window_heading_));
+    if ((n < options_.bootstrap_min_frames || window_max_turn_ < options_.bootstrap_rotation) &&
+        n < options_.bootstrap_max_frames) {
+      history_.push_back(rec);
+      ++frame_;
+      return;
+    }
+    end_bootstrap(rec);
+    return;
+  }
+  step(frame);
+}
+
+void CalibrationFilter::finish() {
+  if (!bootstrapping_ || window_.frames.empty()) return;
+  --frame_;
+  FrameEstimate rec = history_.back();
+  history_.pop_back();
+  end_bootstrap(rec);
+}
+
+void CalibrationFilter::end_bootstrap(FrameEstimate rec) {
+  {
+    bootstrapping_ = false;
+    std::string why;
+    if (bootstrap_filter_state(window_, options_, &state_, &why)) {
+      rec.extrinsics = state_.extrinsics();
+      rec.covariance = state_.extrinsics_covariance();
+      rec.num_features = state_.num_features();
+      rec.num_new = state_.num_features();
+      history_.push_back(rec);
+      record_tracks();
+      ++frame_;
+      window_.frames.clear();
+      return;
+    }
+    // The window could not be solved: run the plain filter over it.
+    const int first = frame_ - static_cast<int>(window_.frames.size()) + 1;
+    history_.resize(first);
+    frame_ = first;
+    CalibrationRun w = std::move(window_);
+    window_.frames.clear();
+    for (const FrameInput& f : w.frames) step(f);
+  }
+}
+
+void CalibrationFilter::step(const FrameInput& frame) {
+  FrameEstimate rec;
+  rec.frame = frame_;
+  // Prediction, eq. (29). (The first frame carries no travel; propagating zero is harmless.)
+  if (state_.num_features() > 0) propagator_.propagate(frame.d_right, frame.d_left, &state_);
+
+  // Updates of the tracks already in the state, eq. (30), all bearings of the frame at once.
+  std::vector<const BearingObservation*> fresh;
+  std::vector<BearingMeasurement> z;
+  for (const BearingObservation& o : frame.observations) {
+    const int slot = state_.find(o.track_id);
+    if (slot < 0) {
+      fresh.push_back(&o);
+      continue;
+    }
+    state_.mutable_slots()[slot].last_seen_frame = frame_;
+    z.push_back({slot, o.beta});
+  }
+  const std::vector<BearingUpdateResult> results = updater_.update(z, &state_);
+  for (std::size_t k = 0; k < z.size(); ++k) {
+    if (results[k].accepted) {
+      ++rec.num_updates;
+      ++state_.mutable_slots()[z[k].slot].num_updates;
+    } else {
+      ++rec.num_rejected;
+    }
+  }
+  // Tracks that start enter the state (their first bearing is used by the initialisation).
+  for (const BearingObservation* o : fresh) {
+    initializer_.initialize(o->track_id, o->beta, frame_, &state_);
+    ++rec.num_new;
+  }
+  // Inverse-depth blocks whose depth is now well known change to (D, theta) of eq. (28)
+  // (kInverseDistance) or to a robot-frame point (kAnchored).
+  if (options_.convert_ratio > 0.0) {
+    for (int s = 0; s < state_.num_features(); ++s) {
+      const FeatureSlot& slot = state_.slots()[s];
+      if (slot.param == FeatureParam::kInverseDistance) {
+        const int i = slot.index;
+        const double q = state_.x()(i);
+        if (std::sqrt(state_.P()(i, i)) < options_.convert_ratio * q) {
+          const Eigen::Vector2d y(1.0 / q, state_.x()(i + 1));
+          const Eigen::Matrix2d J = (Eigen::Matrix2d() << -1.0 / (q * q), 0, 0, 1).finished();
+          state_.reparametrise(s, FeatureParam::kDistance, y, J);
+        }
+      } else if (slot.param == FeatureParam::kAnchored) {
+        const int i = slot.index;
+        const double q = state_.x()(i + 3);
+        if (std::sqrt(state_.P()(i + 3, i + 3)) < options_.convert_ratio * q) {
+          Eigen::Matrix<double, 2, 4> J;
+          const Eigen::Vector2d y = anchored_to_point(state_.x().segment<4>(i), &J);
+          state_.reparametrise(s, FeatureParam::kPoint, y, J);
+        }
+      }
+    }
+  }
+  record_tracks();
+  // Tracks that ended leave the state (marginalisation).
+  for (int s = state_.num_features() - 1; s >= 0; --s)
+    if (frame_ - state_.slots()[s].last_seen_frame > options_.max_missed_frames)
+      state_.remove_feature(s);
+
+  rec.extrinsics = state_.extrinsics();
+  rec.covariance = state_.extrinsics_covariance();
+  rec.num_features = state_.num_features();
+  history_.push_back(rec);
+  ++frame_;
+}
+
+void CalibrationFilter::record_tracks() {
+  for (int s = 0; s < state_.num_features(); ++s) {
+    const FeatureSlot& slot = state_.slots()[s];
+    if (slot.last_seen_frame != frame_ && tracks_.count(slot.track_id)) continue;
+    TrackEstimate& t = tracks_[slot.track_id];
+    t.track_id = slot.track_id;
+    t.frame = frame_;
+    t.D_theta = state_.feature_distance_form(s, &t.covariance);
+    t.num_updates = slot.num_updates;
+  }
+}
+
+FilterResult run_filter(const CalibrationRun& run, const Options& options) {
+  CalibrationFilter filter(options);
+  for (const FrameInput& f : run.frames) filter.process(f);
+  filter.finish();
+  return {filter.extrinsics(), filter.covariance(), filter.history(), filter.tracks()};
+}
+
+}  // namespace omnivert::calib

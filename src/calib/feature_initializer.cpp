@@ -1,0 +1,71 @@
+#include "omnivert/calib/feature_initializer.hpp"
+
+#include "omnivert/calib/model.hpp"
+#include "omnivert/core/angles.hpp"
+
+namespace omnivert::calib {
+
+int FeatureInitializer::initialize(int track_id, double beta, int frame, FilterState* state) const {
+  const Extrinsics ex = state->extrinsics();
+  const int n = state->dim();
+  const int e = state->extrinsics_index();
+  const double var_beta = options_.bearing_sigma * options_.bearing_sigma;
+
+  FeatureSlot slot;
+  slot.track_id = track_id;
+  slot.first_frame = frame;
+  slot.last_seen_frame = frame;
+  const double q_lo = 1.0 / options_.max_feature_distance;
+  const double q_hi = 1.0 / options_.min_feature_distance;
+  const double q0 = 0.5 * (q_lo + q_hi);
+  const double sigma_q = 0.25 * (q_hi - q_lo);  // the range is +-2 sigma
+  Eigen::VectorXd y;
+  Eigen::MatrixXd G_ex;   // d y / d (extrinsics block)
+  Eigen::MatrixXd G_n;    // d y / d (prior variable, beta)
+  Eigen::Vector2d var_n;  // variances of (prior variable, beta)
+  switch (options_.feature_init) {
+    case FeatureInit::kNaive: {
+      // NOTES Sec. 5 "naive": far-feature approximation of eq. (27),
+      // beta ~ pi - theta - phi - psi, and a fixed distance prior.
+      slot.param = FeatureParam::kDistance;
+      y = Eigen::Vector2d(options_.naive_distance, wrap_angle(kPi - beta - ex.phi - ex.psi));
+      G_ex = (Eigen::Matrix<double, 2, 3>() << 0, 0, 0, -1, 0, -1).finished();
+      G_n = (Eigen::Matrix2d() << 1, 0, 0, -1).finished();
+      var_n << options_.naive_distance_sigma * options_.naive_distance_sigma, var_beta;
+      break;
+    }
+    case FeatureInit::kInverseDistance: {
+      slot.param = FeatureParam::kInverseDistance;
+      Mat2 Gn;
+      Mat23 Ge;
+      y = feature_from_ray(q0, beta, ex, &Gn, &Ge);
+      G_n = Gn;
+      G_ex = Ge;
+      var_n << sigma_q * sigma_q, var_beta;
+      break;
+    }
+    case FeatureInit::kAnchoredInverseDepth: {
+      // Anchor at the camera centre, azimuth alpha = beta + eta in the robot frame, inverse
+      // depth q0 along the ray.
+      slot.param = FeatureParam::kAnchored;
+      const Eigen::Vector3d cam = state->x().tail<3>();
+      y = Eigen::Vector4d(cam(0), cam(1), wrap_angle(beta + cam(2)), q0);
+      G_ex = Eigen::MatrixXd::Zero(4, 3);
+      G_ex(0, 0) = G_ex(1, 1) = G_ex(2, 2) = 1.0;
+      G_n = Eigen::MatrixXd::Zero(4, 2);
+      G_n(3, 0) = 1.0;
+      G_n(2, 1) = 1.0;
+      var_n << sigma_q * sigma_q, var_beta;
+      break;
+    }
+  }
+  const Eigen::MatrixXd& P = state->P();
+  const Eigen::MatrixXd P_yx = G_ex * P.middleRows(e, 3);
+  const Eigen::MatrixXd P_yy =
+      G_ex * P.block(e, e, 3, 3) * G_ex.transpose() + G_n * var_n.asDiagonal() * G_n.transpose();
+  (void)n;
+  state->add_feature(slot, y, P_yx, P_yy);
+  return state->num_features() - 1;
+}
+
+}  // namespace omnivert::calib

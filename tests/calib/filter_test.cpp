@@ -1,0 +1,182 @@
+// The self-calibration filter and batch refinement on synthetic runs with ground truth:
+// convergence without noise, Monte-Carlo consistency (NEES), gating, tracks entering and
+// leaving, bad input.
+#include <gtest/gtest.h>
+
+#include <Eigen/Cholesky>
+#include <cmath>
+
+#include "omnivert/calib/batch.hpp"
+#include "omnivert/calib/calibration_filter.hpp"
+#include "omnivert/calib/synthetic_run.hpp"
+#include "omnivert/calib/updater.hpp"
+#include "omnivert/core/angles.hpp"
+#include "omnivert/core/error.hpp"
+
+namespace omnivert::calib {
+namespace {
+
+Options options_for(const SyntheticRunOptions& so) {
+  Options o;
+  o.wheel_base = so.wheel_base;
+  o.odometry_K = so.odometry_K;
+  o.bearing_sigma = deg2rad(0.3);
+  return o;
+}
+
+Eigen::Vector3d error(const Extrinsics& est, const Extrinsics& truth) {
+  return {angle_diff(est.phi, truth.phi), est.rho - truth.rho, angle_diff(est.psi, truth.psi)};
+}
+
+double nees(const Extrinsics& est, const Eigen::Matrix3d& cov, const Extrinsics& truth) {
+  const Eigen::Vector3d e = error(est, truth);
+  return e.dot(cov.ldlt().solve(e));
+}
+
+TEST(ChiSquare, Quantiles) {
+  EXPECT_NEAR(chi2_quantile(0.95, 1), 3.841459, 1e-5);
+  EXPECT_NEAR(chi2_quantile(0.999, 1), 10.827566, 1e-5);
+  EXPECT_NEAR(chi2_quantile(0.95, 2), 5.991465, 1e-6);
+  EXPECT_NEAR(chi2_quantile(0.95, 3), 7.814728, 1e-5);
+  EXPECT_NEAR(chi2_quantile(0.99, 10), 23.209251, 1e-5);
+  // Cross-check against the Wilson-Hilferty approximation at large dof (within 0.1%).
+  const double z = -1.959963985;  // normal 2.5% quantile
+  const double a = 2.0 / (9.0 * 150);
+  const double wh = 150 * std::pow(1 - a + z * std::sqrt(a), 3);
+  EXPECT_NEAR(chi2_quantile(0.025, 150), wh, 1e-3 * wh);
+}
+
+TEST(Updater, JosephUpdateKeepsCovarianceSymmetricPositiveDefinite) {
+  Eigen::MatrixXd A = Eigen::MatrixXd::Random(6, 6);
+  Eigen::MatrixXd P = A * A.transpose() + 1e-3 * Eigen::MatrixXd::Identity(6, 6);
+  const Eigen::MatrixXd H = Eigen::MatrixXd::Random(2, 6);
+  const Eigen::MatrixXd R = 1e-8 * Eigen::MatrixXd::Identity(2, 2);  // nearly exact
+  const Eigen::MatrixXd P0 = P;
+  Eigen::MatrixXd K;
+  ASSERT_TRUE(joseph_update(H, R, &P, &K));
+  EXPECT_LT((P - P.transpose()).norm(), 1e-14);
+  EXPECT_EQ(Eigen::LLT<Eigen::MatrixXd>(P).info(), Eigen::Success);
+  // Same as the textbook form (I - K H) P0 for the optimal gain.
+  EXPECT_LT((P - (Eigen::MatrixXd::Identity(6, 6) - K * H) * P0).norm(), 1e-6 * P0.norm());
+}
+
+TEST(CalibrationFilter, NoiseFreeRunConvergesToTruth) {
+  SyntheticRunOptions so;
+  so.bearing_sigma = 0.0;
+  so.odometry_K = 0.0;
+  so.seed = 3;
+  const SyntheticRun run = make_synthetic_run(so);
+  Options o = options_for(so);
+  o.odometry_K = 1e-9;
+  const FilterResult r = run_filter(run.run, o);
+  const Eigen::Vector3d e = error(r.extrinsics, run.truth);
+  EXPECT_LT(std::abs(rad2deg(e(0))), 0.05);
+  EXPECT_LT(std::abs(e(1)), 2e-4);
+  EXPECT_LT(std::abs(rad2deg(e(2))), 0.05);
+  // The refinement from there lands on the truth.
+  const RefinementResult rr = refine_batch(run.run, o, batch_point_from_filter(run.run, o, r));
+  ASSERT_TRUE(rr.covariance_ok);
+  const Eigen::Vector3d er = error(rr.extrinsics, run.truth);
+  EXPECT_LT(er.cwiseAbs().maxCoeff(), 1e-5);
+}
+
+// Monte Carlo (reduced: 20 runs; the full study is bench/calib/calib_monte_carlo): mean NEES
+// of (phi, rho, psi) inside the 95% interval of chi-square(3 N) / N, for the filter and the
+// refinement, and the naive initialisation far outside it.
+TEST(CalibrationFilter, MonteCarloNeesIsConsistent) {
+  const int N = 20;
+  SyntheticRunOptions so;
+  double filt = 0, ref = 0, naive = 0;
+  for (int r = 0; r < N; ++r) {
+    so.seed = 100 + r;
+    const SyntheticRun run = make_synthetic_run(so);
+    const Options o = options_for(so);
+    const FilterResult fr = run_filter(run.run, o);
+    filt += nees(fr.extrinsics, fr.covariance, run.truth);
+    const RefinementResult rr = refine_batch(run.run, o, batch_point_from_filter(run.run, o, fr));
+    ASSERT_TRUE(rr.covariance_ok);
+    ref += nees(rr.extrinsics, rr.covariance, run.truth);
+    if (r < 5) {
+      Options on = o;
+      on.feature_init = FeatureInit::kNaive;
+      const FilterResult nr = run_filter(run.run, on);
+      naive += nees(nr.extrinsics, nr.covariance, run.truth);
+    }
+  }
+  const double lo = chi2_quantile(0.025, 3 * N) / N, hi = chi2_quantile(0.975, 3 * N) / N;
+  EXPECT_GT(filt / N, lo);
+  EXPECT_LT(filt / N, hi);
+  EXPECT_GT(ref / N, lo);
+  EXPECT_LT(ref / N, hi);
+  EXPECT_GT(naive / 5, 50.0);  // NOTES Sec. 5: the naive initialisation is inconsistent
+}
+
+TEST(CalibrationFilter, OutlierBearingIsGated) {
+  SyntheticRunOptions so;
+  so.seed = 7;
+  SyntheticRun run = make_synthetic_run(so);
+  // False matches: one in the bootstrap window (frame 30), two after it (filter's gate).
+  run.run.frames[30].observations[4].beta += deg2rad(25.0);
+  run.run.frames[100].observations[2].beta += deg2rad(25.0);
+  run.run.frames[105].observations[6].beta -= deg2rad(10.0);
+  const Options o = options_for(so);
+  CalibrationFilter f(o);
+  for (const FrameInput& fr : run.run.frames) f.process(fr);
+  f.finish();
+  EXPECT_GE(f.history()[100].num_rejected, 1);
+  EXPECT_GE(f.history()[105].num_rejected, 1);
+  const Eigen::Vector3d e = error(f.extrinsics(), run.truth);
+  const Eigen::Matrix3d C = f.covariance();
+  for (int i = 0; i < 3; ++i) EXPECT_LT(std::abs(e(i)), 3.5 * std::sqrt(C(i, i))) << i;
+  // The refinement drops the three as well.
+  const FilterResult fr{f.extrinsics(), f.covariance(), f.history(), f.tracks()};
+  const RefinementResult rr = refine_batch(run.run, o, batch_point_from_filter(run.run, o, fr));
+  EXPECT_GE(rr.num_rejected, 3);
+  const Eigen::Vector3d er = error(rr.extrinsics, run.truth);
+  for (int i = 0; i < 3; ++i) EXPECT_LT(std::abs(er(i)), 3.5 * std::sqrt(rr.covariance(i, i))) << i;
+}
+
+TEST(CalibrationFilter, TracksEnterAndLeave) {
+  SyntheticRunOptions so;
+  so.seed = 11;
+  so.break_probability = 0.03;  // tracks are cut and restart under new ids
+  const SyntheticRun run = make_synthetic_run(so);
+  ASSERT_GT(run.track_feature.size(), 30u);
+  Options o = options_for(so);
+  o.max_missed_frames = 0;  // a track not seen in this frame has ended
+  CalibrationFilter f(o);
+  int max_features = 0;
+  for (const FrameInput& fr : run.run.frames) {
+    f.process(fr);
+    max_features = std::max(max_features, f.history().back().num_features);
+  }
+  f.finish();
+  EXPECT_LE(max_features, so.num_features);  // ended tracks were marginalised
+  EXPECT_LE(f.state().num_features(), so.num_features);
+  const Eigen::Vector3d e = error(f.extrinsics(), run.truth);
+  const Eigen::Matrix3d C = f.covariance();
+  for (int i = 0; i < 3; ++i) EXPECT_LT(std::abs(e(i)), 4.0 * std::sqrt(C(i, i))) << i;
+}
+
+TEST(CalibrationFilter, BadInputIsAnInputError) {
+  Options o;
+  o.bearing_sigma = -1.0;
+  std::string why;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("bearing_sigma"), std::string::npos);
+  EXPECT_THROW(CalibrationFilter{o}, InputError);
+
+  CalibrationFilter f(Options{});
+  FrameInput bad;
+  bad.d_right = std::nan("");
+  EXPECT_THROW(f.process(bad), InputError);
+  FrameInput dup;
+  dup.observations = {{1, 0.1}, {1, 0.2}};
+  EXPECT_THROW(f.process(dup), InputError);
+  FrameInput nanbeta;
+  nanbeta.observations = {{1, std::nan("")}};
+  EXPECT_THROW(f.process(nanbeta), InputError);
+}
+
+}  // namespace
+}  // namespace omnivert::calib
