@@ -81,7 +81,7 @@ Eigen::VectorXd Updater::predict(const FilterState& state,
                                  const std::vector<BearingMeasurement>& z,
                                  Eigen::MatrixXd* H) const {
   const int e = state.extrinsics_index();
-  const bool paper = state.extrinsics_param() == ExtrinsicsParam::kPaper;
+  [[maybe_unused]] const bool paper = state.extrinsics_param() == ExtrinsicsParam::kPaper;
   const Extrinsics ex = Extrinsics::from_vec(x.segment<3>(e));  // (phi, rho, psi) if paper
   const Vec3 cam = x.segment<3>(e);                             // (c_x, c_y, eta) otherwise
   const int m = static_cast<int>(z.size());
