@@ -130,6 +130,42 @@ void Tracker::add_frame(const FrameFeatures& frame,
     const BearingGate gate = options_.gate.enabled
                                  ? make_bearing_gate(options_.gate, slot.odometry, odometry_)
                                  : BearingGate{};
+    const bool restrict = options_.gate.enabled && options_.gate_candidates && gate.informative;
+    if (restrict) {
+      // Tests 1 and 3 among the candidates the gate admits; test 2's mean over all of them.
+      const auto d = matcher_.last_distances();
+      const int nc = static_cast<int>(slot.num_lines);
+      for (int q = 0; q < nq; ++q) {
+        const double bearing = frame.lines[static_cast<std::size_t>(unmatched_[static_cast<std::size_t>(q)])].bearing;
+        MatchResult& r = results_[static_cast<std::size_t>(q)];
+        float best = std::numeric_limits<float>::infinity(), second = best;
+        int best_j = -1, admitted = 0;
+        for (int j = 0; j < nc; ++j) {
+          if (!gate.admits(slot.bearings[static_cast<std::size_t>(j)], bearing)) continue;
+          ++admitted;
+          const float v = d(q, j);
+          if (v < best) {
+            second = best;
+            best = v;
+            best_j = j;
+          } else if (v < second) {
+            second = v;
+          }
+        }
+        if (admitted == 0) {
+          if (r.accepted()) ++stats_.rejected_gate;
+          r.best = -1;
+          r.verdict = MatchVerdict::kNoCandidates;
+          continue;
+        }
+        r.best = best_j;
+        r.min_distance = best;
+        r.second_distance = second;
+        // N_B = all lines of the frame (test 2's mean over them); with one admitted candidate
+        // the second distance is +inf and test 3 is vacuous.
+        r.verdict = apply_match_tests(options_.match, nc, best, second, r.mean_distance);
+      }
+    }
     still_unmatched_.clear();
     for (int q = 0; q < nq; ++q) {
       const int i = unmatched_[static_cast<std::size_t>(q)];
@@ -154,7 +190,20 @@ void Tracker::add_frame(const FrameFeatures& frame,
         // lines are processed): the nearest line of the new frame to B_best must be A_i.
         // Computed for the accepted candidate only (n dot products), ties to lowest index.
         int nearest = -1;
-        if (all_rows) {
+        if (restrict) {
+          // Among the lines of the new frame that the gate admits for B_best.
+          const double b_bearing = slot.bearings[static_cast<std::size_t>(r.best)];
+          const auto b = slot.descriptors.row(r.best);
+          float nearest_sq = std::numeric_limits<float>::infinity();
+          for (int a = 0; a < n; ++a) {
+            if (!gate.admits(b_bearing, frame.lines[static_cast<std::size_t>(a)].bearing)) continue;
+            const float sq = (frame.descriptors.row(a) - b).squaredNorm();
+            if (sq < nearest_sq) {
+              nearest_sq = sq;
+              nearest = a;
+            }
+          }
+        } else if (all_rows) {
           // The whole column of distances to B_best is at hand (row q is line q).
           Eigen::Index idx = 0;
           matcher_.last_distances().col(r.best).minCoeff(&idx);

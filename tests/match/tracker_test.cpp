@@ -451,6 +451,45 @@ TEST(Tracker, OdometryGateRejectsImpossibleBearingJump) {
   }
 }
 
+// Two look-alike lines (a repeated door frame) 1 rad apart: in the next frame the true line
+// fails test 3 against its twin (and starts a new track) unless the candidates are restricted
+// to those the odometry gate admits (gate_candidates), where the twin is not one of them.
+TEST(Tracker, GateCandidatesResolveLookAlikes) {
+  std::mt19937 rng(43);
+  FrameFeatures f0;
+  f0.descriptors.resize(6, kPaperDescriptorSize);
+  for (int k = 0; k < 6; ++k) {
+    f0.descriptors.row(k) = random_descriptor(rng);
+    VerticalLine v;
+    v.bearing = -2.5 + k;
+    f0.lines.push_back(v);
+  }
+  f0.descriptors.row(3) = perturb(f0.descriptors.row(2), 0.0005f, rng);  // 2's twin
+  const WheelIncrement turn{0.03, -0.03};  // bearings shift by -0.15 rad
+  FrameFeatures f1 = f0;
+  for (int k = 0; k < 6; ++k) {
+    f1.descriptors.row(k) = perturb(f0.descriptors.row(k), 0.004f, rng);
+    f1.lines[static_cast<std::size_t>(k)].bearing = wrap_angle(f0.lines[k].bearing - 0.15);
+  }
+  for (bool restrict : {false, true}) {
+    TrackerOptions o = recommended_tracker_options(0.4);
+    o.gate_candidates = restrict;
+    Tracker tracker(o);
+    std::vector<TrackAssignment> out0, out1;
+    tracker.add_frame(f0, WheelIncrement{}, &out0);
+    tracker.add_frame(f1, turn, &out1);
+    for (int k : {0, 1, 4, 5}) EXPECT_EQ(out1[static_cast<std::size_t>(k)].track_id, out0[k].track_id);
+    for (int k : {2, 3}) {
+      if (restrict) {
+        EXPECT_EQ(out1[static_cast<std::size_t>(k)].track_id, out0[k].track_id) << k;
+      } else {
+        EXPECT_TRUE(out1[static_cast<std::size_t>(k)].is_new()) << k;  // test 3 fails
+      }
+    }
+    EXPECT_EQ(tracker.stats().rejected_test3, restrict ? 0 : 2);
+  }
+}
+
 }  // namespace
 }  // namespace omnivert
 

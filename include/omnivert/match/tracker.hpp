@@ -40,6 +40,12 @@ struct TrackerOptions {
   int look_back = 20;        // frames searched back for an unmatched line (Sec. 9.1)
   bool mutual = false;       // one-to-one, mutual nearest neighbours
   OdometryGateOptions gate;  // bearing-change gate from wheel travel (off by default)
+  // With the gate on: the nearest and second-nearest candidates of tests 1 and 3 (and the
+  // mutual check) are taken among the lines the gate admits, instead of the gate vetoing the
+  // nearest of all lines afterwards. Test 2's mean stays over all lines of the frame. A
+  // look-alike that the wheels rule out then neither wins nor makes the true line fail test 3
+  // (docs/tracking.md, measured there).
+  bool gate_candidates = false;
 
   bool IsValid(std::string* error) const;
 };
