@@ -19,6 +19,7 @@ struct TrackerFlags {
   double f1 = 1.05, f2 = 0.75, f3 = 0.8;
   std::string gate_candidates = "default";  // on|off|default (the rule set's)
   double gate_min_distance = -1.0, gate_tolerance_deg = -1.0;  // < 0: the default
+  std::string same_polarity = "default";  // on|off|default (the rule set's)
 
   // The options these flags select (the wheel base is filled in from the dataset).
   TrackerOptions options() const {
@@ -30,6 +31,7 @@ struct TrackerFlags {
     o.match.f2 = f2;
     o.match.f3 = f3;
     if (gate_candidates != "default") o.gate_candidates = gate_candidates == "on";
+    if (same_polarity != "default") o.same_polarity = same_polarity == "on";
     if (gate_min_distance > 0.0) o.gate.min_feature_distance = gate_min_distance;
     if (gate_tolerance_deg >= 0.0) o.gate.bearing_tolerance = deg2rad(gate_tolerance_deg);
     return o;
@@ -53,6 +55,12 @@ inline void add_tracker_options(CLI::App* cmd, TrackerFlags& t) {
   cmd->add_option("--gate-candidates", t.gate_candidates,
                   "on: tests 1 and 3 and the mutual check among the lines the odometry gate admits; "
                   "off: the gate only vetoes the nearest line (default: the rule set's)")
+      ->check(CLI::IsMember({"on", "off", "default"}))
+      ->capture_default_str()
+      ->group(g);
+  cmd->add_option("--same-polarity", t.same_polarity,
+                  "on: a line is matched only to lines of the same edge polarity (default: the "
+                  "rule set's)")
       ->check(CLI::IsMember({"on", "off", "default"}))
       ->capture_default_str()
       ->group(g);

@@ -130,18 +130,29 @@ void Tracker::add_frame(const FrameFeatures& frame,
     const BearingGate gate = options_.gate.enabled
                                  ? make_bearing_gate(options_.gate, slot.odometry, odometry_)
                                  : BearingGate{};
-    const bool restrict = options_.gate.enabled && options_.gate_candidates && gate.informative;
+    const bool gate_restricts =
+        options_.gate.enabled && options_.gate_candidates && gate.informative;
+    const bool restrict = gate_restricts || options_.same_polarity;
+    // Whether line `a` of the new frame may be matched to line `j` of frame t-k.
+    auto admissible = [&](int a, int j) {
+      const VerticalLine& l = frame.lines[static_cast<std::size_t>(a)];
+      if (options_.same_polarity) {
+        const int pj = slot.polarities[static_cast<std::size_t>(j)];
+        if (l.polarity != 0 && pj != 0 && l.polarity != pj) return false;
+      }
+      return !gate_restricts || gate.admits(slot.bearings[static_cast<std::size_t>(j)], l.bearing);
+    };
     if (restrict) {
-      // Tests 1 and 3 among the candidates the gate admits; test 2's mean over all of them.
+      // Tests 1 and 3 among the admissible candidates; test 2's mean over all of them.
       const auto d = matcher_.last_distances();
       const int nc = static_cast<int>(slot.num_lines);
       for (int q = 0; q < nq; ++q) {
-        const double bearing = frame.lines[static_cast<std::size_t>(unmatched_[static_cast<std::size_t>(q)])].bearing;
+        const int line = unmatched_[static_cast<std::size_t>(q)];
         MatchResult& r = results_[static_cast<std::size_t>(q)];
         float best = std::numeric_limits<float>::infinity(), second = best;
         int best_j = -1, admitted = 0;
         for (int j = 0; j < nc; ++j) {
-          if (!gate.admits(slot.bearings[static_cast<std::size_t>(j)], bearing)) continue;
+          if (!admissible(line, j)) continue;
           ++admitted;
           const float v = d(q, j);
           if (v < best) {
@@ -191,12 +202,11 @@ void Tracker::add_frame(const FrameFeatures& frame,
         // Computed for the accepted candidate only (n dot products), ties to lowest index.
         int nearest = -1;
         if (restrict) {
-          // Among the lines of the new frame that the gate admits for B_best.
-          const double b_bearing = slot.bearings[static_cast<std::size_t>(r.best)];
+          // Among the lines of the new frame admissible for B_best.
           const auto b = slot.descriptors.row(r.best);
           float nearest_sq = std::numeric_limits<float>::infinity();
           for (int a = 0; a < n; ++a) {
-            if (!gate.admits(b_bearing, frame.lines[static_cast<std::size_t>(a)].bearing)) continue;
+            if (!admissible(a, r.best)) continue;
             const float sq = (frame.descriptors.row(a) - b).squaredNorm();
             if (sq < nearest_sq) {
               nearest_sq = sq;
@@ -273,13 +283,16 @@ void Tracker::store_frame(const FrameFeatures& frame, const std::vector<TrackAss
     slot.descriptors.resize(line_capacity(std::max<Eigen::Index>(slot.descriptors.rows(), n)),
                             cols);
     slot.bearings.reserve(static_cast<std::size_t>(slot.descriptors.rows()));
+    slot.polarities.reserve(static_cast<std::size_t>(slot.descriptors.rows()));
     slot.track_ids.reserve(static_cast<std::size_t>(slot.descriptors.rows()));
   }
   if (n > 0) slot.descriptors.topRows(n) = frame.descriptors;
   slot.bearings.resize(static_cast<std::size_t>(n));
+  slot.polarities.resize(static_cast<std::size_t>(n));
   slot.track_ids.resize(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) {
     slot.bearings[static_cast<std::size_t>(i)] = frame.lines[static_cast<std::size_t>(i)].bearing;
+    slot.polarities[static_cast<std::size_t>(i)] = frame.lines[static_cast<std::size_t>(i)].polarity;
     slot.track_ids[static_cast<std::size_t>(i)] = out[static_cast<std::size_t>(i)].track_id;
   }
   slot.num_lines = n;

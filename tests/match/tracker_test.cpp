@@ -490,6 +490,44 @@ TEST(Tracker, GateCandidatesResolveLookAlikes) {
   }
 }
 
+// The other side of a door frame (opposite polarity, a look-alike descriptor) seen where the
+// first side was: linked by the paper's rules, a new track with same_polarity; lines of
+// unknown polarity (0) are not constrained.
+TEST(Tracker, SamePolarityKeepsOppositeEdgesApart) {
+  std::mt19937 rng(47);
+  FrameFeatures f0;
+  f0.descriptors.resize(6, kPaperDescriptorSize);
+  for (int k = 0; k < 6; ++k) {
+    f0.descriptors.row(k) = random_descriptor(rng);
+    VerticalLine v;
+    v.bearing = -2.5 + k;
+    v.polarity = k % 2 ? 1 : -1;
+    f0.lines.push_back(v);
+  }
+  FrameFeatures f1 = f0;
+  for (int k = 0; k < 6; ++k) f1.descriptors.row(k) = perturb(f0.descriptors.row(k), 0.004f, rng);
+  f1.lines[2].polarity = -f0.lines[2].polarity;  // the frame's other side
+  f1.descriptors.row(2) = perturb(f0.descriptors.row(2), 0.02f, rng);
+  for (int unknown : {0, 1}) {
+    for (bool same : {false, true}) {
+      TrackerOptions o;
+      o.same_polarity = same;
+      Tracker tracker(o);
+      FrameFeatures g0 = f0, g1 = f1;
+      if (unknown) g1.lines[2].polarity = 0;
+      std::vector<TrackAssignment> out0, out1;
+      tracker.add_frame(g0, &out0);
+      tracker.add_frame(g1, &out1);
+      for (int k : {0, 1, 3, 4, 5}) EXPECT_EQ(out1[static_cast<std::size_t>(k)].track_id, out0[k].track_id);
+      if (same && !unknown) {
+        EXPECT_TRUE(out1[2].is_new());
+      } else {
+        EXPECT_EQ(out1[2].track_id, out0[2].track_id);
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace omnivert
 

@@ -46,6 +46,11 @@ struct TrackerOptions {
   // look-alike that the wheels rule out then neither wins nor makes the true line fail test 3
   // (docs/tracking.md, measured there).
   bool gate_candidates = false;
+  // Candidates of the opposite edge polarity (VerticalLine::polarity; 0 = unknown matches
+  // anything) are left out of tests 1-3 and the mutual check. The two sides of a thin door
+  // frame look alike to the descriptor but have opposite polarities: where extraction finds
+  // them in turn, the paper's rules link them (docs/tracking.md, measured there).
+  bool same_polarity = false;
 
   bool IsValid(std::string* error) const;
 };
@@ -111,6 +116,7 @@ class Tracker {
   struct Slot {
     DescriptorMatrix descriptors;  // capacity rows; the first `num_lines` are live
     std::vector<double> bearings;
+    std::vector<int> polarities;
     std::vector<std::int64_t> track_ids;
     int num_lines = 0;
     OdometryAccumulator odometry;
