@@ -36,6 +36,7 @@ TrackerOptions paper_tracker_options() { return TrackerOptions{}; }
 TrackerOptions recommended_tracker_options(double wheel_base) {
   TrackerOptions o;
   o.mutual = true;
+  o.same_polarity = true;
   if (wheel_base > 0.0) {
     o.gate.enabled = true;
     o.gate.wheel_base = wheel_base;

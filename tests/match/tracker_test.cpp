@@ -542,10 +542,12 @@ TEST(TrackerOptions, PaperAndRecommended) {
   EXPECT_DOUBLE_EQ(p.match.f3, 0.8);
   EXPECT_FALSE(p.mutual);
   EXPECT_FALSE(p.gate.enabled);
+  EXPECT_FALSE(p.same_polarity);
   std::string error;
   const TrackerOptions r = recommended_tracker_options(0.45);
   EXPECT_TRUE(r.IsValid(&error)) << error;
   EXPECT_TRUE(r.mutual);
+  EXPECT_TRUE(r.same_polarity);
   EXPECT_TRUE(r.gate.enabled);
   EXPECT_DOUBLE_EQ(r.gate.wheel_base, 0.45);
   const TrackerOptions no_odometry = recommended_tracker_options(0.0);
