@@ -20,6 +20,7 @@ struct TrackerFlags {
   std::string gate_candidates = "default";  // on|off|default (the rule set's)
   double gate_min_distance = -1.0, gate_tolerance_deg = -1.0;  // < 0: the default
   std::string same_polarity = "default";  // on|off|default (the rule set's)
+  double continuity_deg = -1.0;            // < 0: the rule set's
 
   // The options these flags select (the wheel base is filled in from the dataset).
   TrackerOptions options() const {
@@ -31,6 +32,7 @@ struct TrackerFlags {
     o.match.f2 = f2;
     o.match.f3 = f3;
     if (gate_candidates != "default") o.gate_candidates = gate_candidates == "on";
+    if (continuity_deg >= 0.0) o.continuity_tolerance = deg2rad(continuity_deg);
     if (same_polarity != "default") o.same_polarity = same_polarity == "on";
     if (gate_min_distance > 0.0) o.gate.min_feature_distance = gate_min_distance;
     if (gate_tolerance_deg >= 0.0) o.gate.bearing_tolerance = deg2rad(gate_tolerance_deg);
@@ -64,6 +66,10 @@ inline void add_tracker_options(CLI::App* cmd, TrackerFlags& t) {
                   "rule set's)")
       ->check(CLI::IsMember({"on", "off", "default"}))
       ->capture_default_str()
+      ->group(g);
+  cmd->add_option("--continuity", t.continuity_deg,
+                  "Track continuity tolerance [degrees]: refuse links that deviate more from the "
+                  "track's predicted bearing (needs wheel data; 0: off; default: the rule set's)")
       ->group(g);
   cmd->add_option("--gate-min-distance", t.gate_min_distance,
                   "Odometry gate: nearest distance of a line from the camera [m] (default 0.5)")

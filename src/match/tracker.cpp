@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
 
 namespace omnivert {
@@ -26,6 +27,10 @@ bool TrackerOptions::IsValid(std::string* error) const {
   if (!match.IsValid(error)) return false;
   if (look_back < 1 || look_back > 1000) {
     if (error) *error = "look-back must be between 1 and 1000 frames (paper: 20)";
+    return false;
+  }
+  if (!(continuity_tolerance >= 0.0 && continuity_tolerance < kPi)) {
+    if (error) *error = "continuity tolerance must be in [0, pi) radians (0: off)";
     return false;
   }
   return gate.IsValid(error);
@@ -50,7 +55,8 @@ std::string TrackerStats::BriefReport() const {
     << " matched in the previous frame, " << matched_look_back << " by look-back, " << new_tracks
     << " new tracks; rejected: test1 " << rejected_test1 << ", test2 " << rejected_test2
     << ", test3 " << rejected_test3 << ", mutual " << rejected_mutual << ", claimed "
-    << rejected_claimed << ", odometry gate " << rejected_gate;
+    << rejected_claimed << ", odometry gate " << rejected_gate << ", continuity "
+    << rejected_continuity;
   return s.str();
 }
 
@@ -245,6 +251,11 @@ void Tracker::add_frame(const FrameFeatures& frame,
         ++stats_.rejected_gate;
         ok = false;
       }
+      if (ok && options_.gate.enabled && options_.continuity_tolerance > 0.0 &&
+          !continues_track(k, r.best, frame.lines[static_cast<std::size_t>(i)].bearing)) {
+        ++stats_.rejected_continuity;
+        ok = false;
+      }
       if (!ok) {
         still_unmatched_.push_back(i);
         continue;
@@ -273,6 +284,46 @@ void Tracker::add_frame(const FrameFeatures& frame,
   store_frame(frame, *out);
   ++stats_.frames;
   stats_.lines += n;
+}
+
+bool Tracker::continues_track(int k, int j, double bearing) {
+  const std::int64_t id = slot_back(k).track_ids[static_cast<std::size_t>(j)];
+  const int held = static_cast<int>(std::min<std::int64_t>(frame_count_, options_.look_back));
+  // The track's two most recent observations in the frames held (the newest may be more
+  // recent than frame t-k, when the line was matched further back).
+  const Slot* s1 = nullptr;
+  const Slot* s0 = nullptr;
+  double b1 = 0.0, b0 = 0.0;
+  for (int m = 1; m <= held && s0 == nullptr; ++m) {
+    const Slot& sl = slot_back(m);
+    for (int q = 0; q < sl.num_lines; ++q) {
+      if (sl.track_ids[static_cast<std::size_t>(q)] != id) continue;
+      if (s1 == nullptr) {
+        s1 = &sl;
+        b1 = sl.bearings[static_cast<std::size_t>(q)];
+      } else {
+        s0 = &sl;
+        b0 = sl.bearings[static_cast<std::size_t>(q)];
+      }
+      break;
+    }
+  }
+  if (s1 == nullptr || s0 == nullptr) return true;  // no history: nothing to predict from
+  // u = bearing + theta is free of the robot's rotation (eq. 16); its change is parallax.
+  const double u0 = b0 + s0->odometry.theta;
+  const double u1 = b1 + s1->odometry.theta;
+  const double u2 = bearing + odometry_.theta;
+  const double path01 = s1->odometry.path_length - s0->odometry.path_length;
+  const double path12 = odometry_.path_length - s1->odometry.path_length;
+  // Parallax per metre; none known when the robot turned on the spot in between.
+  const double rate = path01 > 0.01 ? angle_diff(u1, u0) / path01 : 0.0;
+  const double predicted = u1 + rate * path12;
+  // Camera swing under rotation (rho_max), as in the gate, bounds what is not predicted.
+  const double d_theta = odometry_.theta - s1->odometry.theta;
+  const double swing = 2.0 * options_.gate.max_camera_offset * std::abs(std::sin(0.5 * d_theta));
+  const double tol = options_.continuity_tolerance +
+                     std::asin(std::min(1.0, swing / options_.gate.min_feature_distance));
+  return std::abs(angle_diff(u2, predicted)) <= tol;
 }
 
 void Tracker::store_frame(const FrameFeatures& frame, const std::vector<TrackAssignment>& out) {

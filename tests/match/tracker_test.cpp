@@ -528,6 +528,51 @@ TEST(Tracker, SamePolarityKeepsOppositeEdgesApart) {
   }
 }
 
+// Driving straight, line 2 drifts by 0.2 degree a frame (parallax); in frame 3 extraction finds
+// its neighbour edge instead, 1.3 degrees off the predicted bearing. Continuity refuses that
+// link (a new track); the true continuation of every other line is kept.
+TEST(Tracker, ContinuityRefusesAJumpToTheNeighbourEdge) {
+  std::mt19937 rng(53);
+  const double deg = kPi / 180.0;
+  std::vector<Eigen::RowVectorXf> d;
+  for (int k = 0; k < 6; ++k) d.push_back(random_descriptor(rng));
+  auto frame = [&](int f, bool neighbour) {
+    FrameFeatures fr;
+    fr.descriptors.resize(6, kPaperDescriptorSize);
+    for (int k = 0; k < 6; ++k) {
+      VerticalLine v;
+      v.bearing = -2.5 + k + (k == 2 ? 0.2 * deg * f : 0.0);
+      fr.descriptors.row(k) = perturb(d[static_cast<std::size_t>(k)], 0.004f, rng);
+      if (k == 2 && neighbour) {
+        v.bearing += 1.3 * deg;
+        fr.descriptors.row(k) = perturb(d[2], 0.02f, rng);
+      }
+      fr.lines.push_back(v);
+    }
+    return fr;
+  };
+  const WheelIncrement straight{0.038, 0.038};
+  for (double tol : {0.0, 0.6 * deg}) {
+    TrackerOptions o = recommended_tracker_options(0.4);
+    o.continuity_tolerance = tol;
+    Tracker tracker(o);
+    std::vector<TrackAssignment> out0, out;
+    tracker.add_frame(frame(0, false), WheelIncrement{}, &out0);
+    for (int f = 1; f <= 2; ++f) {
+      tracker.add_frame(frame(f, false), straight, &out);
+      for (int k = 0; k < 6; ++k) EXPECT_EQ(out[static_cast<std::size_t>(k)].track_id, out0[k].track_id);
+    }
+    tracker.add_frame(frame(3, true), straight, &out);
+    for (int k : {0, 1, 3, 4, 5}) EXPECT_EQ(out[static_cast<std::size_t>(k)].track_id, out0[k].track_id);
+    if (tol > 0.0) {
+      EXPECT_TRUE(out[2].is_new());
+      EXPECT_GE(tracker.stats().rejected_continuity, 1);
+    } else {
+      EXPECT_EQ(out[2].track_id, out0[2].track_id);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace omnivert
 

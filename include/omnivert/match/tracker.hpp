@@ -51,6 +51,12 @@ struct TrackerOptions {
   // frame look alike to the descriptor but have opposite polarities: where extraction finds
   // them in turn, the paper's rules link them (docs/tracking.md, measured there).
   bool same_polarity = false;
+  // Track continuity (needs the odometry gate's wheel data; 0 = off): a link to track T is
+  // refused when the new bearing deviates from T's predicted one by more than this (radians)
+  // plus the gate's camera-swing term. The prediction removes the robot's rotation (eq. 16) and
+  // extrapolates T's parallax per metre driven, measured between its last two observations
+  // (up to 3 frames apart). It targets two close edges that extraction finds in turn.
+  double continuity_tolerance = 0.0;
 
   bool IsValid(std::string* error) const;
 };
@@ -88,6 +94,7 @@ struct TrackerStats {
   std::int64_t rejected_mutual = 0;   // not mutual nearest neighbours
   std::int64_t rejected_claimed = 0;  // track already taken in this frame (mutual on)
   std::int64_t rejected_gate = 0;     // odometry gate veto
+  std::int64_t rejected_continuity = 0;  // track continuity veto
   std::string BriefReport() const;
 };
 
@@ -126,6 +133,9 @@ class Tracker {
   Slot& slot_back(int k);
   void store_frame(const FrameFeatures& frame, const std::vector<TrackAssignment>& out);
   bool track_claimed(std::int64_t id) const;
+  // TrackerOptions::continuity_tolerance: may line `bearing` of the new frame continue the
+  // track of line j of frame t-k?
+  bool continues_track(int k, int j, double bearing);
 
   TrackerOptions options_;
   Matcher matcher_;
