@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cassert>
 #include <limits>
 #include <sstream>
@@ -107,6 +108,7 @@ void Tracker::add_frame(const FrameFeatures& frame,
   if (static_cast<Eigen::Index>(unmatched_.capacity()) < n) {
     const auto cap = static_cast<std::size_t>(line_capacity(n));
     unmatched_.reserve(cap);
+    rates_.reserve(cap);
     still_unmatched_.reserve(cap);
     claimed_.reserve(cap);
   }
@@ -287,39 +289,15 @@ void Tracker::add_frame(const FrameFeatures& frame,
 }
 
 bool Tracker::continues_track(int k, int j, double bearing) {
-  const std::int64_t id = slot_back(k).track_ids[static_cast<std::size_t>(j)];
-  const int held = static_cast<int>(std::min<std::int64_t>(frame_count_, options_.look_back));
-  // The track's two most recent observations in the frames held (the newest may be more
-  // recent than frame t-k, when the line was matched further back).
-  const Slot* s1 = nullptr;
-  const Slot* s0 = nullptr;
-  double b1 = 0.0, b0 = 0.0;
-  for (int m = 1; m <= held && s0 == nullptr; ++m) {
-    const Slot& sl = slot_back(m);
-    for (int q = 0; q < sl.num_lines; ++q) {
-      if (sl.track_ids[static_cast<std::size_t>(q)] != id) continue;
-      if (s1 == nullptr) {
-        s1 = &sl;
-        b1 = sl.bearings[static_cast<std::size_t>(q)];
-      } else {
-        s0 = &sl;
-        b0 = sl.bearings[static_cast<std::size_t>(q)];
-      }
-      break;
-    }
-  }
-  if (s1 == nullptr || s0 == nullptr) return true;  // no history: nothing to predict from
+  const Slot& s1 = slot_back(k);
+  const double rate = s1.parallax_rates[static_cast<std::size_t>(j)];
+  if (std::isnan(rate)) return true;  // no recent history: nothing to predict from
   // u = bearing + theta is free of the robot's rotation (eq. 16); its change is parallax.
-  const double u0 = b0 + s0->odometry.theta;
-  const double u1 = b1 + s1->odometry.theta;
+  const double u1 = s1.bearings[static_cast<std::size_t>(j)] + s1.odometry.theta;
   const double u2 = bearing + odometry_.theta;
-  const double path01 = s1->odometry.path_length - s0->odometry.path_length;
-  const double path12 = odometry_.path_length - s1->odometry.path_length;
-  // Parallax per metre; none known when the robot turned on the spot in between.
-  const double rate = path01 > 0.01 ? angle_diff(u1, u0) / path01 : 0.0;
-  const double predicted = u1 + rate * path12;
+  const double predicted = u1 + rate * (odometry_.path_length - s1.odometry.path_length);
   // Camera swing under rotation (rho_max), as in the gate, bounds what is not predicted.
-  const double d_theta = odometry_.theta - s1->odometry.theta;
+  const double d_theta = odometry_.theta - s1.odometry.theta;
   const double swing = 2.0 * options_.gate.max_camera_offset * std::abs(std::sin(0.5 * d_theta));
   const double tol = options_.continuity_tolerance +
                      std::asin(std::min(1.0, swing / options_.gate.min_feature_distance));
@@ -327,20 +305,37 @@ bool Tracker::continues_track(int k, int j, double bearing) {
 }
 
 void Tracker::store_frame(const FrameFeatures& frame, const std::vector<TrackAssignment>& out) {
+  const int n = static_cast<int>(frame.lines.size());
+  // Track continuity: each line's parallax per metre, from its link when that spans at most 3
+  // frames (NaN: unknown). Computed before the slot of frame t - look_back is overwritten.
+  rates_.assign(static_cast<std::size_t>(n), std::numeric_limits<double>::quiet_NaN());
+  if (options_.continuity_tolerance > 0.0 && options_.gate.enabled) {
+    for (int i = 0; i < n; ++i) {
+      const TrackAssignment& a = out[static_cast<std::size_t>(i)];
+      if (a.frames_back < 1 || a.frames_back > 3 || a.matched_line < 0) continue;
+      const Slot& s0 = slot_back(a.frames_back);
+      const double u0 = s0.bearings[static_cast<std::size_t>(a.matched_line)] + s0.odometry.theta;
+      const double u1 = frame.lines[static_cast<std::size_t>(i)].bearing + odometry_.theta;
+      const double path = odometry_.path_length - s0.odometry.path_length;
+      // None known when the robot turned on the spot in between.
+      rates_[static_cast<std::size_t>(i)] = path > 0.01 ? angle_diff(u1, u0) / path : 0.0;
+    }
+  }
   // The slot of frame t replaces that of frame t - look_back, which is no longer needed.
   Slot& slot = ring_[static_cast<std::size_t>(frame_count_ % options_.look_back)];
-  const int n = static_cast<int>(frame.lines.size());
   const Eigen::Index cols = frame.descriptors.cols();
   if (slot.descriptors.rows() < n || slot.descriptors.cols() != cols) {
     slot.descriptors.resize(line_capacity(std::max<Eigen::Index>(slot.descriptors.rows(), n)),
                             cols);
     slot.bearings.reserve(static_cast<std::size_t>(slot.descriptors.rows()));
     slot.polarities.reserve(static_cast<std::size_t>(slot.descriptors.rows()));
+    slot.parallax_rates.reserve(static_cast<std::size_t>(slot.descriptors.rows()));
     slot.track_ids.reserve(static_cast<std::size_t>(slot.descriptors.rows()));
   }
   if (n > 0) slot.descriptors.topRows(n) = frame.descriptors;
   slot.bearings.resize(static_cast<std::size_t>(n));
   slot.polarities.resize(static_cast<std::size_t>(n));
+  slot.parallax_rates.assign(rates_.begin(), rates_.end());
   slot.track_ids.resize(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) {
     slot.bearings[static_cast<std::size_t>(i)] = frame.lines[static_cast<std::size_t>(i)].bearing;

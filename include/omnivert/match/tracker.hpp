@@ -54,8 +54,9 @@ struct TrackerOptions {
   // Track continuity (needs the odometry gate's wheel data; 0 = off): a link to track T is
   // refused when the new bearing deviates from T's predicted one by more than this (radians)
   // plus the gate's camera-swing term. The prediction removes the robot's rotation (eq. 16) and
-  // extrapolates T's parallax per metre driven, measured between its last two observations
-  // (up to 3 frames apart). It targets two close edges that extraction finds in turn.
+  // extrapolates the parallax per metre driven of the observation linked to, measured on that
+  // observation's own link when it spans at most 3 frames (otherwise the link is not checked).
+  // It targets two close edges that extraction finds in turn.
   double continuity_tolerance = 0.0;
 
   bool IsValid(std::string* error) const;
@@ -124,6 +125,7 @@ class Tracker {
     DescriptorMatrix descriptors;  // capacity rows; the first `num_lines` are live
     std::vector<double> bearings;
     std::vector<int> polarities;
+    std::vector<double> parallax_rates;  // continuity: rad per metre driven, NaN = unknown
     std::vector<std::int64_t> track_ids;
     int num_lines = 0;
     OdometryAccumulator odometry;
@@ -136,6 +138,7 @@ class Tracker {
   // TrackerOptions::continuity_tolerance: may line `bearing` of the new frame continue the
   // track of line j of frame t-k?
   bool continues_track(int k, int j, double bearing);
+  std::vector<double> rates_;  // work space of store_frame
 
   TrackerOptions options_;
   Matcher matcher_;
