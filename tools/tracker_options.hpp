@@ -44,7 +44,7 @@ inline void add_tracker_options(CLI::App* cmd, TrackerFlags& t) {
   const std::string g = "Tracking (Sec. 4, 9.1)";
   cmd->add_option("--rules", t.rules,
                   "paper: the three matching rules alone; recommended: plus mutual (one-to-one), same "
-                  "edge polarity "
+                  "edge polarity, track continuity "
                   "matching and the odometry bearing gate (docs/tracking.md)")
       ->check(CLI::IsMember({"paper", "recommended"}))
       ->capture_default_str()
