@@ -374,18 +374,21 @@ Dataset Dataset::load(const std::string& dir, const LoadOptions& options) {
     im.path = rel(dir, "cam0/data/" + im.filename);
     if (!fs::is_regular_file(im.path, ec)) {
       if (!options.allow_missing_images) {
-        throw InputError(cam_csv, r.line, "image file '" + im.filename + "' not found in cam0/data/");
+        throw InputError(
+            cam_csv, r.line, "image file '" + im.filename + "' not found in cam0/data/");
       }
       im.missing = true;
     }
     d.images_.push_back(std::move(im));
   }
   if (d.images_.empty()) throw InputError(cam_csv, 0, "no images listed");
-  const auto first_present = std::find_if(d.images_.begin(), d.images_.end(),
-                                          [](const ImageRecord& im) { return !im.missing; });
+  const auto first_present = std::find_if(
+      d.images_.begin(), d.images_.end(), [](const ImageRecord& im) { return !im.missing; });
   if (first_present == d.images_.end()) {
-    throw InputError(cam_csv, 0, "none of the " + std::to_string(d.images_.size()) +
-                                     " listed image files exists in cam0/data/");
+    throw InputError(cam_csv,
+                     0,
+                     "none of the " + std::to_string(d.images_.size()) +
+                         " listed image files exists in cam0/data/");
   }
   if (options.check_all_images) {
     for (std::size_t i = 0; i < d.images_.size(); ++i) {
@@ -427,7 +430,8 @@ cv::Mat1b Dataset::image(std::size_t i) const {
   if (i >= images_.size()) throw std::out_of_range("image index out of range");
   const ImageRecord& im = images_[i];
   if (im.missing) {
-    throw InputError(rel(root_, "cam0/data.csv"), im.line,
+    throw InputError(rel(root_, "cam0/data.csv"),
+                     im.line,
                      "image file '" + im.filename + "' not found in cam0/data/");
   }
   return read_checked_image(im.path, camera_);

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <bit>
-#include <cmath>
 #include <cassert>
+#include <cmath>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -340,7 +340,8 @@ void Tracker::store_frame(const FrameFeatures& frame, const std::vector<TrackAss
   slot.track_ids.resize(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) {
     slot.bearings[static_cast<std::size_t>(i)] = frame.lines[static_cast<std::size_t>(i)].bearing;
-    slot.polarities[static_cast<std::size_t>(i)] = frame.lines[static_cast<std::size_t>(i)].polarity;
+    slot.polarities[static_cast<std::size_t>(i)] =
+        frame.lines[static_cast<std::size_t>(i)].polarity;
     slot.track_ids[static_cast<std::size_t>(i)] = out[static_cast<std::size_t>(i)].track_id;
   }
   slot.num_lines = n;

@@ -184,16 +184,19 @@ TEST(TrackingEval, DoubleClaimDuringTurnUsesMatchedLine) {
     truth.push_back(gt(f, 1, -3.0 * f * deg));
     truth.push_back(gt(f, 2, (2.0 - 3.0 * f) * deg));
   }
-  auto row = [&](std::int64_t frame, int line, double bearing, std::int64_t matched,
-                 int matched_line) {
-    TrackRow r = det(frame, 5, bearing, matched);
-    r.line = line;
-    r.matched_line = matched_line;
-    return r;
-  };
-  std::vector<TrackRow> tracks = {row(0, 0, 0.0, -1, -1),          row(0, 1, 2.0 * deg, -1, -1),
-                                  row(1, 0, -3.0 * deg, 0, 0),     row(1, 1, -1.0 * deg, 0, 1),
-                                  row(2, 0, -6.0 * deg, 1, 0),     row(2, 1, -4.0 * deg, 1, 1)};
+  auto row =
+      [&](std::int64_t frame, int line, double bearing, std::int64_t matched, int matched_line) {
+        TrackRow r = det(frame, 5, bearing, matched);
+        r.line = line;
+        r.matched_line = matched_line;
+        return r;
+      };
+  std::vector<TrackRow> tracks = {row(0, 0, 0.0, -1, -1),
+                                  row(0, 1, 2.0 * deg, -1, -1),
+                                  row(1, 0, -3.0 * deg, 0, 0),
+                                  row(1, 1, -1.0 * deg, 0, 1),
+                                  row(2, 0, -6.0 * deg, 1, 0),
+                                  row(2, 1, -4.0 * deg, 1, 1)};
   TrackingEvaluation ev = evaluate_tracking(tracks, truth, options());
   EXPECT_EQ(ev.total.matches, 4);
   EXPECT_EQ(ev.total.correct, 4);

@@ -478,7 +478,8 @@ TEST(Tracker, GateCandidatesResolveLookAlikes) {
     std::vector<TrackAssignment> out0, out1;
     tracker.add_frame(f0, WheelIncrement{}, &out0);
     tracker.add_frame(f1, turn, &out1);
-    for (int k : {0, 1, 4, 5}) EXPECT_EQ(out1[static_cast<std::size_t>(k)].track_id, out0[k].track_id);
+    for (int k : {0, 1, 4, 5})
+      EXPECT_EQ(out1[static_cast<std::size_t>(k)].track_id, out0[k].track_id);
     for (int k : {2, 3}) {
       if (restrict) {
         EXPECT_EQ(out1[static_cast<std::size_t>(k)].track_id, out0[k].track_id) << k;
@@ -518,7 +519,8 @@ TEST(Tracker, SamePolarityKeepsOppositeEdgesApart) {
       std::vector<TrackAssignment> out0, out1;
       tracker.add_frame(g0, &out0);
       tracker.add_frame(g1, &out1);
-      for (int k : {0, 1, 3, 4, 5}) EXPECT_EQ(out1[static_cast<std::size_t>(k)].track_id, out0[k].track_id);
+      for (int k : {0, 1, 3, 4, 5})
+        EXPECT_EQ(out1[static_cast<std::size_t>(k)].track_id, out0[k].track_id);
       if (same && !unknown) {
         EXPECT_TRUE(out1[2].is_new());
       } else {
@@ -563,10 +565,12 @@ TEST(Tracker, ContinuityRefusesAJumpToTheNeighbourEdge) {
     tracker.add_frame(frame(0, false), WheelIncrement{}, &out0);
     for (int f = 1; f <= 2; ++f) {
       tracker.add_frame(frame(f, false), straight, &out);
-      for (int k = 0; k < 6; ++k) EXPECT_EQ(out[static_cast<std::size_t>(k)].track_id, out0[k].track_id);
+      for (int k = 0; k < 6; ++k)
+        EXPECT_EQ(out[static_cast<std::size_t>(k)].track_id, out0[k].track_id);
     }
     tracker.add_frame(frame(3, true), straight, &out);
-    for (int k : {0, 1, 3, 4, 5}) EXPECT_EQ(out[static_cast<std::size_t>(k)].track_id, out0[k].track_id);
+    for (int k : {0, 1, 3, 4, 5})
+      EXPECT_EQ(out[static_cast<std::size_t>(k)].track_id, out0[k].track_id);
     if (tol > 0.0) {
       EXPECT_TRUE(out[2].is_new());
       EXPECT_GE(tracker.stats().rejected_continuity, 1);
