@@ -76,14 +76,17 @@ inline void add_tracker_options(CLI::App* cmd, TrackerFlags& t) {
                   t.continuity_deg,
                   "Track continuity tolerance [degrees]: refuse links that deviate more from the "
                   "track's predicted bearing (needs wheel data; 0: off; default: the rule set's)")
+      ->check(CLI::Range(0.0, 179.0))
       ->group(g);
   cmd->add_option("--gate-min-distance",
                   t.gate_min_distance,
                   "Odometry gate: nearest distance of a line from the camera [m] (default 0.5)")
+      ->check(CLI::PositiveNumber)
       ->group(g);
   cmd->add_option("--gate-tolerance",
                   t.gate_tolerance_deg,
                   "Odometry gate: bearing detection tolerance [degrees] (default 2)")
+      ->check(CLI::Range(0.0, 179.0))
       ->group(g);
   cmd->add_option("--f1", t.f1, "Test 1, eq. (8): min distance <= F1")->check(CLI::PositiveNumber)->capture_default_str()->group(g);
   cmd->add_option("--f2", t.f2, "Test 2, eq. (9): min <= F2 * mean")->check(CLI::Range(0.0, 1.0))->capture_default_str()->group(g);
