@@ -43,7 +43,7 @@ TrackerOptions recommended_tracker_options(double wheel_base) {
   TrackerOptions o;
   o.mutual = true;
   o.same_polarity = true;
-  o.continuity_tolerance = deg2rad(0.6);  // used when the gate (odometry) is on
+  o.continuity_tolerance = deg2rad(1.0);  // used when the gate (odometry) is on
   if (wheel_base > 0.0) {
     o.gate.enabled = true;
     o.gate.wheel_base = wheel_base;

@@ -601,7 +601,7 @@ TEST(TrackerOptions, PaperAndRecommended) {
   EXPECT_TRUE(r.IsValid(&error)) << error;
   EXPECT_TRUE(r.mutual);
   EXPECT_TRUE(r.same_polarity);
-  EXPECT_NEAR(r.continuity_tolerance, 0.6 * kPi / 180.0, 1e-12);
+  EXPECT_NEAR(r.continuity_tolerance, 1.0 * kPi / 180.0, 1e-12);
   EXPECT_TRUE(r.gate.enabled);
   EXPECT_DOUBLE_EQ(r.gate.wheel_base, 0.45);
   const TrackerOptions no_odometry = recommended_tracker_options(0.0);

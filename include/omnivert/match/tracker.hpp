@@ -65,7 +65,7 @@ struct TrackerOptions {
 // The paper's tracker alone: tests 1-3 with Table 2's factors, look-back 20 (Sec. 9.1).
 TrackerOptions paper_tracker_options();
 // What we recommend (docs/tracking.md, measured there): the paper's rules plus the mutual
-// constraint, same edge polarity, and the odometry gate with track continuity (0.6 degree)
+// constraint, same edge polarity, and the odometry gate with track continuity (1 degree)
 // when the wheel base is known
 // (wheel_base > 0; pass 0 when there is no odometry).
 TrackerOptions recommended_tracker_options(double wheel_base);
