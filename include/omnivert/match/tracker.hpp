@@ -20,6 +20,9 @@
 //    take the same id (the paper's behaviour).
 //  - odometry gate (odometry_gate.hpp): an accepted match whose bearing change contradicts
 //    the wheel travel since the candidate frame is vetoed; the line goes on looking back.
+//  - same polarity, gate-restricted candidates, track continuity: see TrackerOptions and
+//    docs/tracking.md Sec. 3 (recommended_tracker_options() turns on mutual, the gate, same
+//    polarity and continuity).
 //
 // Bookkeeping: a ring buffer holds the last `look_back` frames (descriptors, bearings, track
 // ids, accumulated odometry). Buffers grow to the largest frame seen and are then reused: no
