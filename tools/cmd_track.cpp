@@ -32,6 +32,7 @@ void run_track(const TrackArgs& a) {
   if (!a.pipeline.IsValid(&why)) throw InputError("invalid extraction options: " + why);
   dataset::LoadOptions lo;
   lo.require_wheel = false;
+  lo.allow_missing_images = true;  // a missing frame is warned about and skipped (no lines)
   const auto data = dataset::Dataset::load(a.dataset, lo);
   std::error_code ec;
   fs::create_directories(a.out, ec);

@@ -4,13 +4,16 @@
 #include <cstdio>
 #include <exception>
 
-#include <CLI/CLI.hpp>
+#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
+#include <CLI/CLI.hpp>
 
 #include "commands.hpp"
 #include "omnivert/core/error.hpp"
 
 int main(int argc, char** argv) {
+  // Warnings and log lines go to stderr: stdout carries results (tables, summaries).
+  spdlog::set_default_logger(spdlog::stderr_color_mt("omnivert"));
   CLI::App app{"omnivert: vertical lines in omnidirectional images (extraction, description, "
                "tracking, camera-odometry self-calibration)"};
   app.require_subcommand(1);

@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "omnivert/core/angles.hpp"
 #include "omnivert/match/tracker.hpp"
 
 namespace omnivert::cli {
@@ -16,6 +17,10 @@ struct TrackerFlags {
   bool no_gate = false;
   int look_back = 20;
   double f1 = 1.05, f2 = 0.75, f3 = 0.8;
+  std::string gate_candidates = "default";                     // on|off|default (the rule set's)
+  double gate_min_distance = -1.0, gate_tolerance_deg = -1.0;  // < 0: the default
+  std::string same_polarity = "default";                       // on|off|default (the rule set's)
+  double continuity_deg = -1.0;                                // < 0: the rule set's
 
   // The options these flags select (the wheel base is filled in from the dataset).
   TrackerOptions options() const {
@@ -26,15 +31,23 @@ struct TrackerFlags {
     o.match.f1 = f1;
     o.match.f2 = f2;
     o.match.f3 = f3;
+    if (gate_candidates != "default") o.gate_candidates = gate_candidates == "on";
+    if (continuity_deg >= 0.0) o.continuity_tolerance = deg2rad(continuity_deg);
+    if (same_polarity != "default") o.same_polarity = same_polarity == "on";
+    if (gate_min_distance > 0.0) o.gate.min_feature_distance = gate_min_distance;
+    if (gate_tolerance_deg >= 0.0) o.gate.bearing_tolerance = deg2rad(gate_tolerance_deg);
     return o;
   }
 };
 
 inline void add_tracker_options(CLI::App* cmd, TrackerFlags& t) {
   const std::string g = "Tracking (Sec. 4, 9.1)";
-  cmd->add_option("--rules", t.rules,
-                  "paper: the three matching rules alone; recommended: plus mutual (one-to-one) "
-                  "matching and the odometry bearing gate (docs/tracking.md)")
+  cmd->add_option(
+         "--rules",
+         t.rules,
+         "paper: the three matching rules alone; recommended: plus mutual (one-to-one), same "
+         "edge polarity, track continuity "
+         "matching and the odometry bearing gate (docs/tracking.md)")
       ->check(CLI::IsMember({"paper", "recommended"}))
       ->capture_default_str()
       ->group(g);
@@ -43,6 +56,37 @@ inline void add_tracker_options(CLI::App* cmd, TrackerFlags& t) {
   cmd->add_option("--look-back", t.look_back, "Frames searched back for an unmatched line")
       ->check(CLI::Range(1, 1000))
       ->capture_default_str()
+      ->group(g);
+  cmd->add_option(
+         "--gate-candidates",
+         t.gate_candidates,
+         "on: tests 1 and 3 and the mutual check among the lines the odometry gate admits; "
+         "off: the gate only vetoes the nearest line (default: the rule set's)")
+      ->check(CLI::IsMember({"on", "off", "default"}))
+      ->capture_default_str()
+      ->group(g);
+  cmd->add_option("--same-polarity",
+                  t.same_polarity,
+                  "on: a line is matched only to lines of the same edge polarity (default: the "
+                  "rule set's)")
+      ->check(CLI::IsMember({"on", "off", "default"}))
+      ->capture_default_str()
+      ->group(g);
+  cmd->add_option("--continuity",
+                  t.continuity_deg,
+                  "Track continuity tolerance [degrees]: refuse links that deviate more from the "
+                  "track's predicted bearing (needs wheel data; 0: off; default: the rule set's)")
+      ->check(CLI::Range(0.0, 179.0))
+      ->group(g);
+  cmd->add_option("--gate-min-distance",
+                  t.gate_min_distance,
+                  "Odometry gate: nearest distance of a line from the camera [m] (default 0.5)")
+      ->check(CLI::PositiveNumber)
+      ->group(g);
+  cmd->add_option("--gate-tolerance",
+                  t.gate_tolerance_deg,
+                  "Odometry gate: bearing detection tolerance [degrees] (default 2)")
+      ->check(CLI::Range(0.0, 179.0))
       ->group(g);
   cmd->add_option("--f1", t.f1, "Test 1, eq. (8): min distance <= F1")->check(CLI::PositiveNumber)->capture_default_str()->group(g);
   cmd->add_option("--f2", t.f2, "Test 2, eq. (9): min <= F2 * mean")->check(CLI::Range(0.0, 1.0))->capture_default_str()->group(g);

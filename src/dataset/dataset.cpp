@@ -1,5 +1,6 @@
 #include "omnivert/dataset/dataset.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
@@ -372,15 +373,29 @@ Dataset Dataset::load(const std::string& dir, const LoadOptions& options) {
     if (im.filename.empty()) throw InputError(cam_csv, r.line, "empty file name");
     im.path = rel(dir, "cam0/data/" + im.filename);
     if (!fs::is_regular_file(im.path, ec)) {
-      throw InputError(cam_csv, r.line, "image file '" + im.filename + "' not found in cam0/data/");
+      if (!options.allow_missing_images) {
+        throw InputError(
+            cam_csv, r.line, "image file '" + im.filename + "' not found in cam0/data/");
+      }
+      im.missing = true;
     }
     d.images_.push_back(std::move(im));
   }
   if (d.images_.empty()) throw InputError(cam_csv, 0, "no images listed");
+  const auto first_present = std::find_if(
+      d.images_.begin(), d.images_.end(), [](const ImageRecord& im) { return !im.missing; });
+  if (first_present == d.images_.end()) {
+    throw InputError(cam_csv,
+                     0,
+                     "none of the " + std::to_string(d.images_.size()) +
+                         " listed image files exists in cam0/data/");
+  }
   if (options.check_all_images) {
-    for (std::size_t i = 0; i < d.images_.size(); ++i) (void)d.image(i);
+    for (std::size_t i = 0; i < d.images_.size(); ++i) {
+      if (!d.images_[i].missing) (void)d.image(i);
+    }
   } else {
-    (void)d.image(0);
+    (void)d.image(static_cast<std::size_t>(first_present - d.images_.begin()));
   }
 
   // Wheels.
@@ -413,7 +428,13 @@ Dataset Dataset::load(const std::string& dir, const LoadOptions& options) {
 
 cv::Mat1b Dataset::image(std::size_t i) const {
   if (i >= images_.size()) throw std::out_of_range("image index out of range");
-  return read_checked_image(images_[i].path, camera_);
+  const ImageRecord& im = images_[i];
+  if (im.missing) {
+    throw InputError(rel(root_, "cam0/data.csv"),
+                     im.line,
+                     "image file '" + im.filename + "' not found in cam0/data/");
+  }
+  return read_checked_image(im.path, camera_);
 }
 
 WheelTravel Dataset::travel_at(std::int64_t t) const {

@@ -181,9 +181,20 @@ TrackingEvaluation evaluate_tracking(const std::vector<TrackRow>& tracks,
           }
         }
       }
+      // The exact predecessor when the file names the matched line (matched_line); else, if
+      // the track holds several lines in pred_frame (a double claim), the nearest bearing. That
+      // guess goes wrong when the scene turns faster than the two lines are apart, so files
+      // written by omnivert carry matched_line.
       std::size_t pred = n;
+      if (d.matched_line >= 0 && pred_frame == d.matched_frame) {
+        for (std::size_t m = 0; m < k; ++m) {
+          const std::size_t j = dets[m];
+          if (tracks[j].frame == pred_frame && tracks[j].line == d.matched_line) pred = j;
+        }
+      }
       double pred_d = 10.0;
-      for (std::size_t m = 0; m < k; ++m) {
+      const bool exact = pred < n;
+      for (std::size_t m = 0; m < k && !exact; ++m) {
         const std::size_t j = dets[m];
         if (tracks[j].frame != pred_frame) continue;
         const double dd = std::abs(angle_diff(tracks[j].bearing, d.bearing));

@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <bit>
 #include <cassert>
+#include <cmath>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
 
+#include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
 
 namespace omnivert {
@@ -28,6 +30,10 @@ bool TrackerOptions::IsValid(std::string* error) const {
     if (error) *error = "look-back must be between 1 and 1000 frames (paper: 20)";
     return false;
   }
+  if (!(continuity_tolerance >= 0.0 && continuity_tolerance < kPi)) {
+    if (error) *error = "continuity tolerance must be in [0, pi) radians (0: off)";
+    return false;
+  }
   return gate.IsValid(error);
 }
 
@@ -36,6 +42,8 @@ TrackerOptions paper_tracker_options() { return TrackerOptions{}; }
 TrackerOptions recommended_tracker_options(double wheel_base) {
   TrackerOptions o;
   o.mutual = true;
+  o.same_polarity = true;
+  o.continuity_tolerance = deg2rad(1.0);  // used when the gate (odometry) is on
   if (wheel_base > 0.0) {
     o.gate.enabled = true;
     o.gate.wheel_base = wheel_base;
@@ -49,7 +57,8 @@ std::string TrackerStats::BriefReport() const {
     << " matched in the previous frame, " << matched_look_back << " by look-back, " << new_tracks
     << " new tracks; rejected: test1 " << rejected_test1 << ", test2 " << rejected_test2
     << ", test3 " << rejected_test3 << ", mutual " << rejected_mutual << ", claimed "
-    << rejected_claimed << ", odometry gate " << rejected_gate;
+    << rejected_claimed << ", odometry gate " << rejected_gate << ", continuity "
+    << rejected_continuity;
   return s.str();
 }
 
@@ -100,6 +109,7 @@ void Tracker::add_frame(const FrameFeatures& frame,
   if (static_cast<Eigen::Index>(unmatched_.capacity()) < n) {
     const auto cap = static_cast<std::size_t>(line_capacity(n));
     unmatched_.reserve(cap);
+    rates_.reserve(cap);
     still_unmatched_.reserve(cap);
     claimed_.reserve(cap);
   }
@@ -130,6 +140,53 @@ void Tracker::add_frame(const FrameFeatures& frame,
     const BearingGate gate = options_.gate.enabled
                                  ? make_bearing_gate(options_.gate, slot.odometry, odometry_)
                                  : BearingGate{};
+    const bool gate_restricts =
+        options_.gate.enabled && options_.gate_candidates && gate.informative;
+    const bool restrict = gate_restricts || options_.same_polarity;
+    // Whether line `a` of the new frame may be matched to line `j` of frame t-k.
+    auto admissible = [&](int a, int j) {
+      const VerticalLine& l = frame.lines[static_cast<std::size_t>(a)];
+      if (options_.same_polarity) {
+        const int pj = slot.polarities[static_cast<std::size_t>(j)];
+        if (l.polarity != 0 && pj != 0 && l.polarity != pj) return false;
+      }
+      return !gate_restricts || gate.admits(slot.bearings[static_cast<std::size_t>(j)], l.bearing);
+    };
+    if (restrict) {
+      // Tests 1 and 3 among the admissible candidates; test 2's mean over all of them.
+      const auto d = matcher_.last_distances();
+      const int nc = static_cast<int>(slot.num_lines);
+      for (int q = 0; q < nq; ++q) {
+        const int line = unmatched_[static_cast<std::size_t>(q)];
+        MatchResult& r = results_[static_cast<std::size_t>(q)];
+        float best = std::numeric_limits<float>::infinity(), second = best;
+        int best_j = -1, admitted = 0;
+        for (int j = 0; j < nc; ++j) {
+          if (!admissible(line, j)) continue;
+          ++admitted;
+          const float v = d(q, j);
+          if (v < best) {
+            second = best;
+            best = v;
+            best_j = j;
+          } else if (v < second) {
+            second = v;
+          }
+        }
+        if (admitted == 0) {
+          if (r.accepted()) ++stats_.rejected_gate;
+          r.best = -1;
+          r.verdict = MatchVerdict::kNoCandidates;
+          continue;
+        }
+        r.best = best_j;
+        r.min_distance = best;
+        r.second_distance = second;
+        // N_B = all lines of the frame (test 2's mean over them); with one admitted candidate
+        // the second distance is +inf and test 3 is vacuous.
+        r.verdict = apply_match_tests(options_.match, nc, best, second, r.mean_distance);
+      }
+    }
     still_unmatched_.clear();
     for (int q = 0; q < nq; ++q) {
       const int i = unmatched_[static_cast<std::size_t>(q)];
@@ -154,7 +211,19 @@ void Tracker::add_frame(const FrameFeatures& frame,
         // lines are processed): the nearest line of the new frame to B_best must be A_i.
         // Computed for the accepted candidate only (n dot products), ties to lowest index.
         int nearest = -1;
-        if (all_rows) {
+        if (restrict) {
+          // Among the lines of the new frame admissible for B_best.
+          const auto b = slot.descriptors.row(r.best);
+          float nearest_sq = std::numeric_limits<float>::infinity();
+          for (int a = 0; a < n; ++a) {
+            if (!admissible(a, r.best)) continue;
+            const float sq = (frame.descriptors.row(a) - b).squaredNorm();
+            if (sq < nearest_sq) {
+              nearest_sq = sq;
+              nearest = a;
+            }
+          }
+        } else if (all_rows) {
           // The whole column of distances to B_best is at hand (row q is line q).
           Eigen::Index idx = 0;
           matcher_.last_distances().col(r.best).minCoeff(&idx);
@@ -183,6 +252,11 @@ void Tracker::add_frame(const FrameFeatures& frame,
           !gate.admits(slot.bearings[static_cast<std::size_t>(r.best)],
                        frame.lines[static_cast<std::size_t>(i)].bearing)) {
         ++stats_.rejected_gate;
+        ok = false;
+      }
+      if (ok && options_.gate.enabled && options_.continuity_tolerance > 0.0 &&
+          !continues_track(k, r.best, frame.lines[static_cast<std::size_t>(i)].bearing)) {
+        ++stats_.rejected_continuity;
         ok = false;
       }
       if (!ok) {
@@ -215,22 +289,59 @@ void Tracker::add_frame(const FrameFeatures& frame,
   stats_.lines += n;
 }
 
+bool Tracker::continues_track(int k, int j, double bearing) {
+  const Slot& s1 = slot_back(k);
+  const double rate = s1.parallax_rates[static_cast<std::size_t>(j)];
+  if (std::isnan(rate)) return true;  // no recent history: nothing to predict from
+  // u = bearing + theta is free of the robot's rotation (eq. 16); its change is parallax.
+  const double u1 = s1.bearings[static_cast<std::size_t>(j)] + s1.odometry.theta;
+  const double u2 = bearing + odometry_.theta;
+  const double predicted = u1 + rate * (odometry_.path_length - s1.odometry.path_length);
+  // Camera swing under rotation (rho_max), as in the gate, bounds what is not predicted.
+  const double d_theta = odometry_.theta - s1.odometry.theta;
+  const double swing = 2.0 * options_.gate.max_camera_offset * std::abs(std::sin(0.5 * d_theta));
+  const double tol = options_.continuity_tolerance +
+                     std::asin(std::min(1.0, swing / options_.gate.min_feature_distance));
+  return std::abs(angle_diff(u2, predicted)) <= tol;
+}
+
 void Tracker::store_frame(const FrameFeatures& frame, const std::vector<TrackAssignment>& out) {
+  const int n = static_cast<int>(frame.lines.size());
+  // Track continuity: each line's parallax per metre, from its link when that spans at most 3
+  // frames (NaN: unknown). Computed before the slot of frame t - look_back is overwritten.
+  rates_.assign(static_cast<std::size_t>(n), std::numeric_limits<double>::quiet_NaN());
+  if (options_.continuity_tolerance > 0.0 && options_.gate.enabled) {
+    for (int i = 0; i < n; ++i) {
+      const TrackAssignment& a = out[static_cast<std::size_t>(i)];
+      if (a.frames_back < 1 || a.frames_back > 3 || a.matched_line < 0) continue;
+      const Slot& s0 = slot_back(a.frames_back);
+      const double u0 = s0.bearings[static_cast<std::size_t>(a.matched_line)] + s0.odometry.theta;
+      const double u1 = frame.lines[static_cast<std::size_t>(i)].bearing + odometry_.theta;
+      const double path = odometry_.path_length - s0.odometry.path_length;
+      // None known when the robot turned on the spot in between.
+      rates_[static_cast<std::size_t>(i)] = path > 0.01 ? angle_diff(u1, u0) / path : 0.0;
+    }
+  }
   // The slot of frame t replaces that of frame t - look_back, which is no longer needed.
   Slot& slot = ring_[static_cast<std::size_t>(frame_count_ % options_.look_back)];
-  const int n = static_cast<int>(frame.lines.size());
   const Eigen::Index cols = frame.descriptors.cols();
   if (slot.descriptors.rows() < n || slot.descriptors.cols() != cols) {
     slot.descriptors.resize(line_capacity(std::max<Eigen::Index>(slot.descriptors.rows(), n)),
                             cols);
     slot.bearings.reserve(static_cast<std::size_t>(slot.descriptors.rows()));
+    slot.polarities.reserve(static_cast<std::size_t>(slot.descriptors.rows()));
+    slot.parallax_rates.reserve(static_cast<std::size_t>(slot.descriptors.rows()));
     slot.track_ids.reserve(static_cast<std::size_t>(slot.descriptors.rows()));
   }
   if (n > 0) slot.descriptors.topRows(n) = frame.descriptors;
   slot.bearings.resize(static_cast<std::size_t>(n));
+  slot.polarities.resize(static_cast<std::size_t>(n));
+  slot.parallax_rates.assign(rates_.begin(), rates_.end());
   slot.track_ids.resize(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) {
     slot.bearings[static_cast<std::size_t>(i)] = frame.lines[static_cast<std::size_t>(i)].bearing;
+    slot.polarities[static_cast<std::size_t>(i)] =
+        frame.lines[static_cast<std::size_t>(i)].polarity;
     slot.track_ids[static_cast<std::size_t>(i)] = out[static_cast<std::size_t>(i)].track_id;
   }
   slot.num_lines = n;

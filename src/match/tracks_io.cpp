@@ -76,6 +76,8 @@ void append_track_rows(std::int64_t frame_index,
     r.r_outer = l.r_outer;
     r.matched_frame = a.is_new() ? -1 : frame_index - a.frames_back;
     r.distance = a.distance;
+    r.line = static_cast<int>(i);
+    r.matched_line = a.is_new() ? -1 : a.matched_line;
     rows->push_back(r);
   }
 }
@@ -85,12 +87,12 @@ void write_tracks_csv(const fs::path& path, const std::vector<TrackRow>& rows) {
   out.reserve(rows.size() * 96 + 128);
   out +=
       "frame,timestamp_ns,track_id,bearing_rad,image_angle_rad,edge_pixels,r_inner,r_outer,"
-      "matched_frame,distance\n";
+      "matched_frame,distance,line,matched_line\n";
   char buf[256];
   for (const TrackRow& r : rows) {
     const int n = std::snprintf(buf,
                                 sizeof(buf),
-                                "%lld,%lld,%lld,%.9f,%.9f,%d,%.3f,%.3f,%lld,%.6f\n",
+                                "%lld,%lld,%lld,%.9f,%.9f,%d,%.3f,%.3f,%lld,%.6f,%d,%d\n",
                                 static_cast<long long>(r.frame),
                                 static_cast<long long>(r.timestamp_ns),
                                 static_cast<long long>(r.track_id),
@@ -100,7 +102,9 @@ void write_tracks_csv(const fs::path& path, const std::vector<TrackRow>& rows) {
                                 r.r_inner,
                                 r.r_outer,
                                 static_cast<long long>(r.matched_frame),
-                                r.distance);
+                                r.distance,
+                                r.line,
+                                r.matched_line);
     out.append(buf, static_cast<std::size_t>(n));
   }
   write_text_atomic(path.string(), out);
@@ -175,6 +179,10 @@ std::vector<TrackRow> read_tracks_csv(const fs::path& path) {
     }
     if (has("distance"))
       r.distance = parse_number<double>(field("distance"), file, line_no, "distance");
+    if (has("line")) r.line = parse_number<int>(field("line"), file, line_no, "line");
+    if (has("matched_line")) {
+      r.matched_line = parse_number<int>(field("matched_line"), file, line_no, "matched_line");
+    }
     rows.push_back(r);
   }
   if (!have_header) throw InputError(file, 0, "empty file: no header line");

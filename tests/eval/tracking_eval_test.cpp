@@ -174,6 +174,38 @@ TEST(TrackingEval, DoubleClaimCountsAsFalseMatch) {
   EXPECT_EQ(ev.total.false_matches, 1);
 }
 
+// A double claim while the scene turns 3 degrees a frame and the two lines are 2 degrees
+// apart: by nearest bearing each link of frame 2 would be taken from the wrong line of frame
+// 1 (two false matches); with the matched line named (line, matched_line) both are correct.
+TEST(TrackingEval, DoubleClaimDuringTurnUsesMatchedLine) {
+  const double deg = kPi / 180.0;
+  std::vector<GroundTruthLine> truth;
+  for (int f = 0; f < 3; ++f) {
+    truth.push_back(gt(f, 1, -3.0 * f * deg));
+    truth.push_back(gt(f, 2, (2.0 - 3.0 * f) * deg));
+  }
+  auto row =
+      [&](std::int64_t frame, int line, double bearing, std::int64_t matched, int matched_line) {
+        TrackRow r = det(frame, 5, bearing, matched);
+        r.line = line;
+        r.matched_line = matched_line;
+        return r;
+      };
+  std::vector<TrackRow> tracks = {row(0, 0, 0.0, -1, -1),
+                                  row(0, 1, 2.0 * deg, -1, -1),
+                                  row(1, 0, -3.0 * deg, 0, 0),
+                                  row(1, 1, -1.0 * deg, 0, 1),
+                                  row(2, 0, -6.0 * deg, 1, 0),
+                                  row(2, 1, -4.0 * deg, 1, 1)};
+  TrackingEvaluation ev = evaluate_tracking(tracks, truth, options());
+  EXPECT_EQ(ev.total.matches, 4);
+  EXPECT_EQ(ev.total.correct, 4);
+  EXPECT_EQ(ev.total.false_matches, 0);
+  for (auto& r : tracks) r.matched_line = -1;  // the old file format: nearest bearing
+  ev = evaluate_tracking(tracks, truth, options());
+  EXPECT_EQ(ev.total.false_matches, 2);
+}
+
 // Two lines cross (within 1 degree of each other in frame 2) and the tracks swap there:
 // one false match per track, where the lines separate; no false match while they are
 // indistinguishable, and none for tracks that follow their line through the crossing.

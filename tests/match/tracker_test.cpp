@@ -451,6 +451,135 @@ TEST(Tracker, OdometryGateRejectsImpossibleBearingJump) {
   }
 }
 
+// Two look-alike lines (a repeated door frame) 1 rad apart: in the next frame the true line
+// fails test 3 against its twin (and starts a new track) unless the candidates are restricted
+// to those the odometry gate admits (gate_candidates), where the twin is not one of them.
+TEST(Tracker, GateCandidatesResolveLookAlikes) {
+  std::mt19937 rng(43);
+  FrameFeatures f0;
+  f0.descriptors.resize(6, kPaperDescriptorSize);
+  for (int k = 0; k < 6; ++k) {
+    f0.descriptors.row(k) = random_descriptor(rng);
+    VerticalLine v;
+    v.bearing = -2.5 + k;
+    f0.lines.push_back(v);
+  }
+  f0.descriptors.row(3) = perturb(f0.descriptors.row(2), 0.0005f, rng);  // 2's twin
+  const WheelIncrement turn{0.03, -0.03};  // bearings shift by -0.15 rad
+  FrameFeatures f1 = f0;
+  for (int k = 0; k < 6; ++k) {
+    f1.descriptors.row(k) = perturb(f0.descriptors.row(k), 0.004f, rng);
+    f1.lines[static_cast<std::size_t>(k)].bearing = wrap_angle(f0.lines[k].bearing - 0.15);
+  }
+  for (bool restrict : {false, true}) {
+    TrackerOptions o = recommended_tracker_options(0.4);
+    o.gate_candidates = restrict;
+    Tracker tracker(o);
+    std::vector<TrackAssignment> out0, out1;
+    tracker.add_frame(f0, WheelIncrement{}, &out0);
+    tracker.add_frame(f1, turn, &out1);
+    for (int k : {0, 1, 4, 5})
+      EXPECT_EQ(out1[static_cast<std::size_t>(k)].track_id, out0[k].track_id);
+    for (int k : {2, 3}) {
+      if (restrict) {
+        EXPECT_EQ(out1[static_cast<std::size_t>(k)].track_id, out0[k].track_id) << k;
+      } else {
+        EXPECT_TRUE(out1[static_cast<std::size_t>(k)].is_new()) << k;  // test 3 fails
+      }
+    }
+    EXPECT_EQ(tracker.stats().rejected_test3, restrict ? 0 : 2);
+  }
+}
+
+// The other side of a door frame (opposite polarity, a look-alike descriptor) seen where the
+// first side was: linked by the paper's rules, a new track with same_polarity; lines of
+// unknown polarity (0) are not constrained.
+TEST(Tracker, SamePolarityKeepsOppositeEdgesApart) {
+  std::mt19937 rng(47);
+  FrameFeatures f0;
+  f0.descriptors.resize(6, kPaperDescriptorSize);
+  for (int k = 0; k < 6; ++k) {
+    f0.descriptors.row(k) = random_descriptor(rng);
+    VerticalLine v;
+    v.bearing = -2.5 + k;
+    v.polarity = k % 2 ? 1 : -1;
+    f0.lines.push_back(v);
+  }
+  FrameFeatures f1 = f0;
+  for (int k = 0; k < 6; ++k) f1.descriptors.row(k) = perturb(f0.descriptors.row(k), 0.004f, rng);
+  f1.lines[2].polarity = -f0.lines[2].polarity;  // the frame's other side
+  f1.descriptors.row(2) = perturb(f0.descriptors.row(2), 0.02f, rng);
+  for (int unknown : {0, 1}) {
+    for (bool same : {false, true}) {
+      TrackerOptions o;
+      o.same_polarity = same;
+      Tracker tracker(o);
+      FrameFeatures g0 = f0, g1 = f1;
+      if (unknown) g1.lines[2].polarity = 0;
+      std::vector<TrackAssignment> out0, out1;
+      tracker.add_frame(g0, &out0);
+      tracker.add_frame(g1, &out1);
+      for (int k : {0, 1, 3, 4, 5})
+        EXPECT_EQ(out1[static_cast<std::size_t>(k)].track_id, out0[k].track_id);
+      if (same && !unknown) {
+        EXPECT_TRUE(out1[2].is_new());
+      } else {
+        EXPECT_EQ(out1[2].track_id, out0[2].track_id);
+      }
+    }
+  }
+}
+
+// Driving straight, line 2 drifts by 0.2 degree a frame (parallax); in frame 3 extraction finds
+// its neighbour edge instead, 1.3 degrees off the predicted bearing. Continuity refuses that
+// link (a new track); the true continuation of every other line is kept.
+TEST(Tracker, ContinuityRefusesAJumpToTheNeighbourEdge) {
+  std::mt19937 rng(53);
+  const double deg = kPi / 180.0;
+  std::vector<Eigen::RowVectorXf> d;
+  for (int k = 0; k < 6; ++k) d.push_back(random_descriptor(rng));
+  auto frame = [&](int f, bool neighbour) {
+    FrameFeatures fr;
+    fr.descriptors.resize(6, kPaperDescriptorSize);
+    for (int k = 0; k < 6; ++k) {
+      VerticalLine v;
+      v.bearing = -2.5 + k + (k == 2 ? 0.2 * deg * f : 0.0);
+      fr.descriptors.row(k) = perturb(d[static_cast<std::size_t>(k)], 0.004f, rng);
+      if (k == 2 && neighbour) {
+        v.bearing += 1.3 * deg;
+        fr.descriptors.row(k) = perturb(d[2], 0.02f, rng);
+      }
+      fr.lines.push_back(v);
+    }
+    return fr;
+  };
+  const WheelIncrement straight{0.038, 0.038};
+  for (double tol : {0.0, 0.6 * deg}) {
+    TrackerOptions o = recommended_tracker_options(0.4);
+    o.continuity_tolerance = tol;
+    // Frame 0 has no history before it: a link to it would not be checked, so the look-back
+    // stops before it.
+    o.look_back = 2;
+    Tracker tracker(o);
+    std::vector<TrackAssignment> out0, out;
+    tracker.add_frame(frame(0, false), WheelIncrement{}, &out0);
+    for (int f = 1; f <= 2; ++f) {
+      tracker.add_frame(frame(f, false), straight, &out);
+      for (int k = 0; k < 6; ++k)
+        EXPECT_EQ(out[static_cast<std::size_t>(k)].track_id, out0[k].track_id);
+    }
+    tracker.add_frame(frame(3, true), straight, &out);
+    for (int k : {0, 1, 3, 4, 5})
+      EXPECT_EQ(out[static_cast<std::size_t>(k)].track_id, out0[k].track_id);
+    if (tol > 0.0) {
+      EXPECT_TRUE(out[2].is_new());
+      EXPECT_GE(tracker.stats().rejected_continuity, 1);
+    } else {
+      EXPECT_EQ(out[2].track_id, out0[2].track_id);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace omnivert
 
@@ -465,10 +594,14 @@ TEST(TrackerOptions, PaperAndRecommended) {
   EXPECT_DOUBLE_EQ(p.match.f3, 0.8);
   EXPECT_FALSE(p.mutual);
   EXPECT_FALSE(p.gate.enabled);
+  EXPECT_FALSE(p.same_polarity);
+  EXPECT_EQ(p.continuity_tolerance, 0.0);
   std::string error;
   const TrackerOptions r = recommended_tracker_options(0.45);
   EXPECT_TRUE(r.IsValid(&error)) << error;
   EXPECT_TRUE(r.mutual);
+  EXPECT_TRUE(r.same_polarity);
+  EXPECT_NEAR(r.continuity_tolerance, 1.0 * kPi / 180.0, 1e-12);
   EXPECT_TRUE(r.gate.enabled);
   EXPECT_DOUBLE_EQ(r.gate.wheel_base, 0.45);
   const TrackerOptions no_odometry = recommended_tracker_options(0.0);

@@ -48,6 +48,7 @@ TEST(TracksCsv, RoundTrip) {
   as[1].track_id = 9;  // new
   as[2].track_id = 2;
   as[2].frames_back = 5;
+  as[2].matched_line = 4;
   std::vector<TrackRow> rows;
   append_track_rows(12, 1'000'000'123, frame, as, &rows);
   ASSERT_EQ(rows.size(), 3u);
@@ -73,7 +74,11 @@ TEST(TracksCsv, RoundTrip) {
     EXPECT_EQ(back[i].edge_pixels, rows[i].edge_pixels);
     EXPECT_NEAR(back[i].r_outer, 180.25, 1e-9);
     EXPECT_EQ(back[i].matched_frame, rows[i].matched_frame);
+    EXPECT_EQ(back[i].line, static_cast<int>(i));
+    EXPECT_EQ(back[i].matched_line, rows[i].matched_line);
   }
+  EXPECT_EQ(back[1].matched_line, -1);
+  EXPECT_EQ(back[2].matched_line, 4);
   EXPECT_NEAR(back[0].distance, 0.25, 1e-6);
 }
 

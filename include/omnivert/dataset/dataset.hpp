@@ -19,7 +19,11 @@
 // Images: load() checks that every listed image file exists and reads the first one to
 // check its size and depth against cam0/sensor.yaml (all of them with
 // LoadOptions::check_all_images). image(i) checks each image it reads, so a bad image later
-// in the sequence is reported, with its file name, when a tool reaches it.
+// in the sequence is reported, with its file name, when a tool reaches it. With
+// LoadOptions::allow_missing_images (what `omnivert track` uses) a listed file that does not
+// exist is kept in images() with `missing` set, so frame indices and odometry stay aligned;
+// image(i) then throws the InputError that load() would have thrown, for the caller to warn
+// and skip the frame; the first image that exists is the one read on load.
 
 #include <cstdint>
 #include <optional>
@@ -38,6 +42,7 @@ struct ImageRecord {
   std::string filename;  // as listed in cam0/data.csv
   std::string path;      // full path
   int line = 0;          // line in cam0/data.csv
+  bool missing = false;  // the file does not exist (LoadOptions::allow_missing_images)
 };
 
 enum class WheelUnit { kMeters, kTicks };
@@ -101,6 +106,9 @@ struct LoadOptions {
   bool check_all_images = false;
   // Without wheel0/ the dataset still loads (images only) when this is false.
   bool require_wheel = true;
+  // A listed image file that does not exist is an error when this is false; when true it is
+  // recorded (ImageRecord::missing) and image(i) throws for it (at least one must exist).
+  bool allow_missing_images = false;
   // A wheel moving faster than this between two samples is an error (a wrapped counter
   // without counter_bits, a glitch) [m/s].
   double max_wheel_speed = 5.0;

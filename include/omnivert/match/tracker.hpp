@@ -20,6 +20,9 @@
 //    take the same id (the paper's behaviour).
 //  - odometry gate (odometry_gate.hpp): an accepted match whose bearing change contradicts
 //    the wheel travel since the candidate frame is vetoed; the line goes on looking back.
+//  - same polarity, gate-restricted candidates, track continuity: see TrackerOptions and
+//    docs/tracking.md Sec. 3 (recommended_tracker_options() turns on mutual, the gate, same
+//    polarity and continuity).
 //
 // Bookkeeping: a ring buffer holds the last `look_back` frames (descriptors, bearings, track
 // ids, accumulated odometry). Buffers grow to the largest frame seen and are then reused: no
@@ -40,6 +43,24 @@ struct TrackerOptions {
   int look_back = 20;        // frames searched back for an unmatched line (Sec. 9.1)
   bool mutual = false;       // one-to-one, mutual nearest neighbours
   OdometryGateOptions gate;  // bearing-change gate from wheel travel (off by default)
+  // With the gate on: the nearest and second-nearest candidates of tests 1 and 3 (and the
+  // mutual check) are taken among the lines the gate admits, instead of the gate vetoing the
+  // nearest of all lines afterwards. Test 2's mean stays over all lines of the frame. A
+  // look-alike that the wheels rule out then neither wins nor makes the true line fail test 3
+  // (docs/tracking.md, measured there).
+  bool gate_candidates = false;
+  // Candidates of the opposite edge polarity (VerticalLine::polarity; 0 = unknown matches
+  // anything) are left out of tests 1-3 and the mutual check. The two sides of a thin door
+  // frame look alike to the descriptor but have opposite polarities: where extraction finds
+  // them in turn, the paper's rules link them (docs/tracking.md, measured there).
+  bool same_polarity = false;
+  // Track continuity (needs the odometry gate's wheel data; 0 = off): a link to track T is
+  // refused when the new bearing deviates from T's predicted one by more than this (radians)
+  // plus the gate's camera-swing term. The prediction removes the robot's rotation (eq. 16) and
+  // extrapolates the parallax per metre driven of the observation linked to, measured on that
+  // observation's own link when it spans at most 3 frames (otherwise the link is not checked).
+  // It targets two close edges that extraction finds in turn.
+  double continuity_tolerance = 0.0;
 
   bool IsValid(std::string* error) const;
 };
@@ -47,8 +68,9 @@ struct TrackerOptions {
 // The paper's tracker alone: tests 1-3 with Table 2's factors, look-back 20 (Sec. 9.1).
 TrackerOptions paper_tracker_options();
 // What we recommend (docs/tracking.md, measured there): the paper's rules plus the mutual
-// constraint, and the odometry gate when the wheel base is known (wheel_base > 0; pass 0
-// when there is no odometry).
+// constraint, same edge polarity, and the odometry gate with track continuity (1 degree)
+// when the wheel base is known
+// (wheel_base > 0; pass 0 when there is no odometry).
 TrackerOptions recommended_tracker_options(double wheel_base);
 
 // What the tracker decided for one line of a frame.
@@ -77,6 +99,7 @@ struct TrackerStats {
   std::int64_t rejected_mutual = 0;   // not mutual nearest neighbours
   std::int64_t rejected_claimed = 0;  // track already taken in this frame (mutual on)
   std::int64_t rejected_gate = 0;     // odometry gate veto
+  std::int64_t rejected_continuity = 0;  // track continuity veto
   std::string BriefReport() const;
 };
 
@@ -105,6 +128,8 @@ class Tracker {
   struct Slot {
     DescriptorMatrix descriptors;  // capacity rows; the first `num_lines` are live
     std::vector<double> bearings;
+    std::vector<int> polarities;
+    std::vector<double> parallax_rates;  // continuity: rad per metre driven, NaN = unknown
     std::vector<std::int64_t> track_ids;
     int num_lines = 0;
     OdometryAccumulator odometry;
@@ -114,6 +139,10 @@ class Tracker {
   Slot& slot_back(int k);
   void store_frame(const FrameFeatures& frame, const std::vector<TrackAssignment>& out);
   bool track_claimed(std::int64_t id) const;
+  // TrackerOptions::continuity_tolerance: may line `bearing` of the new frame continue the
+  // track of line j of frame t-k?
+  bool continues_track(int k, int j, double bearing);
+  std::vector<double> rates_;  // work space of store_frame
 
   TrackerOptions options_;
   Matcher matcher_;

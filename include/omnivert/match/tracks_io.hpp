@@ -32,6 +32,11 @@ struct TrackRow {
   double r_outer = 0.0;
   std::int64_t matched_frame = -1;
   double distance = 0.0;
+  // Index of this line among its frame's lines, and of the line it was matched to among the
+  // lines of matched_frame (-1: unknown, or a new track). They identify a link exactly even
+  // when a track holds two lines in one frame (the paper's rules allow such double claims).
+  int line = -1;
+  int matched_line = -1;
 };
 
 // Appends one row per line of `frame` (in line order) from the tracker's assignments.
