@@ -97,24 +97,27 @@ void run_similarity(const SimilarityArgs& a) {
                   {"ssd", &r.ssd, &r.ssd_d, "SSD of the 2 r_a pattern (per pixel)", "SSD / px"},
                   {"zncc", &r.zncc, &r.zncc_d, "1 - ZNCC of the 2 r_a pattern", "1 - ZNCC"}};
   std::ostringstream sum;
-  sum << "#measure,gap,median_gap,ambiguous_share,median_distance,band_deg\n";
+  sum << "#measure,gap,median_gap,ambiguous_share,valley_deg,median_distance,band_deg\n";
   std::printf("%s: centre (%.1f, %.1f), annulus %.1f..%.1f px, panorama %dx%d, pattern %d columns\n",
               a.image.c_str(), f.circle.center.x(), f.circle.center.y(), f.circle.r_min, f.circle.r_max,
               r.panorama.width(), r.panorama.rows(), r.pattern_columns);
-  std::printf("%-11s %8s %11s %10s   (gap: mean nearest distance outside +-%.0f deg / median distance)\n",
-              "measure", "gap", "median_gap", "ambiguous", a.band);
+  std::printf("%-11s %8s %11s %10s %11s   (gap: mean nearest distance outside +-%.0f deg / median distance;"
+              " ambiguous: rows with gap < %.2f)\n",
+              "measure", "gap", "median_gap", "ambiguous", "valley[deg]", a.band, o.ambiguous_below);
   for (const auto& m : ms) {
     write_matrix_csv(out_path(a.out, std::string("similarity_") + m.name + ".csv"), *m.m, r.bearings);
     HeatmapOptions h;
     char t[200];
-    std::snprintf(t, sizeof t, "%s   gap %.2f, ambiguous %.0f%%", m.title, m.d->gap, 100 * m.d->ambiguous);
+    std::snprintf(t, sizeof t, "%s   gap %.2f, ambiguous %.0f%%, valley %.0f deg", m.title, m.d->gap,
+                  100 * m.d->ambiguous, m.d->valley_deg);
     h.title = t;
     h.scale_label = m.scale;
     h.cell = std::max(1, 720 / std::max(1, r.descriptor.rows));
     write_image_atomic(out_path(a.out, std::string("similarity_") + m.name + ".png"), draw_heatmap(*m.m, h));
     sum << m.name << ',' << f6(m.d->gap) << ',' << f6(m.d->median_gap) << ',' << f6(m.d->ambiguous) << ','
-        << f6(m.d->median_distance) << ',' << f6(a.band) << '\n';
-    std::printf("%-11s %8.3f %11.3f %9.1f%%\n", m.name, m.d->gap, m.d->median_gap, 100 * m.d->ambiguous);
+        << f6(m.d->valley_deg) << ',' << f6(m.d->median_distance) << ',' << f6(a.band) << '\n';
+    std::printf("%-11s %8.3f %11.3f %9.1f%% %11.1f\n", m.name, m.d->gap, m.d->median_gap, 100 * m.d->ambiguous,
+                m.d->valley_deg);
   }
   write_text_atomic(out_path(a.out, "similarity_summary.csv"), sum.str());
   // The panorama with the pattern of bearing 0 (Fig. 10).
@@ -177,69 +180,110 @@ void run_sensitivity(const DatasetArgs& a) {
   dataset::Dataset data;
   const StudySet set = load_set(a, data);
   const DescriptorOptions base = a.pipeline.descriptor;
-  auto score = [&](const DescriptorOptions& d, double noise) {
-    return nearest_neighbour_score(set, describe_ours(set, d, noise, a.seed));
+  // Three scores per setting: the database NN of the paper, the frame-pair NN, and the
+  // frame-pair NN over baselines of 1-2 m.
+  struct Scores {
+    NearestNeighbourScore db, pair, far;
+    double ap = 0;
   };
+  auto score = [&](const DescriptorOptions& d, double noise) {
+    const auto m = describe_ours(set, d, noise, a.seed);
+    const auto rec = match_frame_pairs(set, m);
+    Scores s;
+    s.db = nearest_neighbour_score(set, m);
+    s.pair = pair_nearest_score(set, rec);
+    s.far = pair_nearest_score(set, rec, 1.0, a.max_baseline);
+    s.ap = average_precision(precision_recall(rec, 0));
+    return s;
+  };
+  auto head = [](std::ostringstream& o) {
+    o << "queries_db,correct_db,percent_db,queries_pair,percent_pair,queries_pair_1m,percent_pair_1m,"
+         "ratio_test_average_precision\n";
+  };
+  auto row = [](std::ostringstream& o, const Scores& s) {
+    o << s.db.queries << ',' << s.db.correct << ',' << f6(s.db.percent()) << ',' << s.pair.queries << ','
+      << f6(s.pair.percent()) << ',' << s.far.queries << ',' << f6(s.far.percent()) << ',' << f6(s.ap) << '\n';
+  };
+  auto three = [](const std::string& suffix) {
+    return std::vector<PlotSeries>{{"database NN" + suffix, {}, {}, plot_color(0)},
+                                   {"frame-pair NN" + suffix, {}, {}, plot_color(1)},
+                                   {"frame-pair NN, 1-2 m" + suffix, {}, {}, plot_color(2)}};
+  };
+  auto add = [](std::vector<PlotSeries>& v, std::size_t at, double x, const Scores& s) {
+    v[at].x.push_back(x), v[at].y.push_back(s.db.percent());
+    v[at + 1].x.push_back(x), v[at + 1].y.push_back(s.pair.percent());
+    v[at + 2].x.push_back(x), v[at + 2].y.push_back(s.far.percent());
+  };
+  std::printf("%% correct nearest neighbour: database (all frames within the baseline) / frame pairs / frame "
+              "pairs 1-2 m apart; AP: average precision of the ratio test on frame pairs\n");
 
   // Fig. 13: clipping threshold.
   const std::vector<double> clips = {0.025, 0.05, 0.075, 0.1, 0.125, 0.15, 0.2, 0.3, 0.5, 1.0};
   std::ostringstream cs;
-  cs << "#clip,queries,correct,percent\n";
-  PlotSeries sc{"nearest neighbour correct", {}, {}, plot_color(0)};
-  std::printf("Fig. 13, clipping threshold (1.0 = no clipping): %% correct nearest neighbour\n");
+  cs << "#clip,";
+  head(cs);
+  auto sc = three("");
+  std::printf("Fig. 13, clipping threshold (1.0 = no clipping)\n");
   for (double c : clips) {
     DescriptorOptions d = base;
     d.clip = c;
     const auto s = score(d, 0.0);
-    cs << f6(c) << ',' << s.queries << ',' << s.correct << ',' << f6(s.percent()) << '\n';
-    sc.x.push_back(c), sc.y.push_back(s.percent());
-    std::printf("  clip %-6g %6.2f%%  (%lld / %lld)\n", c, s.percent(), static_cast<long long>(s.correct),
-                static_cast<long long>(s.queries));
+    cs << f6(c) << ',';
+    row(cs, s);
+    add(sc, 0, c, s);
+    std::printf("  clip %-6g %6.2f%% %6.2f%% %6.2f%%  AP %.4f\n", c, s.db.percent(), s.pair.percent(),
+                s.far.percent(), s.ap);
   }
   write_text_atomic(out_path(a.out, "sensitivity_clip.csv"), cs.str());
   PlotOptions pc{"Fig. 13: influence of clipping", "clipping threshold", "% correct nearest neighbour"};
   pc.vertical_lines = {base.clip};
   pc.vertical_labels = {"default"};
-  write_plot(out_path(a.out, "sensitivity_clip.png"), {sc}, pc);
+  pc.legend_bottom = true;
+  write_plot(out_path(a.out, "sensitivity_clip.png"), sc, pc);
 
   // Fig. 14: Gaussian image noise, sigma = p% of 255.
   std::ostringstream ns;
-  ns << "#noise_percent,sigma_grey,queries,correct,percent\n";
-  PlotSeries sn{"nearest neighbour correct", {}, {}, plot_color(0)};
+  ns << "#noise_percent,sigma_grey,";
+  head(ns);
+  auto sn = three("");
   std::printf("Fig. 14, Gaussian image noise (sigma in %% of 255)\n");
   for (double p : {0.0, 1.0, 2.0, 4.0, 6.0, 8.0, 10.0}) {
     const auto s = score(base, p / 100.0 * 255.0);
-    ns << f6(p) << ',' << f6(p * 2.55) << ',' << s.queries << ',' << s.correct << ',' << f6(s.percent()) << '\n';
-    sn.x.push_back(p), sn.y.push_back(s.percent());
-    std::printf("  noise %4.1f%% %6.2f%%\n", p, s.percent());
+    ns << f6(p) << ',' << f6(p * 2.55) << ',';
+    row(ns, s);
+    add(sn, 0, p, s);
+    std::printf("  noise %4.1f%% %6.2f%% %6.2f%% %6.2f%%  AP %.4f\n", p, s.db.percent(), s.pair.percent(),
+                s.far.percent(), s.ap);
   }
   write_text_atomic(out_path(a.out, "sensitivity_noise.csv"), ns.str());
-  write_plot(out_path(a.out, "sensitivity_noise.png"), {sn},
-             {"Fig. 14: influence of image noise", "noise sigma [% of 255]", "% correct nearest neighbour"});
+  PlotOptions pn{"Fig. 14: influence of image noise", "noise sigma [% of 255]", "% correct nearest neighbour"};
+  pn.legend_bottom = true;
+  write_plot(out_path(a.out, "sensitivity_noise.png"), sn, pn);
 
   // Fig. 15: bins and areas; with the separation of the rule-3 ratio (average precision).
   std::ostringstream bs;
-  bs << "#bins,areas,size,queries,correct,percent,ratio_test_average_precision\n";
+  bs << "#bins,areas,size,";
+  head(bs);
   std::vector<PlotSeries> sb;
-  std::printf("Fig. 15, orientation bins x areas: %% correct NN, average precision of the ratio test\n");
+  std::printf("Fig. 15, orientation bins x areas\n");
   for (int areas : {3, 5}) {
-    PlotSeries s{std::to_string(areas) + (areas == 3 ? " areas (touching)" : " areas (overlapping)"), {}, {},
-                 plot_color(areas == 3 ? 0 : 1)};
+    auto s3 = three(areas == 3 ? ", 3 areas" : ", 5 areas");
+    for (auto& s : s3) s.dashed = areas == 5;
     for (int bins : {8, 16, 32}) {
       DescriptorOptions d = base;
       d.bins = bins, d.areas = areas;
-      const auto m = describe_ours(set, d, 0.0, a.seed);
-      const auto nn = nearest_neighbour_score(set, m);
-      const double ap = average_precision(precision_recall(match_frame_pairs(set, m), 0));
-      bs << bins << ',' << areas << ',' << d.size() << ',' << nn.queries << ',' << nn.correct << ','
-         << f6(nn.percent()) << ',' << f6(ap) << '\n';
-      s.x.push_back(bins), s.y.push_back(nn.percent());
-      std::printf("  %2d bins, %d areas (%3d-D): %6.2f%%, AP %.4f\n", bins, areas, d.size(), nn.percent(), ap);
+      const auto s = score(d, 0.0);
+      bs << bins << ',' << areas << ',' << d.size() << ',';
+      row(bs, s);
+      add(s3, 0, bins, s);
+      std::printf("  %2d bins, %d areas (%3d-D): %6.2f%% %6.2f%% %6.2f%%  AP %.4f\n", bins, areas, d.size(),
+                  s.db.percent(), s.pair.percent(), s.far.percent(), s.ap);
     }
-    sb.push_back(s);
+    sb.insert(sb.end(), s3.begin(), s3.end());
   }
   write_text_atomic(out_path(a.out, "sensitivity_bins.csv"), bs.str());
   PlotOptions pb{"Fig. 15: orientation bins and areas", "orientation bins", "% correct nearest neighbour"};
+  pb.legend_bottom = true;
   pb.x_lo = 4, pb.x_hi = 36;
   write_plot(out_path(a.out, "sensitivity_bins.png"), sb, pb);
 
@@ -279,6 +323,9 @@ void run_sensitivity(const DatasetArgs& a) {
                   100 * sh.false_removed, 100 * sh.correct_lost);
     PlotOptions po{t, names[rule - 1], "probability density"};
     po.x_lo = 0, po.x_hi = hi;
+    po.y_lo = 0;
+    for (std::size_t i = 0; i < x.size(); ++i) po.y_hi = std::max({po.y_hi, 1.08 * yc[i], 1.08 * yi[i]});
+    if (!(po.y_hi > 0)) po.y_hi = 1;
     po.vertical_lines = {thr[rule - 1]};
     po.vertical_labels = {"F" + std::to_string(rule) + " = " + f6(thr[rule - 1])};
     write_plot(out_path(a.out, "rule" + std::to_string(rule) + "_pdf.png"),
@@ -365,6 +412,7 @@ void run_baselines(const DatasetArgs& a) {
   write_text_atomic(out_path(a.out, "baselines_pr.csv"), cs.str());
   PlotOptions po{"Precision-recall, ratio test nearest / second (frame pairs within baseline)", "recall", "precision"};
   po.x_lo = 0, po.x_hi = 1, po.y_lo = 0, po.y_hi = 1.02;
+  po.legend_bottom = true;
   write_plot(out_path(a.out, "baselines_pr.png"), series, po);
   std::printf("wrote %s/baselines.csv, baselines_pr.{csv,png}\n", a.out.c_str());
 }

@@ -368,6 +368,21 @@ NearestNeighbourScore nearest_neighbour_score(const StudySet& set, const MethodF
   return s;
 }
 
+NearestNeighbourScore pair_nearest_score(const StudySet& set, const std::vector<MatchRecord>& records,
+                                         double min_baseline, double max_baseline) {
+  NearestNeighbourScore s;
+  for (const auto& r : records) {
+    if (!r.has_true) continue;
+    const auto& a = set.frames[static_cast<std::size_t>(r.query_frame)];
+    const auto& b = set.frames[static_cast<std::size_t>(r.candidate_frame)];
+    const double d = std::hypot(a.x - b.x, a.y - b.y);
+    if (d < min_baseline || d > max_baseline) continue;
+    ++s.queries;
+    s.correct += r.correct();
+  }
+  return s;
+}
+
 double rule_value(const MatchRecord& r, int rule) {
   switch (rule) {
     case 1: return r.nearest;

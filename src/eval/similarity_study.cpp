@@ -42,6 +42,20 @@ Distinctiveness distinctiveness(const cv::Mat1f& s, double band_deg, double ambi
     }
     if (std::isfinite(m)) ratio.push_back(m / out.median_distance);
   }
+  std::vector<double> valley;
+  for (int i = 0; i < n; ++i) {
+    for (int k = 1; k <= n / 2; ++k) {
+      const double v = 0.5 * (s(i, (i + k) % n) + s(i, (i - k + n) % n));
+      if (v >= 0.5 * out.median_distance) {
+        valley.push_back(k * step);
+        break;
+      }
+    }
+  }
+  if (!valley.empty()) {
+    std::nth_element(valley.begin(), valley.begin() + valley.size() / 2, valley.end());
+    out.valley_deg = valley[valley.size() / 2];
+  }
   if (ratio.empty()) return out;
   double sum = 0;
   int amb = 0;

@@ -35,6 +35,7 @@ void vertical_text(cv::Mat& img, const std::string& s, cv::Point center, double 
 
 std::string fmt(double v) {
   char b[32];
+  if (std::abs(v) < 1e-12) v = 0.0;
   if (v != 0 && (std::abs(v) < 0.01 || std::abs(v) >= 1e5)) {
     std::snprintf(b, sizeof b, "%.1e", v);
   } else {
@@ -165,7 +166,7 @@ cv::Mat draw_plot(const std::vector<PlotSeries>& series, const PlotOptions& o) {
     const double v = o.vertical_lines[k];
     if (v < xlo || v > xhi) continue;
     dashed_line(img, {X(v), top}, {X(v), top + ph}, kGrey, 2);
-    if (k < o.vertical_labels.size()) text(img, o.vertical_labels[k], {X(v) + 4, top + 15}, 0.45, {90, 90, 90});
+    if (k < o.vertical_labels.size()) text(img, o.vertical_labels[k], {X(v) + 4, top + ph - 8}, 0.45, {90, 90, 90});
   }
   cv::Mat plot_area = img(cv::Rect(left, top, pw + 1, ph + 1));
   for (std::size_t si = 0; si < series.size(); ++si) {
@@ -194,7 +195,7 @@ cv::Mat draw_plot(const std::vector<PlotSeries>& series, const PlotOptions& o) {
   }
   if (!series.empty()) {
     const int bw = lw + 50, bh = 20 * static_cast<int>(series.size()) + 8;
-    const cv::Rect box(left + pw - bw - 8, top + 8, bw, bh);
+    const cv::Rect box(left + pw - bw - 8, o.legend_bottom ? top + ph - bh - 24 : top + 8, bw, bh);
     img(box).setTo(kWhite);
     cv::rectangle(img, box, kGrey);
     for (std::size_t si = 0; si < series.size(); ++si) {

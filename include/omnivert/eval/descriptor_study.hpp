@@ -20,6 +20,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -128,6 +129,13 @@ struct NearestNeighbourScore {
 // Figs. 13-15: per query, the nearest line over the database of all frames within the
 // baseline; correct when it is the same world line.
 NearestNeighbourScore nearest_neighbour_score(const StudySet& set, const MethodFeatures& method);
+
+// The same question on single frame pairs, harder than the database (where a frame 4 cm
+// away usually holds the line): over records whose line is among the candidates and whose
+// frames are between min_baseline and max_baseline apart [m].
+NearestNeighbourScore pair_nearest_score(const StudySet& set, const std::vector<MatchRecord>& records,
+                                         double min_baseline = 0.0,
+                                         double max_baseline = std::numeric_limits<double>::infinity());
 
 // The three matching rules (Sec. 4, eq. 8-10) as distributions (Figs. 16-18).
 struct RuleShares {

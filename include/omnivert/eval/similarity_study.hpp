@@ -12,6 +12,10 @@
 //   gap        = mean_i m_i / median(S)   (larger: more distinctive)
 //   ambiguous  = share of rows with m_i / median(S) < ambiguous_below (a look-alike
 //                elsewhere in the image almost as close as the line itself)
+//   valley     = median over rows of the smallest k (degrees) at which the mean of
+//                S(i, i - k) and S(i, i + k) reaches half the median of S: the width of the
+//                dark band along the diagonal (smaller: the measure localises a line better;
+//                the paper's "size of the blocks along the diagonal")
 // SSD and 1 - ZNCC are squared distances, so their distinctiveness is computed on their
 // square roots (RMS grey-level difference; Euclidean distance of the normalised patterns).
 
@@ -30,12 +34,13 @@ struct Distinctiveness {
   double median_gap = 0.0; // median of the same ratio over rows
   double ambiguous = 0.0;  // share of rows whose ratio is below ambiguous_below
   double median_distance = 0.0;
+  double valley_deg = 0.0;  // median half-width of the diagonal valley
 };
 
 struct SimilarityOptions {
   int steps = 360;              // bearings 0, 360/steps, ... degrees (the paper: 1 degree)
   double band_deg = 10.0;       // excluded around the diagonal (shared support)
-  double ambiguous_below = 0.25;
+  double ambiguous_below = 0.5;
   DescriptorOptions descriptor; // the descriptor compared
   int bearing_sign = 1;
 };

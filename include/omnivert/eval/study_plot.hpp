@@ -38,7 +38,8 @@ struct PlotOptions {
   // Axis ranges; when lo >= hi, taken from the data (with a margin).
   double x_lo = 0, x_hi = 0, y_lo = 0, y_hi = 0;
   std::vector<double> vertical_lines;  // drawn grey, dashed (thresholds)
-  std::vector<std::string> vertical_labels;
+  std::vector<std::string> vertical_labels;  // written at the bottom of each line
+  bool legend_bottom = false;                 // legend box bottom right instead of top right
 };
 
 cv::Mat draw_plot(const std::vector<PlotSeries>& series, const PlotOptions& options);
