@@ -429,6 +429,9 @@ void add_dataset_options(CLI::App* cmd, DatasetArgs& a) {
       ->capture_default_str();
   cmd->add_option("--seed", a.seed, "Seed of the image noise (Fig. 14)")->capture_default_str();
   add_pipeline_options(cmd, a.pipeline);
+  cmd->add_flag("!--linear-intensity", a.pipeline.descriptor.log_intensity,
+                "Gradients of the grey level I (the paper) instead of log(2 + I)")
+      ->group("Descriptor (Sec. 3)");
 }
 
 }  // namespace
