@@ -284,7 +284,7 @@ void run_sensitivity(const DatasetArgs& a) {
   write_text_atomic(out_path(a.out, "sensitivity_bins.csv"), bs.str());
   PlotOptions pb{"Fig. 15: orientation bins and areas", "orientation bins", "% correct nearest neighbour"};
   pb.legend_bottom = true;
-  pb.x_lo = 4, pb.x_hi = 36;
+  pb.x_lo = 4, pb.x_hi = 52;  // room on the right for the legend
   write_plot(out_path(a.out, "sensitivity_bins.png"), sb, pb);
 
   // Figs. 16-18: PDFs of correct / incorrect nearest matches for the three rules (frame pairs).
