@@ -44,9 +44,13 @@ void ensure_dir(const std::string& dir) {
   if (ec || !fs::is_directory(dir)) throw InputError(dir, 0, "cannot create the output folder");
 }
 
-std::string out_path(const std::string& dir, const std::string& name) { return (fs::path(dir) / name).string(); }
+std::string out_path(const std::string& dir, const std::string& name) {
+  return (fs::path(dir) / name).string();
+}
 
-void write_matrix_csv(const std::string& path, const cv::Mat1f& m, const std::vector<double>& bearings) {
+void write_matrix_csv(const std::string& path,
+                      const cv::Mat1f& m,
+                      const std::vector<double>& bearings) {
   std::ostringstream s;
   s << "#bearing [deg]";
   for (double b : bearings) s << ',' << f6(rad2deg(wrap_positive(b)));
@@ -93,30 +97,60 @@ void run_similarity(const SimilarityArgs& a) {
     const char* title;
     const char* scale;
   };
-  const M ms[] = {{"descriptor", &r.descriptor, &r.descriptor_d, "Our descriptor: distance (eq. 6)", "distance"},
+  const M ms[] = {{"descriptor",
+                   &r.descriptor,
+                   &r.descriptor_d,
+                   "Our descriptor: distance (eq. 6)",
+                   "distance"},
                   {"ssd", &r.ssd, &r.ssd_d, "SSD of the 2 r_a pattern (per pixel)", "SSD / px"},
                   {"zncc", &r.zncc, &r.zncc_d, "1 - ZNCC of the 2 r_a pattern", "1 - ZNCC"}};
   std::ostringstream sum;
   sum << "#measure,gap,median_gap,ambiguous_share,valley_deg,median_distance,band_deg\n";
-  std::printf("%s: centre (%.1f, %.1f), annulus %.1f..%.1f px, panorama %dx%d, pattern %d columns\n",
-              a.image.c_str(), f.circle.center.x(), f.circle.center.y(), f.circle.r_min, f.circle.r_max,
-              r.panorama.width(), r.panorama.rows(), r.pattern_columns);
-  std::printf("%-11s %8s %11s %10s %11s   (gap: mean nearest distance outside +-%.0f deg / median distance;"
-              " ambiguous: rows with gap < %.2f)\n",
-              "measure", "gap", "median_gap", "ambiguous", "valley[deg]", a.band, o.ambiguous_below);
+  std::printf(
+      "%s: centre (%.1f, %.1f), annulus %.1f..%.1f px, panorama %dx%d, pattern %d columns\n",
+      a.image.c_str(),
+      f.circle.center.x(),
+      f.circle.center.y(),
+      f.circle.r_min,
+      f.circle.r_max,
+      r.panorama.width(),
+      r.panorama.rows(),
+      r.pattern_columns);
+  std::printf(
+      "%-11s %8s %11s %10s %11s   (gap: mean nearest distance outside +-%.0f deg / median distance;"
+      " ambiguous: rows with gap < %.2f)\n",
+      "measure",
+      "gap",
+      "median_gap",
+      "ambiguous",
+      "valley[deg]",
+      a.band,
+      o.ambiguous_below);
   for (const auto& m : ms) {
-    write_matrix_csv(out_path(a.out, std::string("similarity_") + m.name + ".csv"), *m.m, r.bearings);
+    write_matrix_csv(
+        out_path(a.out, std::string("similarity_") + m.name + ".csv"), *m.m, r.bearings);
     HeatmapOptions h;
     char t[200];
-    std::snprintf(t, sizeof t, "%s   gap %.2f, ambiguous %.0f%%, valley %.0f deg", m.title, m.d->gap,
-                  100 * m.d->ambiguous, m.d->valley_deg);
+    std::snprintf(t,
+                  sizeof t,
+                  "%s   gap %.2f, ambiguous %.0f%%, valley %.0f deg",
+                  m.title,
+                  m.d->gap,
+                  100 * m.d->ambiguous,
+                  m.d->valley_deg);
     h.title = t;
     h.scale_label = m.scale;
     h.cell = std::max(1, 720 / std::max(1, r.descriptor.rows));
-    write_image_atomic(out_path(a.out, std::string("similarity_") + m.name + ".png"), draw_heatmap(*m.m, h));
-    sum << m.name << ',' << f6(m.d->gap) << ',' << f6(m.d->median_gap) << ',' << f6(m.d->ambiguous) << ','
-        << f6(m.d->valley_deg) << ',' << f6(m.d->median_distance) << ',' << f6(a.band) << '\n';
-    std::printf("%-11s %8.3f %11.3f %9.1f%% %11.1f\n", m.name, m.d->gap, m.d->median_gap, 100 * m.d->ambiguous,
+    write_image_atomic(out_path(a.out, std::string("similarity_") + m.name + ".png"),
+                       draw_heatmap(*m.m, h));
+    sum << m.name << ',' << f6(m.d->gap) << ',' << f6(m.d->median_gap) << ',' << f6(m.d->ambiguous)
+        << ',' << f6(m.d->valley_deg) << ',' << f6(m.d->median_distance) << ',' << f6(a.band)
+        << '\n';
+    std::printf("%-11s %8.3f %11.3f %9.1f%% %11.1f\n",
+                m.name,
+                m.d->gap,
+                m.d->median_gap,
+                100 * m.d->ambiguous,
                 m.d->valley_deg);
   }
   write_text_atomic(out_path(a.out, "similarity_summary.csv"), sum.str());
@@ -124,11 +158,13 @@ void run_similarity(const SimilarityArgs& a) {
   cv::Mat pano8, pano;
   r.panorama.image.convertTo(pano8, CV_8U);
   cv::cvtColor(pano8, pano, cv::COLOR_GRAY2BGR);
-  const int c0 = static_cast<int>(std::lround(r.panorama.column_of_bearing(deg2rad(90.0)) - 0.5 * (r.pattern_columns - 1)));
+  const int c0 = static_cast<int>(
+      std::lround(r.panorama.column_of_bearing(deg2rad(90.0)) - 0.5 * (r.pattern_columns - 1)));
   cv::rectangle(pano, cv::Rect(c0, 0, r.pattern_columns, r.panorama.rows()), {0, 0, 255}, 2);
   write_image_atomic(out_path(a.out, "panorama.png"), pano);
-  std::printf("wrote %s/similarity_{descriptor,ssd,zncc}.{csv,png}, similarity_summary.csv, panorama.png\n",
-              a.out.c_str());
+  std::printf(
+      "wrote %s/similarity_{descriptor,ssd,zncc}.{csv,png}, similarity_summary.csv, panorama.png\n",
+      a.out.c_str());
 }
 
 // ---------------------------------------------------------------- sensitivity
@@ -152,9 +188,14 @@ StudySet load_set(const DatasetArgs& a, dataset::Dataset& data) {
   so.pipeline = a.pipeline;
   so.progress = Progress::enabled();
   StudySet set = load_study_set(data, so);
-  std::printf("%s: %zu frames, %zu lines (%zu associated to ground truth), %zu frame pairs within %.2f m\n",
-              a.dataset.c_str(), set.frames.size(), set.lines(), set.associated(), set.frame_pairs(),
-              a.max_baseline);
+  std::printf(
+      "%s: %zu frames, %zu lines (%zu associated to ground truth), %zu frame pairs within %.2f m\n",
+      a.dataset.c_str(),
+      set.frames.size(),
+      set.lines(),
+      set.associated(),
+      set.frame_pairs(),
+      a.max_baseline);
   return set;
 }
 
@@ -163,7 +204,11 @@ void write_plot(const std::string& path, const std::vector<PlotSeries>& s, const
 }
 
 // Histogram densities of values (correct / incorrect) over [0, hi].
-void pdf(const std::vector<double>& v, double hi, int bins, std::vector<double>& x, std::vector<double>& y) {
+void pdf(const std::vector<double>& v,
+         double hi,
+         int bins,
+         std::vector<double>& x,
+         std::vector<double>& y) {
   x.assign(bins, 0), y.assign(bins, 0);
   const double w = hi / bins;
   for (int i = 0; i < bins; ++i) x[i] = (i + 0.5) * w;
@@ -197,12 +242,14 @@ void run_sensitivity(const DatasetArgs& a) {
     return s;
   };
   auto head = [](std::ostringstream& o) {
-    o << "queries_db,correct_db,percent_db,queries_pair,percent_pair,queries_pair_1m,percent_pair_1m,"
+    o << "queries_db,correct_db,percent_db,queries_pair,percent_pair,queries_pair_1m,percent_pair_"
+         "1m,"
          "ratio_test_average_precision\n";
   };
   auto row = [](std::ostringstream& o, const Scores& s) {
-    o << s.db.queries << ',' << s.db.correct << ',' << f6(s.db.percent()) << ',' << s.pair.queries << ','
-      << f6(s.pair.percent()) << ',' << s.far.queries << ',' << f6(s.far.percent()) << ',' << f6(s.ap) << '\n';
+    o << s.db.queries << ',' << s.db.correct << ',' << f6(s.db.percent()) << ',' << s.pair.queries
+      << ',' << f6(s.pair.percent()) << ',' << s.far.queries << ',' << f6(s.far.percent()) << ','
+      << f6(s.ap) << '\n';
   };
   auto three = [](const std::string& suffix) {
     return std::vector<PlotSeries>{{"database NN" + suffix, {}, {}, plot_color(0)},
@@ -214,8 +261,10 @@ void run_sensitivity(const DatasetArgs& a) {
     v[at + 1].x.push_back(x), v[at + 1].y.push_back(s.pair.percent());
     v[at + 2].x.push_back(x), v[at + 2].y.push_back(s.far.percent());
   };
-  std::printf("%% correct nearest neighbour: database (all frames within the baseline) / frame pairs / frame "
-              "pairs 1-2 m apart; AP: average precision of the ratio test on frame pairs\n");
+  std::printf(
+      "%% correct nearest neighbour: database (all frames within the baseline) / frame pairs / "
+      "frame "
+      "pairs 1-2 m apart; AP: average precision of the ratio test on frame pairs\n");
 
   // Fig. 13: clipping threshold.
   const std::vector<double> clips = {0.025, 0.05, 0.075, 0.1, 0.125, 0.15, 0.2, 0.3, 0.5, 1.0};
@@ -231,11 +280,16 @@ void run_sensitivity(const DatasetArgs& a) {
     cs << f6(c) << ',';
     row(cs, s);
     add(sc, 0, c, s);
-    std::printf("  clip %-6g %6.2f%% %6.2f%% %6.2f%%  AP %.4f\n", c, s.db.percent(), s.pair.percent(),
-                s.far.percent(), s.ap);
+    std::printf("  clip %-6g %6.2f%% %6.2f%% %6.2f%%  AP %.4f\n",
+                c,
+                s.db.percent(),
+                s.pair.percent(),
+                s.far.percent(),
+                s.ap);
   }
   write_text_atomic(out_path(a.out, "sensitivity_clip.csv"), cs.str());
-  PlotOptions pc{"Fig. 13: influence of clipping", "clipping threshold", "% correct nearest neighbour"};
+  PlotOptions pc{
+      "Fig. 13: influence of clipping", "clipping threshold", "% correct nearest neighbour"};
   pc.vertical_lines = {base.clip};
   pc.vertical_labels = {"default"};
   pc.legend_bottom = true;
@@ -252,11 +306,16 @@ void run_sensitivity(const DatasetArgs& a) {
     ns << f6(p) << ',' << f6(p * 2.55) << ',';
     row(ns, s);
     add(sn, 0, p, s);
-    std::printf("  noise %4.1f%% %6.2f%% %6.2f%% %6.2f%%  AP %.4f\n", p, s.db.percent(), s.pair.percent(),
-                s.far.percent(), s.ap);
+    std::printf("  noise %4.1f%% %6.2f%% %6.2f%% %6.2f%%  AP %.4f\n",
+                p,
+                s.db.percent(),
+                s.pair.percent(),
+                s.far.percent(),
+                s.ap);
   }
   write_text_atomic(out_path(a.out, "sensitivity_noise.csv"), ns.str());
-  PlotOptions pn{"Fig. 14: influence of image noise", "noise sigma [% of 255]", "% correct nearest neighbour"};
+  PlotOptions pn{
+      "Fig. 14: influence of image noise", "noise sigma [% of 255]", "% correct nearest neighbour"};
   pn.legend_bottom = true;
   write_plot(out_path(a.out, "sensitivity_noise.png"), sn, pn);
 
@@ -276,13 +335,20 @@ void run_sensitivity(const DatasetArgs& a) {
       bs << bins << ',' << areas << ',' << d.size() << ',';
       row(bs, s);
       add(s3, 0, bins, s);
-      std::printf("  %2d bins, %d areas (%3d-D): %6.2f%% %6.2f%% %6.2f%%  AP %.4f\n", bins, areas, d.size(),
-                  s.db.percent(), s.pair.percent(), s.far.percent(), s.ap);
+      std::printf("  %2d bins, %d areas (%3d-D): %6.2f%% %6.2f%% %6.2f%%  AP %.4f\n",
+                  bins,
+                  areas,
+                  d.size(),
+                  s.db.percent(),
+                  s.pair.percent(),
+                  s.far.percent(),
+                  s.ap);
     }
     sb.insert(sb.end(), s3.begin(), s3.end());
   }
   write_text_atomic(out_path(a.out, "sensitivity_bins.csv"), bs.str());
-  PlotOptions pb{"Fig. 15: orientation bins and areas", "orientation bins", "% correct nearest neighbour"};
+  PlotOptions pb{
+      "Fig. 15: orientation bins and areas", "orientation bins", "% correct nearest neighbour"};
   pb.legend_bottom = true;
   pb.x_lo = 4, pb.x_hi = 52;  // room on the right for the legend
   write_plot(out_path(a.out, "sensitivity_bins.png"), sb, pb);
@@ -291,13 +357,15 @@ void run_sensitivity(const DatasetArgs& a) {
   const auto records = match_frame_pairs(set, describe_ours(set, base, 0.0, a.seed));
   const MatchOptions F;
   const double thr[3] = {F.f1, F.f2, F.f3};
-  const char* names[3] = {"nearest distance", "nearest / mean distance", "nearest / second-nearest distance"};
+  const char* names[3] = {
+      "nearest distance", "nearest / mean distance", "nearest / second-nearest distance"};
   const char* fig[3] = {"Fig. 16: rule 1", "Fig. 17: rule 2", "Fig. 18: rule 3"};
   std::ostringstream rs;
   rs << "#rule,threshold,correct,incorrect,false_removed,correct_lost\n";
   std::int64_t n_correct = 0;
   for (const auto& r : records) n_correct += r.correct();
-  std::printf("Figs. 16-18, %zu frame-pair queries, %.1f%% nearest correct\n", records.size(),
+  std::printf("Figs. 16-18, %zu frame-pair queries, %.1f%% nearest correct\n",
+              records.size(),
               records.empty() ? 0.0 : 100.0 * n_correct / records.size());
   for (int rule = 1; rule <= 3; ++rule) {
     std::vector<double> cv, iv;
@@ -313,32 +381,48 @@ void run_sensitivity(const DatasetArgs& a) {
     pdf(iv, hi, 50, x, yi);
     std::ostringstream ps;
     ps << "#value,pdf_correct,pdf_incorrect\n";
-    for (std::size_t i = 0; i < x.size(); ++i) ps << f6(x[i]) << ',' << f6(yc[i]) << ',' << f6(yi[i]) << '\n';
+    for (std::size_t i = 0; i < x.size(); ++i)
+      ps << f6(x[i]) << ',' << f6(yc[i]) << ',' << f6(yi[i]) << '\n';
     write_text_atomic(out_path(a.out, "rule" + std::to_string(rule) + "_pdf.csv"), ps.str());
     const auto sh = rule_shares(records, rule, thr[rule - 1]);
     rs << rule << ',' << f6(sh.threshold) << ',' << sh.correct << ',' << sh.incorrect << ','
        << f6(sh.false_removed) << ',' << f6(sh.correct_lost) << '\n';
     char t[160];
-    std::snprintf(t, sizeof t, "%s: removes %.0f%% of false, loses %.0f%% of correct", fig[rule - 1],
-                  100 * sh.false_removed, 100 * sh.correct_lost);
+    std::snprintf(t,
+                  sizeof t,
+                  "%s: removes %.0f%% of false, loses %.0f%% of correct",
+                  fig[rule - 1],
+                  100 * sh.false_removed,
+                  100 * sh.correct_lost);
     PlotOptions po{t, names[rule - 1], "probability density"};
     po.x_lo = 0, po.x_hi = hi;
     po.y_lo = 0;
-    for (std::size_t i = 0; i < x.size(); ++i) po.y_hi = std::max({po.y_hi, 1.08 * yc[i], 1.08 * yi[i]});
+    for (std::size_t i = 0; i < x.size(); ++i)
+      po.y_hi = std::max({po.y_hi, 1.08 * yc[i], 1.08 * yi[i]});
     if (!(po.y_hi > 0)) po.y_hi = 1;
     po.vertical_lines = {thr[rule - 1]};
     po.vertical_labels = {"F" + std::to_string(rule) + " = " + f6(thr[rule - 1])};
     write_plot(out_path(a.out, "rule" + std::to_string(rule) + "_pdf.png"),
-               {{"correct matches", x, yc, plot_color(2), false}, {"incorrect matches", x, yi, plot_color(3), false}}, po);
-    std::printf("  rule %d (F = %.2f): removes %5.1f%% of false matches, loses %5.1f%% of correct ones\n", rule,
-                thr[rule - 1], 100 * sh.false_removed, 100 * sh.correct_lost);
+               {{"correct matches", x, yc, plot_color(2), false},
+                {"incorrect matches", x, yi, plot_color(3), false}},
+               po);
+    std::printf(
+        "  rule %d (F = %.2f): removes %5.1f%% of false matches, loses %5.1f%% of correct ones\n",
+        rule,
+        thr[rule - 1],
+        100 * sh.false_removed,
+        100 * sh.correct_lost);
   }
   const auto all = rules_operating_point(records, F.f1, F.f2, F.f3);
-  rs << "all,,,," << f6(all.precision) << ',' << f6(all.recall) << "  # precision, recall of the three rules together\n";
-  std::printf("  all three rules: precision %.1f%%, recall %.1f%%\n", 100 * all.precision, 100 * all.recall);
+  rs << "all,,,," << f6(all.precision) << ',' << f6(all.recall)
+     << "  # precision, recall of the three rules together\n";
+  std::printf("  all three rules: precision %.1f%%, recall %.1f%%\n",
+              100 * all.precision,
+              100 * all.recall);
   write_text_atomic(out_path(a.out, "rules.csv"), rs.str());
-  std::printf("wrote %s/sensitivity_{clip,noise,bins}.{csv,png}, rule{1,2,3}_pdf.{csv,png}, rules.csv\n",
-              a.out.c_str());
+  std::printf(
+      "wrote %s/sensitivity_{clip,noise,bins}.{csv,png}, rule{1,2,3}_pdf.{csv,png}, rules.csv\n",
+      a.out.c_str());
 }
 
 // ---------------------------------------------------------------- baselines
@@ -357,12 +441,14 @@ void run_baselines(const DatasetArgs& a) {
 
   const std::vector<double> levels = {0.5, 0.6, 0.7, 0.8, 0.9};
   std::ostringstream bs, cs;
-  bs << "#method,lines_per_frame,queries_per_frame,frame_pair_queries,nn_database_percent,average_precision,max_recall";
+  bs << "#method,lines_per_frame,queries_per_frame,frame_pair_queries,nn_database_percent,average_"
+        "precision,max_recall";
   for (double r : levels) bs << ",precision_at_recall_" << f6(r);
   bs << '\n';
   cs << "#method,ratio_threshold,precision,recall\n";
   std::vector<PlotSeries> series;
-  std::printf("%-14s %6s %7s %8s %7s %6s %7s", "method", "lines", "queries", "NN db %", "AP", "max R", "");
+  std::printf(
+      "%-14s %6s %7s %8s %7s %6s %7s", "method", "lines", "queries", "NN db %", "AP", "max R", "");
   for (double r : levels) std::printf(" P@R%.1f", r);
   std::printf("\n");
   for (std::size_t mi = 0; mi < methods.size(); ++mi) {
@@ -380,8 +466,14 @@ void run_baselines(const DatasetArgs& a) {
     const double nf = static_cast<double>(set.frames.size());
     bs << m.name << ',' << f6(lines / nf) << ',' << f6(queries / nf) << ',' << records.size() << ','
        << f6(nn.percent()) << ',' << f6(ap) << ',' << f6(max_r);
-    std::printf("%-14s %6.1f %7.1f %7.2f%% %7.4f %6.3f %7s", m.name.c_str(), lines / nf, queries / nf, nn.percent(),
-                ap, max_r, "");
+    std::printf("%-14s %6.1f %7.1f %7.2f%% %7.4f %6.3f %7s",
+                m.name.c_str(),
+                lines / nf,
+                queries / nf,
+                nn.percent(),
+                ap,
+                max_r,
+                "");
     for (double r : levels) {
       const double p = precision_at_recall(full, r);
       bs << ',' << (std::isnan(p) ? std::string("") : f6(p));
@@ -395,7 +487,8 @@ void run_baselines(const DatasetArgs& a) {
     std::printf("\n");
     PlotSeries s{m.name, {}, {}, plot_color(static_cast<int>(mi)), false};
     for (const auto& p : precision_recall(records, 300)) {
-      cs << m.name << ',' << f6(p.threshold) << ',' << f6(p.precision) << ',' << f6(p.recall) << '\n';
+      cs << m.name << ',' << f6(p.threshold) << ',' << f6(p.precision) << ',' << f6(p.recall)
+         << '\n';
       s.x.push_back(p.recall), s.y.push_back(p.precision);
     }
     series.push_back(s);
@@ -404,13 +497,20 @@ void run_baselines(const DatasetArgs& a) {
       const auto op = rules_operating_point(records, F.f1, F.f2, F.f3);
       bs << "ours_three_rules,,,,,,," << f6(op.precision) << ',' << f6(op.recall)
          << "  # precision, recall at F1, F2, F3\n";
-      std::printf("%-14s precision %.3f at recall %.3f (F1 %.2f, F2 %.2f, F3 %.2f)\n", "ours 3 rules", op.precision,
-                  op.recall, F.f1, F.f2, F.f3);
+      std::printf("%-14s precision %.3f at recall %.3f (F1 %.2f, F2 %.2f, F3 %.2f)\n",
+                  "ours 3 rules",
+                  op.precision,
+                  op.recall,
+                  F.f1,
+                  F.f2,
+                  F.f3);
     }
   }
   write_text_atomic(out_path(a.out, "baselines.csv"), bs.str());
   write_text_atomic(out_path(a.out, "baselines_pr.csv"), cs.str());
-  PlotOptions po{"Precision-recall, ratio test nearest / second (frame pairs within baseline)", "recall", "precision"};
+  PlotOptions po{"Precision-recall, ratio test nearest / second (frame pairs within baseline)",
+                 "recall",
+                 "precision"};
   po.x_lo = 0, po.x_hi = 1, po.y_lo = 0, po.y_hi = 1.02;
   po.legend_bottom = true;
   write_plot(out_path(a.out, "baselines_pr.png"), series, po);
@@ -418,18 +518,24 @@ void run_baselines(const DatasetArgs& a) {
 }
 
 void add_dataset_options(CLI::App* cmd, DatasetArgs& a) {
-  cmd->add_option("DATASET", a.dataset, "Dataset with ground_truth/lines.csv and poses.csv")->required();
+  cmd->add_option("DATASET", a.dataset, "Dataset with ground_truth/lines.csv and poses.csv")
+      ->required();
   cmd->add_option("--out", a.out, "Output folder (created)")->required();
-  cmd->add_option("--max-baseline", a.max_baseline, "Compare frames up to this far apart [m] (Sec. 6.0.1: 2)")
+  cmd->add_option("--max-baseline",
+                  a.max_baseline,
+                  "Compare frames up to this far apart [m] (Sec. 6.0.1: 2)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  cmd->add_option("--stride", a.stride, "Use every n-th image")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--stride", a.stride, "Use every n-th image")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   cmd->add_option("--max-frames", a.max_frames, "Use at most this many images (0: all)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_option("--seed", a.seed, "Seed of the image noise (Fig. 14)")->capture_default_str();
   add_pipeline_options(cmd, a.pipeline);
-  cmd->add_flag("!--linear-intensity", a.pipeline.descriptor.log_intensity,
+  cmd->add_flag("!--linear-intensity",
+                a.pipeline.descriptor.log_intensity,
                 "Gradients of the grey level I (the paper) instead of log(2 + I)")
       ->group("Descriptor (Sec. 3)");
 }
@@ -437,11 +543,13 @@ void add_dataset_options(CLI::App* cmd, DatasetArgs& a) {
 }  // namespace
 
 void add_study_command(CLI::App& app) {
-  CLI::App* study = app.add_subcommand("study", "The paper's descriptor study (Sec. 5-6) and baselines, as CSV and PNG");
+  CLI::App* study = app.add_subcommand(
+      "study", "The paper's descriptor study (Sec. 5-6) and baselines, as CSV and PNG");
   study->require_subcommand(1);
 
   auto s = std::make_shared<SimilarityArgs>();
-  CLI::App* sim = study->add_subcommand("similarity", "Similarity matrices of one image: ours, SSD, ZNCC (Figs. 9-12)");
+  CLI::App* sim = study->add_subcommand(
+      "similarity", "Similarity matrices of one image: ours, SSD, ZNCC (Figs. 9-12)");
   sim->add_option("IMAGE", s->image, "Catadioptric image")->required();
   sim->add_option("--sensor", s->sensor, "cam0/sensor.yaml: centre, r_min, r_max, bearing_sign");
   sim->add_option("--out", s->out, "Output folder (created)")->required();
@@ -455,13 +563,15 @@ void add_study_command(CLI::App& app) {
   sim->callback([s] { run_similarity(*s); });
 
   auto d = std::make_shared<DatasetArgs>();
-  CLI::App* sens = study->add_subcommand(
-      "sensitivity", "% correct nearest neighbour vs clip, noise, bins/areas; PDFs of the three rules (Figs. 13-18)");
+  CLI::App* sens = study->add_subcommand("sensitivity",
+                                         "% correct nearest neighbour vs clip, noise, bins/areas; "
+                                         "PDFs of the three rules (Figs. 13-18)");
   add_dataset_options(sens, *d);
   sens->callback([d] { run_sensitivity(*d); });
 
   auto b = std::make_shared<DatasetArgs>();
-  CLI::App* base = study->add_subcommand("baselines", "Precision/recall of ours, ZNCC and LBD on the same frames");
+  CLI::App* base = study->add_subcommand(
+      "baselines", "Precision/recall of ours, ZNCC and LBD on the same frames");
   add_dataset_options(base, *b);
   base->callback([b] { run_baselines(*b); });
 }

@@ -41,7 +41,8 @@ cv::Mat1f euclidean(const RowMat& a, const RowMat& b) {
   const Eigen::VectorXf na = a.rowwise().squaredNorm(), nb = b.rowwise().squaredNorm();
   const RowMat g = a * b.transpose();
   for (int i = 0; i < out.rows; ++i)
-    for (int j = 0; j < out.cols; ++j) out(i, j) = std::sqrt(std::max(0.0f, na(i) + nb(j) - 2.0f * g(i, j)));
+    for (int j = 0; j < out.cols; ++j)
+      out(i, j) = std::sqrt(std::max(0.0f, na(i) + nb(j) - 2.0f * g(i, j)));
   return out;
 }
 
@@ -71,16 +72,20 @@ StudySet load_study_set(const dataset::Dataset& data, const StudyOptions& o) {
   const auto& gt = data.ground_truth();
   const std::string gt_dir = (fs::path(data.root()) / "ground_truth").string();
   if (!gt || !gt->has_lines)
-    throw InputError(gt_dir + "/lines.csv", 0, "file not found: the study needs the ground-truth lines");
+    throw InputError(
+        gt_dir + "/lines.csv", 0, "file not found: the study needs the ground-truth lines");
   if (!gt->has_poses)
-    throw InputError(gt_dir + "/poses.csv", 0, "file not found: the study needs the robot positions (baselines)");
+    throw InputError(gt_dir + "/poses.csv",
+                     0,
+                     "file not found: the study needs the robot positions (baselines)");
   std::string why;
   if (!o.pipeline.IsValid(&why)) throw InputError("invalid pipeline options: " + why);
   StudySet set;
   set.bearing_sign = data.camera().bearing_sign;
   FeaturePipeline pipe(data.camera(), o.pipeline);
   std::vector<std::size_t> picks;
-  for (std::size_t i = 0; i < data.size(); i += static_cast<std::size_t>(std::max(1, o.frame_stride))) {
+  for (std::size_t i = 0; i < data.size();
+       i += static_cast<std::size_t>(std::max(1, o.frame_stride))) {
     picks.push_back(i);
     if (o.max_frames > 0 && static_cast<int>(picks.size()) >= o.max_frames) break;
   }
@@ -99,8 +104,11 @@ StudySet load_study_set(const dataset::Dataset& data, const StudyOptions& o) {
     fr.y = gt->poses[i].y;
     const auto truth = gt->lines_in_frame(i);
     for (const auto& l : f.lines)
-      fr.lines.push_back({associate(l.bearing, truth, o.association_tolerance), l.image_angle, l.bearing,
-                          l.r_inner, l.r_outer});
+      fr.lines.push_back({associate(l.bearing, truth, o.association_tolerance),
+                          l.image_angle,
+                          l.bearing,
+                          l.r_inner,
+                          l.r_outer});
     set.frames.push_back(std::move(fr));
     if (o.progress) progress.update(n + 1);
   }
@@ -108,14 +116,19 @@ StudySet load_study_set(const dataset::Dataset& data, const StudyOptions& o) {
   set.neighbours.resize(set.frames.size());
   for (std::size_t k = 0; k < set.frames.size(); ++k)
     for (std::size_t l = 0; l < set.frames.size(); ++l)
-      if (k != l && std::hypot(set.frames[k].x - set.frames[l].x, set.frames[k].y - set.frames[l].y) <= o.max_baseline)
+      if (k != l && std::hypot(set.frames[k].x - set.frames[l].x,
+                               set.frames[k].y - set.frames[l].y) <= o.max_baseline)
         set.neighbours[k].push_back(static_cast<int>(l));
   if (set.associated() == 0)
-    throw InputError(gt_dir + "/lines.csv", 0, "no extracted line is within the association tolerance of a true line");
+    throw InputError(gt_dir + "/lines.csv",
+                     0,
+                     "no extracted line is within the association tolerance of a true line");
   return set;
 }
 
-MethodFeatures describe_ours(const StudySet& set, const DescriptorOptions& options, double noise_sigma,
+MethodFeatures describe_ours(const StudySet& set,
+                             const DescriptorOptions& options,
+                             double noise_sigma,
                              std::uint64_t seed) {
   auto mats = std::make_shared<std::vector<RowMat>>(set.frames.size());
   MethodFeatures m;
@@ -159,14 +172,18 @@ MethodFeatures describe_zncc(const StudySet& set) {
     const Panorama pano = unwrap_panorama(fr.image, fr.circle, po);
     const int w = paper_pattern_columns(pano);
     std::vector<int> ids;
-    RowMat a(static_cast<Eigen::Index>(fr.lines.size()), static_cast<Eigen::Index>(pano.rows()) * w);
+    RowMat a(static_cast<Eigen::Index>(fr.lines.size()),
+             static_cast<Eigen::Index>(pano.rows()) * w);
     for (std::size_t i = 0; i < fr.lines.size(); ++i) {
       ids.push_back(fr.lines[i].line_id);
       const cv::Mat1f p = panorama_pattern(pano, fr.lines[i].bearing, w).clone();
       Eigen::Map<const Eigen::VectorXf> v(p.ptr<float>(), static_cast<Eigen::Index>(p.total()));
       Eigen::VectorXf z = v.array() - v.mean();
       const float nrm = z.norm();
-      if (nrm > 1e-6f) z /= nrm; else z.setZero();
+      if (nrm > 1e-6f)
+        z /= nrm;
+      else
+        z.setZero();
       a.row(static_cast<Eigen::Index>(i)) = z.transpose();
     }
     m.ids.push_back(ids);
@@ -190,7 +207,9 @@ MethodFeatures describe_zncc(const StudySet& set) {
 
 namespace {
 
-MethodFeatures lbd_from_keylines(std::string name, std::vector<std::vector<int>> ids, std::vector<cv::Mat> descs) {
+MethodFeatures lbd_from_keylines(std::string name,
+                                 std::vector<std::vector<int>> ids,
+                                 std::vector<cv::Mat> descs) {
   auto d = std::make_shared<std::vector<cv::Mat>>(std::move(descs));
   MethodFeatures m;
   m.name = std::move(name);
@@ -214,7 +233,9 @@ MethodFeatures lbd_from_keylines(std::string name, std::vector<std::vector<int>>
 
 }  // namespace
 
-MethodFeatures describe_lbd_segments(const StudySet& set, const dataset::Dataset& data, const LbdOptions& o,
+MethodFeatures describe_lbd_segments(const StudySet& set,
+                                     const dataset::Dataset& data,
+                                     const LbdOptions& o,
                                      double tol) {
   using namespace cv::line_descriptor;
   auto bd = BinaryDescriptor::createBinaryDescriptor();
@@ -239,7 +260,9 @@ MethodFeatures describe_lbd_segments(const StudySet& set, const dataset::Dataset
       const double r = std::hypot(mx, my);
       const double dx = kl.endPointX - kl.startPointX, dy = kl.endPointY - kl.startPointY;
       const double len = std::hypot(dx, dy);
-      if (r < fr.circle.r_min || r > fr.circle.r_max || len < o.min_length_fraction * annulus || r < 1) continue;
+      if (r < fr.circle.r_min || r > fr.circle.r_max || len < o.min_length_fraction * annulus ||
+          r < 1)
+        continue;
       const double sin_angle = std::abs(mx * dy - my * dx) / (r * len);
       if (std::asin(std::min(1.0, sin_angle)) > o.max_radial_angle) continue;
       KeyLine k = kl;
@@ -280,7 +303,8 @@ MethodFeatures describe_lbd_on_our_lines(const StudySet& set) {
       k.endPointY = k.ePointInOctaveY = static_cast<float>(fr.circle.center.y() + l.r_outer * s);
       k.lineLength = static_cast<float>(l.r_outer - l.r_inner);
       k.numOfPixels = static_cast<int>(k.lineLength);
-      k.angle = static_cast<float>(std::atan2(k.endPointY - k.startPointY, k.endPointX - k.startPointX));
+      k.angle =
+          static_cast<float>(std::atan2(k.endPointY - k.startPointY, k.endPointX - k.startPointX));
       k.pt = {0.5f * (k.startPointX + k.endPointX), 0.5f * (k.startPointY + k.endPointY)};
       k.octave = 0;
       k.size = k.lineLength;
@@ -368,8 +392,10 @@ NearestNeighbourScore nearest_neighbour_score(const StudySet& set, const MethodF
   return s;
 }
 
-NearestNeighbourScore pair_nearest_score(const StudySet& set, const std::vector<MatchRecord>& records,
-                                         double min_baseline, double max_baseline) {
+NearestNeighbourScore pair_nearest_score(const StudySet& set,
+                                         const std::vector<MatchRecord>& records,
+                                         double min_baseline,
+                                         double max_baseline) {
   NearestNeighbourScore s;
   for (const auto& r : records) {
     if (!r.has_true) continue;
@@ -385,8 +411,10 @@ NearestNeighbourScore pair_nearest_score(const StudySet& set, const std::vector<
 
 double rule_value(const MatchRecord& r, int rule) {
   switch (rule) {
-    case 1: return r.nearest;
-    case 2: return r.mean > 0 ? r.nearest / r.mean : 1.0;
+    case 1:
+      return r.nearest;
+    case 2:
+      return r.mean > 0 ? r.nearest / r.mean : 1.0;
     default:
       if (r.candidates < 2 || !std::isfinite(r.second)) return 0.0;  // vacuous (matcher.cpp)
       return r.second > 0 ? r.nearest / r.second : 1.0;
@@ -423,13 +451,15 @@ std::vector<PrPoint> precision_recall(const std::vector<MatchRecord>& records, i
   for (std::size_t i = 0; i < v.size(); ++i) {
     ++acc, cor += v[i].second;
     if (i + 1 < v.size() && v[i + 1].first == v[i].first) continue;  // ties: one point
-    full.push_back({v[i].first, static_cast<double>(cor) / acc,
+    full.push_back({v[i].first,
+                    static_cast<double>(cor) / acc,
                     positives > 0 ? static_cast<double>(cor) / positives : 0.0});
   }
   if (max_points <= 0 || static_cast<int>(full.size()) <= max_points) return full;
   std::vector<PrPoint> out;
   for (int i = 0; i < max_points; ++i)
-    out.push_back(full[static_cast<std::size_t>(std::lround(static_cast<double>(i) * (full.size() - 1) / (max_points - 1)))]);
+    out.push_back(full[static_cast<std::size_t>(
+        std::lround(static_cast<double>(i) * (full.size() - 1) / (max_points - 1)))]);
   return out;
 }
 
@@ -449,11 +479,15 @@ double average_precision(const std::vector<PrPoint>& curve) {
   return ap;
 }
 
-PrPoint rules_operating_point(const std::vector<MatchRecord>& records, double f1, double f2, double f3) {
+PrPoint rules_operating_point(const std::vector<MatchRecord>& records,
+                              double f1,
+                              double f2,
+                              double f3) {
   std::int64_t acc = 0, cor = 0, pos = 0;
   for (const auto& r : records) {
     pos += r.has_true;
-    if (rule_value(r, 1) <= f1 && rule_value(r, 2) <= f2 && rule_value(r, 3) <= f3) ++acc, cor += r.correct();
+    if (rule_value(r, 1) <= f1 && rule_value(r, 2) <= f2 && rule_value(r, 3) <= f3)
+      ++acc, cor += r.correct();
   }
   PrPoint p;
   p.precision = acc > 0 ? static_cast<double>(cor) / acc : 0.0;

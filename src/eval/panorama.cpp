@@ -25,7 +25,9 @@ double Panorama::radius_of_row(double row) const {
 
 double Panorama::arc_per_column(double r) const { return kTwoPi * r / width(); }
 
-Panorama unwrap_panorama(const cv::Mat& image, const MirrorCircle& circle, const PanoramaOptions& options) {
+Panorama unwrap_panorama(const cv::Mat& image,
+                         const MirrorCircle& circle,
+                         const PanoramaOptions& options) {
   if (image.empty()) throw std::invalid_argument("unwrap_panorama: empty image");
   if (!(circle.r_min >= 0.0 && circle.r_min < circle.r_max))
     throw std::invalid_argument("unwrap_panorama: need 0 <= r_min < r_max");
@@ -48,8 +50,9 @@ Panorama unwrap_panorama(const cv::Mat& image, const MirrorCircle& circle, const
     const double circumference = kPi * (circle.r_min + circle.r_max);
     width = 360 * std::max(1, static_cast<int>(std::lround(circumference / 360.0)));
   }
-  const int rows = options.rows > 0 ? options.rows
-                                    : static_cast<int>(std::lround(circle.r_max - circle.r_min)) + 1;
+  const int rows = options.rows > 0
+                       ? options.rows
+                       : static_cast<int>(std::lround(circle.r_max - circle.r_min)) + 1;
   p.image.create(rows, width);
   cv::Mat1f map_x(rows, width), map_y(rows, width);
   std::vector<double> cs(width), sn(width);

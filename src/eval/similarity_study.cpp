@@ -67,7 +67,9 @@ Distinctiveness distinctiveness(const cv::Mat1f& s, double band_deg, double ambi
   return out;
 }
 
-SimilarityResult similarity_study(const cv::Mat& gray, const MirrorCircle& circle, const SimilarityOptions& o) {
+SimilarityResult similarity_study(const cv::Mat& gray,
+                                  const MirrorCircle& circle,
+                                  const SimilarityOptions& o) {
   SimilarityResult r;
   const int n = std::max(3, o.steps);
   for (int i = 0; i < n; ++i) r.bearings.push_back(wrap_angle(i * kTwoPi / n));
@@ -84,7 +86,8 @@ SimilarityResult similarity_study(const cv::Mat& gray, const MirrorCircle& circl
   r.panorama = unwrap_panorama(gray, circle, po);
   r.pattern_columns = paper_pattern_columns(r.panorama);
   std::vector<cv::Mat1f> patterns;
-  for (double b : r.bearings) patterns.push_back(panorama_pattern(r.panorama, b, r.pattern_columns));
+  for (double b : r.bearings)
+    patterns.push_back(panorama_pattern(r.panorama, b, r.pattern_columns));
   r.ssd.create(n, n);
   r.zncc.create(n, n);
   for (int i = 0; i < n; ++i) {

@@ -11,9 +11,14 @@ namespace omnivert {
 
 namespace {
 
-const cv::Scalar kBlack(0, 0, 0), kGrey(160, 160, 160), kLight(225, 225, 225), kWhite(255, 255, 255);
+const cv::Scalar kBlack(0, 0, 0), kGrey(160, 160, 160), kLight(225, 225, 225),
+    kWhite(255, 255, 255);
 
-void text(cv::Mat& img, const std::string& s, cv::Point p, double scale = 0.5, cv::Scalar c = kBlack,
+void text(cv::Mat& img,
+          const std::string& s,
+          cv::Point p,
+          double scale = 0.5,
+          cv::Scalar c = kBlack,
           bool center = false) {
   int base = 0;
   const cv::Size sz = cv::getTextSize(s, cv::FONT_HERSHEY_SIMPLEX, scale, 1, &base);
@@ -57,18 +62,28 @@ void dashed_line(cv::Mat& img, cv::Point a, cv::Point b, cv::Scalar c, int thick
   const double len = std::hypot(b.x - a.x, b.y - a.y);
   const int n = std::max(1, static_cast<int>(len / 6));
   for (int i = 0; i < n; i += 2) {
-    const double t0 = static_cast<double>(i) / n, t1 = std::min(1.0, static_cast<double>(i + 1) / n);
-    cv::line(img, {static_cast<int>(a.x + t0 * (b.x - a.x)), static_cast<int>(a.y + t0 * (b.y - a.y))},
-             {static_cast<int>(a.x + t1 * (b.x - a.x)), static_cast<int>(a.y + t1 * (b.y - a.y))}, c,
-             thickness, cv::LINE_AA);
+    const double t0 = static_cast<double>(i) / n,
+                 t1 = std::min(1.0, static_cast<double>(i + 1) / n);
+    cv::line(img,
+             {static_cast<int>(a.x + t0 * (b.x - a.x)), static_cast<int>(a.y + t0 * (b.y - a.y))},
+             {static_cast<int>(a.x + t1 * (b.x - a.x)), static_cast<int>(a.y + t1 * (b.y - a.y))},
+             c,
+             thickness,
+             cv::LINE_AA);
   }
 }
 
 }  // namespace
 
 cv::Scalar plot_color(int i) {
-  static const cv::Scalar k[] = {{180, 119, 31}, {14, 127, 255}, {44, 160, 44}, {40, 39, 214},
-                                 {189, 103, 148}, {75, 86, 140}, {194, 119, 227}, {127, 127, 127}};
+  static const cv::Scalar k[] = {{180, 119, 31},
+                                 {14, 127, 255},
+                                 {44, 160, 44},
+                                 {40, 39, 214},
+                                 {189, 103, 148},
+                                 {75, 86, 140},
+                                 {194, 119, 227},
+                                 {127, 127, 127}};
   return k[static_cast<std::size_t>(i) % 8];
 }
 
@@ -134,7 +149,8 @@ cv::Mat draw_plot(const std::vector<PlotSeries>& series, const PlotOptions& o) {
     for (const auto& s : series)
       for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
         if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
-        a = std::min(a, s.x[i]), b = std::max(b, s.x[i]), c = std::min(c, s.y[i]), d = std::max(d, s.y[i]);
+        a = std::min(a, s.x[i]), b = std::max(b, s.x[i]), c = std::min(c, s.y[i]),
+        d = std::max(d, s.y[i]);
       }
     if (!std::isfinite(a)) a = 0, b = 1, c = 0, d = 1;
     if (!(xlo < xhi)) {
@@ -148,8 +164,12 @@ cv::Mat draw_plot(const std::vector<PlotSeries>& series, const PlotOptions& o) {
   const int left = 80, right = 30, top = 45, bottom = 65;
   cv::Mat img(o.height, o.width, CV_8UC3, kWhite);
   const int pw = o.width - left - right, ph = o.height - top - bottom;
-  auto X = [&](double x) { return left + static_cast<int>(std::lround((x - xlo) / (xhi - xlo) * pw)); };
-  auto Y = [&](double y) { return top + ph - static_cast<int>(std::lround((y - ylo) / (yhi - ylo) * ph)); };
+  auto X = [&](double x) {
+    return left + static_cast<int>(std::lround((x - xlo) / (xhi - xlo) * pw));
+  };
+  auto Y = [&](double y) {
+    return top + ph - static_cast<int>(std::lround((y - ylo) / (yhi - ylo) * ph));
+  };
   const double xs = tick_step(xhi - xlo, 8), ys = tick_step(yhi - ylo, 6);
   for (double v = std::ceil(xlo / xs - 1e-9) * xs; v <= xhi + 1e-9 * xs; v += xs) {
     cv::line(img, {X(v), top}, {X(v), top + ph}, kLight);
@@ -166,14 +186,16 @@ cv::Mat draw_plot(const std::vector<PlotSeries>& series, const PlotOptions& o) {
     const double v = o.vertical_lines[k];
     if (v < xlo || v > xhi) continue;
     dashed_line(img, {X(v), top}, {X(v), top + ph}, kGrey, 2);
-    if (k < o.vertical_labels.size()) text(img, o.vertical_labels[k], {X(v) + 4, top + ph - 8}, 0.45, {90, 90, 90});
+    if (k < o.vertical_labels.size())
+      text(img, o.vertical_labels[k], {X(v) + 4, top + ph - 8}, 0.45, {90, 90, 90});
   }
   cv::Mat plot_area = img(cv::Rect(left, top, pw + 1, ph + 1));
   for (std::size_t si = 0; si < series.size(); ++si) {
     const auto& s = series[si];
     std::vector<cv::Point> pts;
     for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i)
-      if (std::isfinite(s.x[i]) && std::isfinite(s.y[i])) pts.push_back({X(s.x[i]) - left, Y(s.y[i]) - top});
+      if (std::isfinite(s.x[i]) && std::isfinite(s.y[i]))
+        pts.push_back({X(s.x[i]) - left, Y(s.y[i]) - top});
     for (std::size_t i = 1; i < pts.size(); ++i) {
       if (s.dashed) {
         dashed_line(plot_area, pts[i - 1], pts[i], s.color, 2);

@@ -94,7 +94,8 @@ TEST(Panorama, DefaultWidthIsAMultipleOf360AndPatternWraps) {
   EXPECT_EQ(p.width() % 360, 0);
   // 2 pi * 75 = 471 px of arc at the middle radius -> 360 columns.
   EXPECT_EQ(p.width(), 360);
-  EXPECT_EQ(paper_pattern_columns(p), static_cast<int>(std::lround(2 * 15.0 / (kTwoPi * 75 / 360))));
+  EXPECT_EQ(paper_pattern_columns(p),
+            static_cast<int>(std::lround(2 * 15.0 / (kTwoPi * 75 / 360))));
   const cv::Mat1f pat = panorama_pattern(p, 0.0, 5);
   ASSERT_EQ(pat.cols, 5);
   for (int r = 0; r < p.rows(); r += 17) {
@@ -178,7 +179,8 @@ TEST(Study, PrecisionRecallBookkeeping) {
   std::vector<MatchRecord> r(4);
   const double ratio[4] = {0.2, 0.5, 0.6, 0.9};
   for (int i = 0; i < 4; ++i) {
-    r[i].query_id = 1, r[i].candidates = 3, r[i].second = 1.0, r[i].nearest = ratio[i], r[i].mean = 1.0;
+    r[i].query_id = 1, r[i].candidates = 3, r[i].second = 1.0, r[i].nearest = ratio[i],
+    r[i].mean = 1.0;
     r[i].nearest_id = (i % 2 == 0) ? 1 : 2;
     r[i].has_true = i < 3;
   }
@@ -205,7 +207,8 @@ TEST(Study, TinySimulatedRun) {
   fs::remove_all(dir);
   sim::SimConfig cfg;
   cfg.max_frames = 6;
-  sim::simulate(sim::world_preset("corridor"), sim::load_trajectory("paper"), cfg, (dir / "run").string());
+  sim::simulate(
+      sim::world_preset("corridor"), sim::load_trajectory("paper"), cfg, (dir / "run").string());
   dataset::LoadOptions lo;
   lo.require_wheel = false;
   const auto data = dataset::Dataset::load((dir / "run").string(), lo);
@@ -213,7 +216,7 @@ TEST(Study, TinySimulatedRun) {
   so.progress = false;
   const StudySet set = load_study_set(data, so);
   ASSERT_EQ(set.frames.size(), 6u);
-  EXPECT_GT(set.associated(), 18u);  // about 4-5 long lines per frame (50% rule)
+  EXPECT_GT(set.associated(), 18u);   // about 4-5 long lines per frame (50% rule)
   EXPECT_EQ(set.frame_pairs(), 30u);  // 6 frames 3.8 cm apart: all within 2 m
   const auto ours = describe_ours(set, {}, 0.0);
   const auto nn = nearest_neighbour_score(set, ours);

@@ -33,11 +33,11 @@
 namespace omnivert {
 
 struct StudyOptions {
-  double max_baseline = 2.0;                     // metres between robot positions
+  double max_baseline = 2.0;                    // metres between robot positions
   double association_tolerance = deg2rad(1.0);  // radians
-  int frame_stride = 1;                          // use every n-th image
-  int max_frames = 0;                            // 0: all (after the stride)
-  FeaturePipelineOptions pipeline;               // extraction (the descriptor is varied later)
+  int frame_stride = 1;                         // use every n-th image
+  int max_frames = 0;                           // 0: all (after the stride)
+  FeaturePipelineOptions pipeline;              // extraction (the descriptor is varied later)
   bool progress = true;
 };
 
@@ -79,8 +79,10 @@ struct MethodFeatures {
 
 // Our descriptor (Sec. 3) at the study's lines, with given options, on the frames with
 // additive Gaussian noise of `noise_sigma` grey levels (0: none; Sec. 6.0.3), seeded.
-MethodFeatures describe_ours(const StudySet& set, const DescriptorOptions& options,
-                             double noise_sigma = 0.0, std::uint64_t seed = 1);
+MethodFeatures describe_ours(const StudySet& set,
+                             const DescriptorOptions& options,
+                             double noise_sigma = 0.0,
+                             std::uint64_t seed = 1);
 
 // ZNCC of the rectangular pattern of width 2 r_a in each frame's panorama (Sec. 5); the
 // distance is 1 - ZNCC.
@@ -98,10 +100,11 @@ struct LbdOptions {
 
 // OpenCV's LBD (line_descriptor::BinaryDescriptor), Hamming distances from
 // BinaryDescriptorMatcher. Segments are associated to the ground truth by the bearing of
-// their midpoint (same tolerance as our lines). `line_counts`, if given, receives the number
-// of near-radial segments per frame.
-MethodFeatures describe_lbd_segments(const StudySet& set, const dataset::Dataset& data,
-                                     const LbdOptions& options, double association_tolerance);
+// their midpoint (same tolerance as our lines); unassociated segments stay as candidates.
+MethodFeatures describe_lbd_segments(const StudySet& set,
+                                     const dataset::Dataset& data,
+                                     const LbdOptions& options,
+                                     double association_tolerance);
 
 // LBD computed on our radial lines (KeyLines from r_inner to r_outer): the descriptor alone,
 // on exactly our line set.
@@ -133,15 +136,17 @@ NearestNeighbourScore nearest_neighbour_score(const StudySet& set, const MethodF
 // The same question on single frame pairs, harder than the database (where a frame 4 cm
 // away usually holds the line): over records whose line is among the candidates and whose
 // frames are between min_baseline and max_baseline apart [m].
-NearestNeighbourScore pair_nearest_score(const StudySet& set, const std::vector<MatchRecord>& records,
-                                         double min_baseline = 0.0,
-                                         double max_baseline = std::numeric_limits<double>::infinity());
+NearestNeighbourScore pair_nearest_score(
+    const StudySet& set,
+    const std::vector<MatchRecord>& records,
+    double min_baseline = 0.0,
+    double max_baseline = std::numeric_limits<double>::infinity());
 
 // The three matching rules (Sec. 4, eq. 8-10) as distributions (Figs. 16-18).
 struct RuleShares {
   double threshold = 0.0;
-  double false_removed = 0.0;   // share of incorrect nearest matches the rule rejects
-  double correct_lost = 0.0;    // share of correct nearest matches it rejects
+  double false_removed = 0.0;  // share of incorrect nearest matches the rule rejects
+  double correct_lost = 0.0;   // share of correct nearest matches it rejects
   std::int64_t correct = 0, incorrect = 0;
 };
 // rule 1: nearest distance; rule 2: nearest / mean; rule 3: nearest / second.
@@ -154,13 +159,17 @@ RuleShares rule_shares(const std::vector<MatchRecord>& records, int rule, double
 struct PrPoint {
   double threshold = 0.0, precision = 0.0, recall = 0.0;
 };
-std::vector<PrPoint> precision_recall(const std::vector<MatchRecord>& records, int max_points = 200);
+std::vector<PrPoint> precision_recall(const std::vector<MatchRecord>& records,
+                                      int max_points = 200);
 // The best precision among operating points with recall >= r (NaN if none reaches r).
 double precision_at_recall(const std::vector<PrPoint>& curve, double r);
 // Area under the precision-recall curve (step-wise), over the recall reached.
 double average_precision(const std::vector<PrPoint>& curve);
 
 // Precision and recall of the three rules together (our matcher's decision) at F1, F2, F3.
-PrPoint rules_operating_point(const std::vector<MatchRecord>& records, double f1, double f2, double f3);
+PrPoint rules_operating_point(const std::vector<MatchRecord>& records,
+                              double f1,
+                              double f2,
+                              double f3);
 
 }  // namespace omnivert

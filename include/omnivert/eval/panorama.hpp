@@ -44,7 +44,9 @@ struct Panorama {
 // Unwraps the annulus circle.r_min..circle.r_max of an image (8-bit or float, 1 channel; a
 // colour image is converted to grey) into a panorama. Throws std::invalid_argument for an
 // empty image or an annulus with r_min >= r_max or r_min < 0.
-Panorama unwrap_panorama(const cv::Mat& image, const MirrorCircle& circle, const PanoramaOptions& options = {});
+Panorama unwrap_panorama(const cv::Mat& image,
+                         const MirrorCircle& circle,
+                         const PanoramaOptions& options = {});
 
 // The rectangular pattern of Sec. 5 (Fig. 10): all rows of the panorama, `width_columns`
 // columns centred on the column of `bearing` (linear interpolation between columns, wrapping

@@ -30,23 +30,23 @@
 namespace omnivert {
 
 struct Distinctiveness {
-  double gap = 0.0;        // mean nearest off-band distance / median distance
-  double median_gap = 0.0; // median of the same ratio over rows
-  double ambiguous = 0.0;  // share of rows whose ratio is below ambiguous_below
+  double gap = 0.0;         // mean nearest off-band distance / median distance
+  double median_gap = 0.0;  // median of the same ratio over rows
+  double ambiguous = 0.0;   // share of rows whose ratio is below ambiguous_below
   double median_distance = 0.0;
   double valley_deg = 0.0;  // median half-width of the diagonal valley
 };
 
 struct SimilarityOptions {
-  int steps = 360;              // bearings 0, 360/steps, ... degrees (the paper: 1 degree)
-  double band_deg = 10.0;       // excluded around the diagonal (shared support)
+  int steps = 360;         // bearings 0, 360/steps, ... degrees (the paper: 1 degree)
+  double band_deg = 10.0;  // excluded around the diagonal (shared support)
   double ambiguous_below = 0.5;
-  DescriptorOptions descriptor; // the descriptor compared
+  DescriptorOptions descriptor;  // the descriptor compared
   int bearing_sign = 1;
 };
 
 struct SimilarityResult {
-  std::vector<double> bearings;  // radians, the rows/columns
+  std::vector<double> bearings;     // radians, the rows/columns
   cv::Mat1f descriptor, ssd, zncc;  // zncc holds 1 - ZNCC
   Distinctiveness descriptor_d, ssd_d, zncc_d;
   Panorama panorama;
@@ -59,6 +59,8 @@ cv::Mat1f descriptor_distance_matrix(const DescriptorMatrix& d);
 Distinctiveness distinctiveness(const cv::Mat1f& s, double band_deg, double ambiguous_below);
 
 // All three matrices for one 8-bit grey image with its mirror circle.
-SimilarityResult similarity_study(const cv::Mat& gray, const MirrorCircle& circle, const SimilarityOptions& options = {});
+SimilarityResult similarity_study(const cv::Mat& gray,
+                                  const MirrorCircle& circle,
+                                  const SimilarityOptions& options = {});
 
 }  // namespace omnivert

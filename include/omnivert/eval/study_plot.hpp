@@ -27,8 +27,8 @@ cv::Mat draw_heatmap(const cv::Mat1f& matrix, const HeatmapOptions& options);
 struct PlotSeries {
   std::string name;
   std::vector<double> x, y;
-  cv::Scalar color;          // BGR
-  bool markers = true;       // a dot at every point
+  cv::Scalar color;     // BGR
+  bool markers = true;  // a dot at every point
   bool dashed = false;
 };
 
@@ -37,9 +37,9 @@ struct PlotOptions {
   int width = 900, height = 600;
   // Axis ranges; when lo >= hi, taken from the data (with a margin).
   double x_lo = 0, x_hi = 0, y_lo = 0, y_hi = 0;
-  std::vector<double> vertical_lines;  // drawn grey, dashed (thresholds)
+  std::vector<double> vertical_lines;        // drawn grey, dashed (thresholds)
   std::vector<std::string> vertical_labels;  // written at the bottom of each line
-  bool legend_bottom = false;                 // legend box bottom right instead of top right
+  bool legend_bottom = false;                // legend box bottom right instead of top right
 };
 
 cv::Mat draw_plot(const std::vector<PlotSeries>& series, const PlotOptions& options);
