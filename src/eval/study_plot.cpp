@@ -190,6 +190,7 @@ cv::Mat draw_plot(const std::vector<PlotSeries>& series, const PlotOptions& o) {
       text(img, o.vertical_labels[k], {X(v) + 4, top + ph - 8}, 0.45, {90, 90, 90});
   }
   cv::Mat plot_area = img(cv::Rect(left, top, pw + 1, ph + 1));
+  cv::Mat1b ink(ph + 1, pw + 1, uchar{0});  // where the data is drawn (legend placement)
   for (std::size_t si = 0; si < series.size(); ++si) {
     const auto& s = series[si];
     std::vector<cv::Point> pts;
@@ -203,13 +204,15 @@ cv::Mat draw_plot(const std::vector<PlotSeries>& series, const PlotOptions& o) {
         cv::line(plot_area, pts[i - 1], pts[i], s.color, 2, cv::LINE_AA);
       }
     }
+    for (std::size_t i = 1; i < pts.size(); ++i) cv::line(ink, pts[i - 1], pts[i], 255, 3);
+    for (const auto& p : pts) cv::circle(ink, p, 5, 255, cv::FILLED);
     if (s.markers)
       for (const auto& p : pts) cv::circle(plot_area, p, 4, s.color, cv::FILLED, cv::LINE_AA);
   }
   text(img, o.title, {o.width / 2, 28}, 0.6, kBlack, true);
   text(img, o.x_label, {left + pw / 2, o.height - 18}, 0.5, kBlack, true);
   vertical_text(img, o.y_label, {15, top + ph / 2});
-  // Legend (top right inside the plot).
+  // Legend, inside the plot.
   int lw = 0;
   for (const auto& s : series) {
     int base = 0;
@@ -217,7 +220,18 @@ cv::Mat draw_plot(const std::vector<PlotSeries>& series, const PlotOptions& o) {
   }
   if (!series.empty()) {
     const int bw = lw + 50, bh = 20 * static_cast<int>(series.size()) + 8;
-    const cv::Rect box(left + pw - bw - 8, o.legend_bottom ? top + ph - bh - 24 : top + 8, bw, bh);
+    // The corner (or side) where the legend covers the least data; the preferred one on ties.
+    const int xr = pw - bw - 8, xl = 8, yt = 8, yb = ph - bh - 24, ym = (ph - bh) / 2;
+    std::vector<cv::Point> spots = {{xr, yt}, {xr, yb}, {xl, yt}, {xl, yb}, {xr, ym}, {xl, ym}};
+    if (o.legend_bottom) std::swap(spots[0], spots[1]);
+    cv::Point best = spots[0];
+    int best_ink = std::numeric_limits<int>::max();
+    for (const auto& sp : spots) {
+      const cv::Rect r = cv::Rect(sp.x, sp.y, bw, bh) & cv::Rect(0, 0, ink.cols, ink.rows);
+      const int n = r.area() > 0 ? cv::countNonZero(ink(r)) : 0;
+      if (n < best_ink) best_ink = n, best = sp;
+    }
+    const cv::Rect box(left + best.x, top + best.y, bw, bh);
     img(box).setTo(kWhite);
     cv::rectangle(img, box, kGrey);
     for (std::size_t si = 0; si < series.size(); ++si) {
