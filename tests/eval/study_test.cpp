@@ -201,6 +201,58 @@ TEST(Study, PrecisionRecallBookkeeping) {
   EXPECT_DOUBLE_EQ(op.recall, 1.0 / 3);
 }
 
+// Three frames on a line, 0, 1.5 and 3 m: frames 0-1 and 1-2 are within 2 m, 0-2 are not.
+// Lines are points on a number line; the distance is |a - b| (a hand-made method).
+TEST(Study, NearestNeighbourProtocol) {
+  StudySet set;
+  set.frames.resize(3);
+  for (int k = 0; k < 3; ++k) set.frames[k].x = 1.5 * k;
+  set.neighbours = {{1}, {0, 2}, {1}};
+  // frame: values (ids)
+  const std::vector<std::vector<double>> v = {
+      {0.0, 10.0, 20.0}, {0.4, 10.9, 13.0, 50.0}, {0.2, 50.0}};
+  MethodFeatures m;
+  m.ids = {{1, 2, 3}, {1, 2, 9, -1}, {1, 7}};
+  m.distances = [&](int k, int l) {
+    cv::Mat1f d(static_cast<int>(v[k].size()), static_cast<int>(v[l].size()));
+    for (int i = 0; i < d.rows; ++i)
+      for (int j = 0; j < d.cols; ++j) d(i, j) = static_cast<float>(std::abs(v[k][i] - v[l][j]));
+    return d;
+  };
+  // Database NN (frames within 2 m):
+  //  frame 0: id 1 -> 0.4 (id 1) correct; id 2 (10) -> 10.9 (id 2) correct; id 3 (20) -> 13
+  //           (id 9) wrong, and id 3 is nowhere in frame 1: not counted.
+  //  frame 1: id 1 (0.4) -> 0.2 (frame 2, id 1) correct; id 2 (10.9) -> 10 (id 2) correct;
+  //           id 9 (13): absent elsewhere, not counted; the -1 line is never a query.
+  //  frame 2: id 1 (0.2) -> 0.4 (id 1) correct; id 7 (50) -> 50 (id -1) wrong, absent: not
+  //           counted.
+  const auto nn = nearest_neighbour_score(set, m);
+  EXPECT_EQ(nn.queries, 5);
+  EXPECT_EQ(nn.correct, 5);
+  // Frame pairs: 4 ordered pairs; queries 3 + 3 + 3 + 2 = 11 records.
+  const auto rec = match_frame_pairs(set, m);
+  ASSERT_EQ(rec.size(), 11u);
+  int with_true = 0, correct = 0;
+  for (const auto& r : rec) with_true += r.has_true, correct += r.correct();
+  // Present: (0->1) ids 1, 2; (1->0) 1, 2; (1->2) 1; (2->1) 1: 6 records.
+  EXPECT_EQ(with_true, 6);
+  // (1->2): id 2 (10.9) -> 0.2 (id 1) wrong, id 9 (13) -> 0.2 wrong; the rest with the line
+  // present are right; (0->1) id 3 -> 13 (id 9) wrong; (2->1) id 7 -> 50 (id -1) wrong.
+  EXPECT_EQ(correct, 6);
+  const auto pair = pair_nearest_score(set, rec);
+  EXPECT_EQ(pair.queries, 6);
+  EXPECT_EQ(pair.correct, 6);
+  // The first record: frame 0, id 1 against frame 1: distances 0.4, 10.9, 13, 50.
+  EXPECT_EQ(rec[0].query_id, 1);
+  EXPECT_FLOAT_EQ(static_cast<float>(rec[0].nearest), 0.4f);
+  EXPECT_FLOAT_EQ(static_cast<float>(rec[0].second), 10.9f);
+  EXPECT_NEAR(rec[0].mean, (0.4 + 10.9 + 13.0 + 50.0) / 4, 1e-5);
+  EXPECT_EQ(rec[0].candidates, 4);
+  // Baselines: only the 1.5 m pairs remain in [1, 2] m; none in [2, 3].
+  EXPECT_EQ(pair_nearest_score(set, rec, 1.0, 2.0).queries, 6);
+  EXPECT_EQ(pair_nearest_score(set, rec, 2.0, 3.0).queries, 0);
+}
+
 TEST(Study, TinySimulatedRun) {
   namespace fs = std::filesystem;
   const fs::path dir = fs::temp_directory_path() / ("omnivert_study_" + std::to_string(::getpid()));
