@@ -242,6 +242,9 @@ MethodFeatures describe_lbd_segments(const StudySet& set,
   auto lsd = LSDDetector::createLSDDetector();
   std::vector<std::vector<int>> ids;
   std::vector<cv::Mat> descs;
+  if (!data.ground_truth() || !data.ground_truth()->has_lines)
+    throw InputError(data.root() + "/ground_truth/lines.csv", 0,
+                     "file not found: the LBD baseline needs the ground-truth lines");
   const auto& gt = *data.ground_truth();
   for (const auto& fr : set.frames) {
     std::vector<KeyLine> all, kept;
