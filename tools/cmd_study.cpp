@@ -74,13 +74,13 @@ struct SimilarityArgs {
 void run_similarity(const SimilarityArgs& a) {
   std::string why;
   if (!a.pipeline.IsValid(&why)) throw InputError("invalid options: " + why);
-  ensure_dir(a.out);
   const cv::Mat image = read_image(a.image);
   CameraGeometry geometry;
   if (!a.sensor.empty()) geometry = load_camera_geometry(a.sensor);
   FeaturePipeline pipe(geometry, a.pipeline);
   FrameFeatures f;
   if (!pipe.process(image, f, &why)) throw InputError(a.image, 0, why);
+  ensure_dir(a.out);  // after the input is known to be good
   cv::Mat gray;
   FeaturePipeline::to_gray8(image, gray);
   SimilarityOptions o;
@@ -221,9 +221,9 @@ void pdf(const std::vector<double>& v,
 }
 
 void run_sensitivity(const DatasetArgs& a) {
-  ensure_dir(a.out);
   dataset::Dataset data;
-  const StudySet set = load_set(a, data);
+  const StudySet set = load_set(a, data);  // validates the input before any output exists
+  ensure_dir(a.out);
   const DescriptorOptions base = a.pipeline.descriptor;
   // Three scores per setting: the database NN of the paper, the frame-pair NN, and the
   // frame-pair NN over baselines of 1-2 m.
@@ -427,9 +427,9 @@ void run_sensitivity(const DatasetArgs& a) {
 
 // ---------------------------------------------------------------- baselines
 void run_baselines(const DatasetArgs& a) {
-  ensure_dir(a.out);
   dataset::Dataset data;
-  const StudySet set = load_set(a, data);
+  const StudySet set = load_set(a, data);  // validates the input before any output exists
+  ensure_dir(a.out);
   std::vector<MethodFeatures> methods;
   methods.push_back(describe_ours(set, a.pipeline.descriptor, 0.0, a.seed));
   methods.push_back(describe_zncc(set));
