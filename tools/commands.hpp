@@ -25,5 +25,7 @@ void add_pattern_command(CLI::App& app);
 void add_simulate_command(CLI::App& app);
 void add_track_command(CLI::App& app);
 void add_evaluate_command(CLI::App& app);
+// omnivert study similarity|sensitivity|baselines: the descriptor study (tools/cmd_study.cpp).
+void add_study_command(CLI::App& app);
 
 }  // namespace omnivert::cli

@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   omnivert::cli::add_simulate_command(app);
   omnivert::cli::add_track_command(app);
   omnivert::cli::add_evaluate_command(app);
+  omnivert::cli::add_study_command(app);
 
   try {
     app.parse(argc, argv);

@@ -1,0 +1,579 @@
+// omnivert study: the paper's descriptor study (Sec. 5-6) and baselines, as CSV and PNG
+// files in --out DIR (docs/study.md).
+//   study similarity IMAGE   similarity matrices, ours / SSD / ZNCC (Figs. 9-12)
+//   study sensitivity DATA   % correct NN vs clip, noise, bins/areas; rule PDFs (Figs. 13-18)
+//   study baselines DATA     precision/recall of ours, ZNCC and LBD on the same frames
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+#include "commands.hpp"
+#include "omnivert/core/angles.hpp"
+#include "omnivert/core/error.hpp"
+#include "omnivert/core/image_io.hpp"
+#include "omnivert/core/progress.hpp"
+#include "omnivert/dataset/dataset.hpp"
+#include "omnivert/eval/descriptor_study.hpp"
+#include "omnivert/eval/similarity_study.hpp"
+#include "omnivert/eval/study_plot.hpp"
+#include "omnivert/match/matcher.hpp"
+#include "pipeline_options.hpp"
+
+namespace omnivert::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string f6(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+
+void ensure_dir(const std::string& dir) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir)) throw InputError(dir, 0, "cannot create the output folder");
+}
+
+std::string out_path(const std::string& dir, const std::string& name) {
+  return (fs::path(dir) / name).string();
+}
+
+void write_matrix_csv(const std::string& path,
+                      const cv::Mat1f& m,
+                      const std::vector<double>& bearings) {
+  std::ostringstream s;
+  s << "#bearing [deg]";
+  for (double b : bearings) s << ',' << f6(rad2deg(wrap_positive(b)));
+  s << '\n';
+  for (int i = 0; i < m.rows; ++i) {
+    s << f6(rad2deg(wrap_positive(bearings[static_cast<std::size_t>(i)])));
+    for (int j = 0; j < m.cols; ++j) s << ',' << f6(m(i, j));
+    s << '\n';
+  }
+  write_text_atomic(path, s.str());
+}
+
+// ---------------------------------------------------------------- similarity
+struct SimilarityArgs {
+  std::string image, sensor, out;
+  int steps = 360;
+  double band = 10.0;
+  FeaturePipelineOptions pipeline;
+};
+
+void run_similarity(const SimilarityArgs& a) {
+  std::string why;
+  if (!a.pipeline.IsValid(&why)) throw InputError("invalid options: " + why);
+  const cv::Mat image = read_image(a.image);
+  CameraGeometry geometry;
+  if (!a.sensor.empty()) geometry = load_camera_geometry(a.sensor);
+  FeaturePipeline pipe(geometry, a.pipeline);
+  FrameFeatures f;
+  if (!pipe.process(image, f, &why)) throw InputError(a.image, 0, why);
+  ensure_dir(a.out);  // after the input is known to be good
+  cv::Mat gray;
+  FeaturePipeline::to_gray8(image, gray);
+  SimilarityOptions o;
+  o.steps = a.steps;
+  o.band_deg = a.band;
+  o.descriptor = a.pipeline.descriptor;
+  o.bearing_sign = geometry.bearing_sign;
+  const SimilarityResult r = similarity_study(gray, f.circle, o);
+
+  struct M {
+    const char* name;
+    const cv::Mat1f* m;
+    const Distinctiveness* d;
+    const char* title;
+    const char* scale;
+  };
+  const M ms[] = {{"descriptor",
+                   &r.descriptor,
+                   &r.descriptor_d,
+                   "Our descriptor: distance (eq. 6)",
+                   "distance"},
+                  {"ssd", &r.ssd, &r.ssd_d, "SSD of the 2 r_a pattern (per pixel)", "SSD / px"},
+                  {"zncc", &r.zncc, &r.zncc_d, "1 - ZNCC of the 2 r_a pattern", "1 - ZNCC"}};
+  std::ostringstream sum;
+  sum << "#measure,gap,median_gap,ambiguous_share,valley_deg,median_distance,band_deg\n";
+  std::printf(
+      "%s: centre (%.1f, %.1f), annulus %.1f..%.1f px, panorama %dx%d, pattern %d columns\n",
+      a.image.c_str(),
+      f.circle.center.x(),
+      f.circle.center.y(),
+      f.circle.r_min,
+      f.circle.r_max,
+      r.panorama.width(),
+      r.panorama.rows(),
+      r.pattern_columns);
+  std::printf(
+      "%-11s %8s %11s %10s %11s   (gap: mean nearest distance outside +-%.0f deg / median distance;"
+      " ambiguous: rows with gap < %.2f)\n",
+      "measure",
+      "gap",
+      "median_gap",
+      "ambiguous",
+      "valley[deg]",
+      a.band,
+      o.ambiguous_below);
+  for (const auto& m : ms) {
+    write_matrix_csv(
+        out_path(a.out, std::string("similarity_") + m.name + ".csv"), *m.m, r.bearings);
+    HeatmapOptions h;
+    char t[200];
+    std::snprintf(t,
+                  sizeof t,
+                  "%s   gap %.2f, ambiguous %.0f%%, valley %.0f deg",
+                  m.title,
+                  m.d->gap,
+                  100 * m.d->ambiguous,
+                  m.d->valley_deg);
+    h.title = t;
+    h.scale_label = m.scale;
+    h.cell = std::max(1, 720 / std::max(1, r.descriptor.rows));
+    write_image_atomic(out_path(a.out, std::string("similarity_") + m.name + ".png"),
+                       draw_heatmap(*m.m, h));
+    sum << m.name << ',' << f6(m.d->gap) << ',' << f6(m.d->median_gap) << ',' << f6(m.d->ambiguous)
+        << ',' << f6(m.d->valley_deg) << ',' << f6(m.d->median_distance) << ',' << f6(a.band)
+        << '\n';
+    std::printf("%-11s %8.3f %11.3f %9.1f%% %11.1f\n",
+                m.name,
+                m.d->gap,
+                m.d->median_gap,
+                100 * m.d->ambiguous,
+                m.d->valley_deg);
+  }
+  write_text_atomic(out_path(a.out, "similarity_summary.csv"), sum.str());
+  // The panorama with the pattern of bearing 0 (Fig. 10).
+  cv::Mat pano8, pano;
+  r.panorama.image.convertTo(pano8, CV_8U);
+  cv::cvtColor(pano8, pano, cv::COLOR_GRAY2BGR);
+  const int c0 = static_cast<int>(
+      std::lround(r.panorama.column_of_bearing(deg2rad(90.0)) - 0.5 * (r.pattern_columns - 1)));
+  cv::rectangle(pano, cv::Rect(c0, 0, r.pattern_columns, r.panorama.rows()), {0, 0, 255}, 2);
+  write_image_atomic(out_path(a.out, "panorama.png"), pano);
+  std::printf(
+      "wrote %s/similarity_{descriptor,ssd,zncc}.{csv,png}, similarity_summary.csv, panorama.png\n",
+      a.out.c_str());
+}
+
+// ---------------------------------------------------------------- sensitivity
+struct DatasetArgs {
+  std::string dataset, out;
+  double max_baseline = 2.0;
+  int stride = 1;
+  int max_frames = 0;
+  std::uint64_t seed = 1;
+  FeaturePipelineOptions pipeline;
+};
+
+StudySet load_set(const DatasetArgs& a, dataset::Dataset& data) {
+  dataset::LoadOptions lo;
+  lo.require_wheel = false;
+  data = dataset::Dataset::load(a.dataset, lo);
+  StudyOptions so;
+  so.max_baseline = a.max_baseline;
+  so.frame_stride = a.stride;
+  so.max_frames = a.max_frames;
+  so.pipeline = a.pipeline;
+  so.progress = Progress::enabled();
+  StudySet set = load_study_set(data, so);
+  std::printf(
+      "%s: %zu frames, %zu lines (%zu associated to ground truth), %zu frame pairs within %.2f m\n",
+      a.dataset.c_str(),
+      set.frames.size(),
+      set.lines(),
+      set.associated(),
+      set.frame_pairs(),
+      a.max_baseline);
+  return set;
+}
+
+void write_plot(const std::string& path, const std::vector<PlotSeries>& s, const PlotOptions& o) {
+  write_image_atomic(path, draw_plot(s, o));
+}
+
+// Histogram densities of values (correct / incorrect) over [0, hi].
+void pdf(const std::vector<double>& v,
+         double hi,
+         int bins,
+         std::vector<double>& x,
+         std::vector<double>& y) {
+  x.assign(bins, 0), y.assign(bins, 0);
+  const double w = hi / bins;
+  for (int i = 0; i < bins; ++i) x[i] = (i + 0.5) * w;
+  if (v.empty()) return;
+  for (double t : v) {
+    const int b = std::clamp(static_cast<int>(t / w), 0, bins - 1);
+    y[b] += 1.0;
+  }
+  for (double& t : y) t /= (v.size() * w);
+}
+
+void run_sensitivity(const DatasetArgs& a) {
+  dataset::Dataset data;
+  const StudySet set = load_set(a, data);  // validates the input before any output exists
+  ensure_dir(a.out);
+  const DescriptorOptions base = a.pipeline.descriptor;
+  // Three scores per setting: the database NN of the paper, the frame-pair NN, and the
+  // frame-pair NN over baselines of 1-2 m.
+  struct Scores {
+    NearestNeighbourScore db, pair, far;
+    double ap = 0;
+  };
+  auto score = [&](const DescriptorOptions& d, double noise) {
+    const auto m = describe_ours(set, d, noise, a.seed);
+    const auto rec = match_frame_pairs(set, m);
+    Scores s;
+    s.db = nearest_neighbour_score(set, m);
+    s.pair = pair_nearest_score(set, rec);
+    s.far = pair_nearest_score(set, rec, 1.0, a.max_baseline);
+    s.ap = average_precision(precision_recall(rec, 0));
+    return s;
+  };
+  auto head = [](std::ostringstream& o) {
+    o << "queries_db,correct_db,percent_db,queries_pair,percent_pair,queries_pair_1m,percent_pair_"
+         "1m,"
+         "ratio_test_average_precision\n";
+  };
+  auto row = [](std::ostringstream& o, const Scores& s) {
+    o << s.db.queries << ',' << s.db.correct << ',' << f6(s.db.percent()) << ',' << s.pair.queries
+      << ',' << f6(s.pair.percent()) << ',' << s.far.queries << ',' << f6(s.far.percent()) << ','
+      << f6(s.ap) << '\n';
+  };
+  auto three = [](const std::string& suffix) {
+    return std::vector<PlotSeries>{{"database NN" + suffix, {}, {}, plot_color(0)},
+                                   {"frame-pair NN" + suffix, {}, {}, plot_color(1)},
+                                   {"frame-pair NN, 1-2 m" + suffix, {}, {}, plot_color(2)}};
+  };
+  auto add = [](std::vector<PlotSeries>& v, std::size_t at, double x, const Scores& s) {
+    v[at].x.push_back(x), v[at].y.push_back(s.db.percent());
+    v[at + 1].x.push_back(x), v[at + 1].y.push_back(s.pair.percent());
+    v[at + 2].x.push_back(x), v[at + 2].y.push_back(s.far.percent());
+  };
+  std::printf(
+      "%% correct nearest neighbour: database (all frames within the baseline) / frame pairs / "
+      "frame "
+      "pairs 1-2 m apart; AP: average precision of the ratio test on frame pairs\n");
+
+  // Fig. 13: clipping threshold.
+  const std::vector<double> clips = {0.025, 0.05, 0.075, 0.1, 0.125, 0.15, 0.2, 0.3, 0.5, 1.0};
+  std::ostringstream cs;
+  cs << "#clip,";
+  head(cs);
+  auto sc = three("");
+  std::printf("Fig. 13, clipping threshold (1.0 = no clipping)\n");
+  for (double c : clips) {
+    DescriptorOptions d = base;
+    d.clip = c;
+    const auto s = score(d, 0.0);
+    cs << f6(c) << ',';
+    row(cs, s);
+    add(sc, 0, c, s);
+    std::printf("  clip %-6g %6.2f%% %6.2f%% %6.2f%%  AP %.4f\n",
+                c,
+                s.db.percent(),
+                s.pair.percent(),
+                s.far.percent(),
+                s.ap);
+  }
+  write_text_atomic(out_path(a.out, "sensitivity_clip.csv"), cs.str());
+  PlotOptions pc{
+      "Fig. 13: influence of clipping", "clipping threshold", "% correct nearest neighbour"};
+  pc.vertical_lines = {base.clip};
+  pc.vertical_labels = {"default"};
+  pc.legend_bottom = true;
+  write_plot(out_path(a.out, "sensitivity_clip.png"), sc, pc);
+
+  // Fig. 14: Gaussian image noise, sigma = p% of 255.
+  std::ostringstream ns;
+  ns << "#noise_percent,sigma_grey,";
+  head(ns);
+  auto sn = three("");
+  std::printf("Fig. 14, Gaussian image noise (sigma in %% of 255)\n");
+  for (double p : {0.0, 1.0, 2.0, 4.0, 6.0, 8.0, 10.0}) {
+    const auto s = score(base, p / 100.0 * 255.0);
+    ns << f6(p) << ',' << f6(p * 2.55) << ',';
+    row(ns, s);
+    add(sn, 0, p, s);
+    std::printf("  noise %4.1f%% %6.2f%% %6.2f%% %6.2f%%  AP %.4f\n",
+                p,
+                s.db.percent(),
+                s.pair.percent(),
+                s.far.percent(),
+                s.ap);
+  }
+  write_text_atomic(out_path(a.out, "sensitivity_noise.csv"), ns.str());
+  PlotOptions pn{
+      "Fig. 14: influence of image noise", "noise sigma [% of 255]", "% correct nearest neighbour"};
+  pn.legend_bottom = true;
+  write_plot(out_path(a.out, "sensitivity_noise.png"), sn, pn);
+
+  // Fig. 15: bins and areas; with the separation of the rule-3 ratio (average precision).
+  std::ostringstream bs;
+  bs << "#bins,areas,size,";
+  head(bs);
+  std::vector<PlotSeries> sb;
+  std::printf("Fig. 15, orientation bins x areas\n");
+  for (int areas : {3, 5}) {
+    auto s3 = three(areas == 3 ? ", 3 areas" : ", 5 areas");
+    for (auto& s : s3) s.dashed = areas == 5;
+    for (int bins : {8, 16, 32}) {
+      DescriptorOptions d = base;
+      d.bins = bins, d.areas = areas;
+      const auto s = score(d, 0.0);
+      bs << bins << ',' << areas << ',' << d.size() << ',';
+      row(bs, s);
+      add(s3, 0, bins, s);
+      std::printf("  %2d bins, %d areas (%3d-D): %6.2f%% %6.2f%% %6.2f%%  AP %.4f\n",
+                  bins,
+                  areas,
+                  d.size(),
+                  s.db.percent(),
+                  s.pair.percent(),
+                  s.far.percent(),
+                  s.ap);
+    }
+    sb.insert(sb.end(), s3.begin(), s3.end());
+  }
+  write_text_atomic(out_path(a.out, "sensitivity_bins.csv"), bs.str());
+  PlotOptions pb{
+      "Fig. 15: orientation bins and areas", "orientation bins", "% correct nearest neighbour"};
+  pb.legend_bottom = true;
+  pb.x_lo = 4, pb.x_hi = 52;  // room on the right for the legend
+  write_plot(out_path(a.out, "sensitivity_bins.png"), sb, pb);
+
+  // Figs. 16-18: PDFs of correct / incorrect nearest matches for the three rules (frame pairs).
+  const auto records = match_frame_pairs(set, describe_ours(set, base, 0.0, a.seed));
+  const MatchOptions F;
+  const double thr[3] = {F.f1, F.f2, F.f3};
+  const char* names[3] = {
+      "nearest distance", "nearest / mean distance", "nearest / second-nearest distance"};
+  const char* fig[3] = {"Fig. 16: rule 1", "Fig. 17: rule 2", "Fig. 18: rule 3"};
+  std::ostringstream rs;
+  rs << "#rule,threshold,correct,incorrect,false_removed,correct_lost\n";
+  std::int64_t n_correct = 0;
+  for (const auto& r : records) n_correct += r.correct();
+  std::printf("Figs. 16-18, %zu frame-pair queries, %.1f%% nearest correct\n",
+              records.size(),
+              records.empty() ? 0.0 : 100.0 * n_correct / records.size());
+  for (int rule = 1; rule <= 3; ++rule) {
+    std::vector<double> cv, iv;
+    double hi = 0;
+    for (const auto& r : records) {
+      const double v = rule_value(r, rule);
+      (r.correct() ? cv : iv).push_back(v);
+      hi = std::max(hi, v);
+    }
+    hi = rule == 1 ? std::max(1.5, hi * 1.02) : 1.0;
+    std::vector<double> x, yc, yi;
+    pdf(cv, hi, 50, x, yc);
+    pdf(iv, hi, 50, x, yi);
+    std::ostringstream ps;
+    ps << "#value,pdf_correct,pdf_incorrect\n";
+    for (std::size_t i = 0; i < x.size(); ++i)
+      ps << f6(x[i]) << ',' << f6(yc[i]) << ',' << f6(yi[i]) << '\n';
+    write_text_atomic(out_path(a.out, "rule" + std::to_string(rule) + "_pdf.csv"), ps.str());
+    const auto sh = rule_shares(records, rule, thr[rule - 1]);
+    rs << rule << ',' << f6(sh.threshold) << ',' << sh.correct << ',' << sh.incorrect << ','
+       << f6(sh.false_removed) << ',' << f6(sh.correct_lost) << '\n';
+    char t[160];
+    std::snprintf(t,
+                  sizeof t,
+                  "%s: removes %.0f%% of false, loses %.0f%% of correct",
+                  fig[rule - 1],
+                  100 * sh.false_removed,
+                  100 * sh.correct_lost);
+    PlotOptions po{t, names[rule - 1], "probability density"};
+    po.x_lo = 0, po.x_hi = hi;
+    po.y_lo = 0;
+    for (std::size_t i = 0; i < x.size(); ++i)
+      po.y_hi = std::max({po.y_hi, 1.08 * yc[i], 1.08 * yi[i]});
+    if (!(po.y_hi > 0)) po.y_hi = 1;
+    po.vertical_lines = {thr[rule - 1]};
+    po.vertical_labels = {"F" + std::to_string(rule) + " = " + f6(thr[rule - 1])};
+    write_plot(out_path(a.out, "rule" + std::to_string(rule) + "_pdf.png"),
+               {{"correct matches", x, yc, plot_color(2), false},
+                {"incorrect matches", x, yi, plot_color(3), false}},
+               po);
+    std::printf(
+        "  rule %d (F = %.2f): removes %5.1f%% of false matches, loses %5.1f%% of correct ones\n",
+        rule,
+        thr[rule - 1],
+        100 * sh.false_removed,
+        100 * sh.correct_lost);
+  }
+  const auto all = rules_operating_point(records, F.f1, F.f2, F.f3);
+  rs << "all,,,," << f6(all.precision) << ',' << f6(all.recall)
+     << "  # precision, recall of the three rules together\n";
+  std::printf("  all three rules: precision %.1f%%, recall %.1f%%\n",
+              100 * all.precision,
+              100 * all.recall);
+  write_text_atomic(out_path(a.out, "rules.csv"), rs.str());
+  std::printf(
+      "wrote %s/sensitivity_{clip,noise,bins}.{csv,png}, rule{1,2,3}_pdf.{csv,png}, rules.csv\n",
+      a.out.c_str());
+}
+
+// ---------------------------------------------------------------- baselines
+void run_baselines(const DatasetArgs& a) {
+  dataset::Dataset data;
+  const StudySet set = load_set(a, data);  // validates the input before any output exists
+  ensure_dir(a.out);
+  std::vector<MethodFeatures> methods;
+  methods.push_back(describe_ours(set, a.pipeline.descriptor, 0.0, a.seed));
+  methods.push_back(describe_zncc(set));
+  methods.push_back(describe_lbd_on_our_lines(set));
+  LbdOptions lo;
+  methods.push_back(describe_lbd_segments(set, data, lo, deg2rad(1.0)));
+  lo.use_lsd = true;
+  methods.push_back(describe_lbd_segments(set, data, lo, deg2rad(1.0)));
+
+  const std::vector<double> levels = {0.5, 0.6, 0.7, 0.8, 0.9};
+  std::ostringstream bs, cs;
+  bs << "#method,lines_per_frame,queries_per_frame,frame_pair_queries,nn_database_percent,average_"
+        "precision,max_recall";
+  for (double r : levels) bs << ",precision_at_recall_" << f6(r);
+  bs << '\n';
+  cs << "#method,ratio_threshold,precision,recall\n";
+  std::vector<PlotSeries> series;
+  std::printf(
+      "%-14s %6s %7s %8s %7s %6s %7s", "method", "lines", "queries", "NN db %", "AP", "max R", "");
+  for (double r : levels) std::printf(" P@R%.1f", r);
+  std::printf("\n");
+  for (std::size_t mi = 0; mi < methods.size(); ++mi) {
+    const auto& m = methods[mi];
+    std::size_t lines = 0, queries = 0;
+    for (const auto& ids : m.ids) {
+      lines += ids.size();
+      for (int id : ids) queries += id >= 0;
+    }
+    const auto records = match_frame_pairs(set, m);
+    const auto full = precision_recall(records, 0);
+    const auto nn = nearest_neighbour_score(set, m);
+    const double ap = average_precision(full);
+    const double max_r = full.empty() ? 0.0 : full.back().recall;
+    const double nf = static_cast<double>(set.frames.size());
+    bs << m.name << ',' << f6(lines / nf) << ',' << f6(queries / nf) << ',' << records.size() << ','
+       << f6(nn.percent()) << ',' << f6(ap) << ',' << f6(max_r);
+    std::printf("%-14s %6.1f %7.1f %7.2f%% %7.4f %6.3f %7s",
+                m.name.c_str(),
+                lines / nf,
+                queries / nf,
+                nn.percent(),
+                ap,
+                max_r,
+                "");
+    for (double r : levels) {
+      const double p = precision_at_recall(full, r);
+      bs << ',' << (std::isnan(p) ? std::string("") : f6(p));
+      if (std::isnan(p)) {
+        std::printf(" %6s", "-");
+      } else {
+        std::printf(" %6.3f", p);
+      }
+    }
+    bs << '\n';
+    std::printf("\n");
+    PlotSeries s{m.name, {}, {}, plot_color(static_cast<int>(mi)), false};
+    for (const auto& p : precision_recall(records, 300)) {
+      cs << m.name << ',' << f6(p.threshold) << ',' << f6(p.precision) << ',' << f6(p.recall)
+         << '\n';
+      s.x.push_back(p.recall), s.y.push_back(p.precision);
+    }
+    series.push_back(s);
+    if (mi == 0) {
+      const MatchOptions F;
+      const auto op = rules_operating_point(records, F.f1, F.f2, F.f3);
+      bs << "ours_three_rules,,,,,,," << f6(op.precision) << ',' << f6(op.recall)
+         << "  # precision, recall at F1, F2, F3\n";
+      std::printf("%-14s precision %.3f at recall %.3f (F1 %.2f, F2 %.2f, F3 %.2f)\n",
+                  "ours 3 rules",
+                  op.precision,
+                  op.recall,
+                  F.f1,
+                  F.f2,
+                  F.f3);
+    }
+  }
+  write_text_atomic(out_path(a.out, "baselines.csv"), bs.str());
+  write_text_atomic(out_path(a.out, "baselines_pr.csv"), cs.str());
+  PlotOptions po{"Precision-recall, ratio test nearest / second (frame pairs within baseline)",
+                 "recall",
+                 "precision"};
+  po.x_lo = 0, po.x_hi = 1, po.y_lo = 0, po.y_hi = 1.02;
+  po.legend_bottom = true;
+  write_plot(out_path(a.out, "baselines_pr.png"), series, po);
+  std::printf("wrote %s/baselines.csv, baselines_pr.{csv,png}\n", a.out.c_str());
+}
+
+void add_dataset_options(CLI::App* cmd, DatasetArgs& a) {
+  cmd->add_option("DATASET", a.dataset, "Dataset with ground_truth/lines.csv and poses.csv")
+      ->required();
+  cmd->add_option("--out", a.out, "Output folder (created)")->required();
+  cmd->add_option("--max-baseline",
+                  a.max_baseline,
+                  "Compare frames up to this far apart [m] (Sec. 6.0.1: 2)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--stride", a.stride, "Use every n-th image")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--max-frames", a.max_frames, "Use at most this many images (0: all)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--seed", a.seed, "Seed of the image noise (Fig. 14)")->capture_default_str();
+  add_pipeline_options(cmd, a.pipeline);
+  cmd->add_flag("!--linear-intensity",
+                a.pipeline.descriptor.log_intensity,
+                "Gradients of the grey level I (the paper) instead of log(2 + I)")
+      ->group("Descriptor (Sec. 3)");
+}
+
+}  // namespace
+
+void add_study_command(CLI::App& app) {
+  CLI::App* study = app.add_subcommand(
+      "study", "The paper's descriptor study (Sec. 5-6) and baselines, as CSV and PNG");
+  study->require_subcommand(1);
+
+  auto s = std::make_shared<SimilarityArgs>();
+  CLI::App* sim = study->add_subcommand(
+      "similarity", "Similarity matrices of one image: ours, SSD, ZNCC (Figs. 9-12)");
+  sim->add_option("IMAGE", s->image, "Catadioptric image")->required();
+  sim->add_option("--sensor", s->sensor, "cam0/sensor.yaml: centre, r_min, r_max, bearing_sign");
+  sim->add_option("--out", s->out, "Output folder (created)")->required();
+  sim->add_option("--steps", s->steps, "Bearings over 360 degrees (the paper: 360)")
+      ->check(CLI::Range(12, 1440))
+      ->capture_default_str();
+  sim->add_option("--band", s->band, "Degrees around the diagonal left out of the distinctiveness")
+      ->check(CLI::Range(0.0, 90.0))
+      ->capture_default_str();
+  add_pipeline_options(sim, s->pipeline);
+  sim->callback([s] { run_similarity(*s); });
+
+  auto d = std::make_shared<DatasetArgs>();
+  CLI::App* sens = study->add_subcommand("sensitivity",
+                                         "% correct nearest neighbour vs clip, noise, bins/areas; "
+                                         "PDFs of the three rules (Figs. 13-18)");
+  add_dataset_options(sens, *d);
+  sens->callback([d] { run_sensitivity(*d); });
+
+  auto b = std::make_shared<DatasetArgs>();
+  CLI::App* base = study->add_subcommand(
+      "baselines", "Precision/recall of ours, ZNCC and LBD on the same frames");
+  add_dataset_options(base, *b);
+  base->callback([b] { run_baselines(*b); });
+}
+
+}  // namespace omnivert::cli
