@@ -6,6 +6,8 @@
 //   0 success; 1 the work failed (a message says why); 2 bad input or usage (file, line,
 //   problem); 3 the result is not determined (calibrate: unobservable trajectory).
 
+#include <string>
+
 #include <CLI/CLI.hpp>
 
 namespace omnivert::cli {
@@ -27,5 +29,11 @@ void add_track_command(CLI::App& app);
 void add_evaluate_command(CLI::App& app);
 // omnivert study similarity|sensitivity|baselines: the descriptor study (tools/cmd_study.cpp).
 void add_study_command(CLI::App& app);
+// omnivert calibrate: the main job (tools/cmd_calibrate.cpp).
+void add_calibrate_command(CLI::App& app);
+
+// The command line as given (for reports), set by main().
+void set_command_line(int argc, char** argv);
+const std::string& command_line();
 
 }  // namespace omnivert::cli

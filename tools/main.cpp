@@ -3,6 +3,7 @@
 
 #include <cstdio>
 #include <exception>
+#include <string>
 
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
@@ -10,6 +11,22 @@
 
 #include "commands.hpp"
 #include "omnivert/core/error.hpp"
+
+namespace omnivert::cli {
+namespace {
+std::string g_command_line;
+}
+void set_command_line(int argc, char** argv) {
+  g_command_line.clear();
+  for (int i = 0; i < argc; ++i) {
+    if (i) g_command_line += ' ';
+    const std::string a = argv[i];
+    const bool quote = a.empty() || a.find_first_of(" \t'\"$") != std::string::npos;
+    g_command_line += quote ? "'" + a + "'" : a;
+  }
+}
+const std::string& command_line() { return g_command_line; }
+}  // namespace omnivert::cli
 
 int main(int argc, char** argv) {
   // Warnings and log lines go to stderr: stdout carries results (tables, summaries).
@@ -27,6 +44,8 @@ int main(int argc, char** argv) {
   omnivert::cli::add_track_command(app);
   omnivert::cli::add_evaluate_command(app);
   omnivert::cli::add_study_command(app);
+  omnivert::cli::add_calibrate_command(app);
+  omnivert::cli::set_command_line(argc, argv);
 
   try {
     app.parse(argc, argv);

@@ -4,6 +4,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
+#include <algorithm>
 #include <limits>
 #include <memory>
 #include <sstream>
@@ -205,6 +206,27 @@ RefinementResult refine_batch(const CalibrationRun& run,
     ceres::Solve(so, b.problem.get(), &summary);
   }
   res.num_bearings = b.num_bearings;
+  res.num_features = static_cast<int>(b.features.size());
+  {
+    // Bearing residuals at the solution, in radians (their scatter is the bearing noise the
+    // data really has: calibrate() can estimate the bearing sigma from it).
+    // Robust scale (1.4826 x median |r|: false matches left inside the gate do not inflate
+    // it), corrected for the parameters fitted (2 per feature, 3 extrinsics).
+    std::vector<double> a;
+    a.reserve(b.bearing_blocks.size());
+    for (ceres::ResidualBlockId id : b.bearing_blocks) {
+      double r = 0.0, cost = 0.0;
+      b.problem->EvaluateResidualBlock(id, /*apply_loss_function=*/false, &cost, &r, nullptr);
+      a.push_back(std::abs(r));
+    }
+    const int dof = b.num_bearings - 2 * res.num_features - 3;
+    if (dof > 0 && !a.empty()) {
+      std::nth_element(a.begin(), a.begin() + a.size() / 2, a.end());
+      const double mad = 1.4826 * a[a.size() / 2];
+      res.bearing_residual_sigma =
+          mad * std::sqrt(static_cast<double>(a.size()) / dof) * options.bearing_sigma;
+    }
+  }
   res.converged = summary.termination_type == ceres::CONVERGENCE;
   res.initial_cost = summary.initial_cost;
   res.final_cost = summary.final_cost;

@@ -1,5 +1,6 @@
 #include "omnivert/calib/calibrate.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -12,10 +13,12 @@
 
 namespace omnivert::calib {
 
-CalibrationResult calibrate(const CalibrationRun& run,
-                            const Options& options,
-                            const CalibrateOptions& co) {
+namespace {
+CalibrationResult calibrate_once(const CalibrationRun& run,
+                                 const Options& options,
+                                 const CalibrateOptions& co) {
   CalibrationResult r;
+  r.bearing_sigma = options.bearing_sigma;
   r.filter = run_filter(run, options);
   r.extrinsics = r.filter.extrinsics;
   r.covariance = r.filter.covariance;
@@ -23,15 +26,31 @@ CalibrationResult calibrate(const CalibrationRun& run,
   if (co.refine) {
     r.refinement = refine_batch(run, options, at, co.batch);
     r.refined = true;
-    if (r.refinement.covariance_ok) {
-      r.extrinsics = r.refinement.extrinsics;
-      r.covariance = r.refinement.covariance;
-    }
     at = r.refinement.solution;
   }
   // Sec. 8.1 at the best estimate of the trajectory, the features and the extrinsics.
   r.observability = analyse_observability(run, options, at, co.batch, co.observability);
+  if (r.refined && !r.refinement.covariance_ok && r.observability.all_determined() &&
+      r.observability.crlb_covariance.allFinite()) {
+    // ceres::Covariance gives up on badly scaled problems (poses in metres, bearings whitened
+    // by a small sigma); the marginal Fisher information at the same solution is the same
+    // quantity, computed with the Schur complement.
+    r.refinement.covariance = r.observability.crlb_covariance;
+    r.refinement.covariance_ok = true;
+    r.covariance_from_information = true;
+  }
+  if (r.refined && r.refinement.covariance_ok) {
+    r.extrinsics = r.refinement.extrinsics;
+    r.covariance = r.refinement.covariance;
+  }
   return r;
+}
+}  // namespace
+
+CalibrationResult calibrate(const CalibrationRun& run,
+                            const Options& options,
+                            const CalibrateOptions& co) {
+  return calibrate_once(run, options, co);
 }
 
 namespace {

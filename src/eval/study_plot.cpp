@@ -142,8 +142,21 @@ cv::Mat draw_heatmap(const cv::Mat1f& m, const HeatmapOptions& o) {
   return img;
 }
 
-cv::Mat draw_plot(const std::vector<PlotSeries>& series, const PlotOptions& o) {
+cv::Mat draw_plot(const std::vector<PlotSeries>& series_in, const PlotOptions& o) {
+  // A logarithmic y axis plots log10(y) (non-positive values are left out) and labels the
+  // ticks with the values themselves.
+  std::vector<PlotSeries> logged;
+  if (o.log_y) {
+    logged = series_in;
+    for (auto& s : logged)
+      for (double& v : s.y) v = v > 0 ? std::log10(v) : std::numeric_limits<double>::quiet_NaN();
+  }
+  const std::vector<PlotSeries>& series = o.log_y ? logged : series_in;
   double xlo = o.x_lo, xhi = o.x_hi, ylo = o.y_lo, yhi = o.y_hi;
+  if (o.log_y && ylo < yhi) {
+    ylo = ylo > 0 ? std::log10(ylo) : 0.0;
+    yhi = std::log10(yhi);
+  }
   if (!(xlo < xhi) || !(ylo < yhi)) {
     double a = std::numeric_limits<double>::infinity(), b = -a, c = a, d = -a;
     for (const auto& s : series)
@@ -176,10 +189,23 @@ cv::Mat draw_plot(const std::vector<PlotSeries>& series, const PlotOptions& o) {
     cv::line(img, {X(v), top + ph}, {X(v), top + ph + 5}, kBlack);
     text(img, fmt(v), {X(v), top + ph + 20}, 0.45, kBlack, true);
   }
-  for (double v = std::ceil(ylo / ys - 1e-9) * ys; v <= yhi + 1e-9 * ys; v += ys) {
-    cv::line(img, {left, Y(v)}, {left + pw, Y(v)}, kLight);
-    cv::line(img, {left - 5, Y(v)}, {left, Y(v)}, kBlack);
-    text(img, fmt(v), {left - 55, Y(v) + 5}, 0.45);
+  if (o.log_y) {
+    // Decades labelled, 2 and 5 times each decade as light lines.
+    for (double d = std::floor(ylo); d <= yhi + 1e-9; d += 1.0) {
+      for (double m : {1.0, 2.0, 5.0}) {
+        const double v = d + std::log10(m);
+        if (v < ylo - 1e-9 || v > yhi + 1e-9) continue;
+        cv::line(img, {left, Y(v)}, {left + pw, Y(v)}, kLight);
+        cv::line(img, {left - (m == 1.0 ? 5 : 3), Y(v)}, {left, Y(v)}, kBlack);
+        if (m == 1.0 || yhi - ylo < 2.5) text(img, fmt(std::pow(10.0, v)), {left - 55, Y(v) + 5}, 0.45);
+      }
+    }
+  } else {
+    for (double v = std::ceil(ylo / ys - 1e-9) * ys; v <= yhi + 1e-9 * ys; v += ys) {
+      cv::line(img, {left, Y(v)}, {left + pw, Y(v)}, kLight);
+      cv::line(img, {left - 5, Y(v)}, {left, Y(v)}, kBlack);
+      text(img, fmt(v), {left - 55, Y(v) + 5}, 0.45);
+    }
   }
   cv::rectangle(img, cv::Rect(left, top, pw, ph), kBlack);
   for (std::size_t k = 0; k < o.vertical_lines.size(); ++k) {
@@ -212,14 +238,18 @@ cv::Mat draw_plot(const std::vector<PlotSeries>& series, const PlotOptions& o) {
   text(img, o.title, {o.width / 2, 28}, 0.6, kBlack, true);
   text(img, o.x_label, {left + pw / 2, o.height - 18}, 0.5, kBlack, true);
   vertical_text(img, o.y_label, {15, top + ph / 2});
-  // Legend, inside the plot.
+  // Legend, inside the plot (series without a name are left out of it).
+  std::vector<const PlotSeries*> named;
+  for (const auto& s : series)
+    if (!s.name.empty()) named.push_back(&s);
   int lw = 0;
-  for (const auto& s : series) {
+  for (const PlotSeries* sp : named) {
+    const PlotSeries& s = *sp;
     int base = 0;
     lw = std::max(lw, cv::getTextSize(s.name, cv::FONT_HERSHEY_SIMPLEX, 0.45, 1, &base).width);
   }
-  if (!series.empty()) {
-    const int bw = lw + 50, bh = 20 * static_cast<int>(series.size()) + 8;
+  if (!named.empty()) {
+    const int bw = lw + 50, bh = 20 * static_cast<int>(named.size()) + 8;
     // The corner (or side) where the legend covers the least data; the preferred one on ties.
     const int xr = pw - bw - 8, xl = 8, yt = 8, yb = ph - bh - 24, ym = (ph - bh) / 2;
     std::vector<cv::Point> spots = {{xr, yt}, {xr, yb}, {xl, yt}, {xl, yb}, {xr, ym}, {xl, ym}};
@@ -234,14 +264,15 @@ cv::Mat draw_plot(const std::vector<PlotSeries>& series, const PlotOptions& o) {
     const cv::Rect box(left + best.x, top + best.y, bw, bh);
     img(box).setTo(kWhite);
     cv::rectangle(img, box, kGrey);
-    for (std::size_t si = 0; si < series.size(); ++si) {
+    for (std::size_t si = 0; si < named.size(); ++si) {
+      const PlotSeries& ns = *named[si];
       const int y = box.y + 16 + 20 * static_cast<int>(si);
-      if (series[si].dashed) {
-        dashed_line(img, {box.x + 6, y - 4}, {box.x + 36, y - 4}, series[si].color, 2);
+      if (ns.dashed) {
+        dashed_line(img, {box.x + 6, y - 4}, {box.x + 36, y - 4}, ns.color, 2);
       } else {
-        cv::line(img, {box.x + 6, y - 4}, {box.x + 36, y - 4}, series[si].color, 2, cv::LINE_AA);
+        cv::line(img, {box.x + 6, y - 4}, {box.x + 36, y - 4}, ns.color, 2, cv::LINE_AA);
       }
-      text(img, series[si].name, {box.x + 42, y}, 0.45);
+      text(img, ns.name, {box.x + 42, y}, 0.45);
     }
   }
   return img;

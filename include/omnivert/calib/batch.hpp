@@ -57,6 +57,11 @@ struct RefinementResult {
   int iterations = 0;
   int num_bearings = 0;  // bearings used
   int num_rejected = 0;  // bearings removed as outliers (|residual| > the filter's gate)
+  int num_features = 0;  // tracks in the problem
+  // Scale of the bearing residuals at the solution, outliers removed [rad]: 1.4826 x median
+  // |residual| x sqrt(bearings / (bearings - 2 features - 3)); the bearing noise the data
+  // has (infinity without redundancy).
+  double bearing_residual_sigma = std::numeric_limits<double>::infinity();
   std::string report;    // Ceres' brief report
 };
 

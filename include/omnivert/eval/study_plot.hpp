@@ -25,7 +25,7 @@ struct HeatmapOptions {
 cv::Mat draw_heatmap(const cv::Mat1f& matrix, const HeatmapOptions& options);
 
 struct PlotSeries {
-  std::string name;
+  std::string name;  // empty: not in the legend
   std::vector<double> x, y;
   cv::Scalar color;     // BGR
   bool markers = true;  // a dot at every point
@@ -40,6 +40,7 @@ struct PlotOptions {
   std::vector<double> vertical_lines;        // drawn grey, dashed (thresholds)
   std::vector<std::string> vertical_labels;  // written at the bottom of each line
   bool legend_bottom = false;                // legend box bottom right instead of top right
+  bool log_y = false;  // logarithmic y axis (y_lo, y_hi in data units; values <= 0 left out)
 };
 
 cv::Mat draw_plot(const std::vector<PlotSeries>& series, const PlotOptions& options);

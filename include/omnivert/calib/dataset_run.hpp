@@ -1,0 +1,56 @@
+#pragma once
+// From a recorded dataset and its tracks to the calibration's input (what `omnivert
+// calibrate` does between tracking and the filter of Sec. 8.2):
+//   - per image, the wheel travels since the previous image (eq. 14-15's inputs), from the
+//     cumulative travel interpolated at the image timestamps (dataset::Dataset);
+//   - per image, the bearings of its tracked lines {track_id, beta}.
+//
+// Checks that turn bad recordings into warnings (each naming the file and lines):
+//   - a gap in the wheel data around an image (no wheel sample within `max_wheel_gap_s` on
+//     one side): the robot's pose at that image is not known, only the travel across the gap,
+//     so the image's bearings are dropped (the travel is kept: it sums correctly);
+//   - a track holding two lines of one frame (the paper's rules allow it): both bearings are
+//     dropped for that frame (which line is the track's is ambiguous);
+//   - long stretches with fewer than `min_lines` tracked lines ("too few lines for too
+//     long"): the filter dead-reckons through them; reported with their frames and duration.
+// A run in which no frame has `min_lines` lines is an InputError.
+
+#include <string>
+#include <vector>
+
+#include "omnivert/calib/types.hpp"
+#include "omnivert/dataset/dataset.hpp"
+#include "omnivert/match/tracks_io.hpp"
+
+namespace omnivert::calib {
+
+struct DatasetRunOptions {
+  double max_wheel_gap_s = 0.5;    // a wheel sample interval longer than this is a gap [s]
+  int min_lines = 2;               // fewer tracked lines than this in a frame: starved
+  double max_starved_s = 10.0;     // a starved stretch longer than this is warned about [s]
+  int min_track_length = 2;        // shorter tracks carry no parallax: left out
+};
+
+struct DatasetRun {
+  CalibrationRun run;
+  std::vector<std::string> warnings;
+  int frames_dropped_for_gaps = 0;  // frames whose bearings were dropped (wheel gap)
+  int double_claims = 0;            // (frame, track) pairs dropped
+  int starved_frames = 0;           // frames with fewer than min_lines lines
+  int tracks = 0;                   // tracks used
+  int observations = 0;             // bearings used
+  double path_length = 0.0;         // distance driven by the axle midpoint [m]
+  double rotation = 0.0;            // total |heading change| [rad]
+};
+
+// `rows` are tracks.csv rows of this dataset (frame = index into data.images()). The dataset
+// must have wheel data (InputError otherwise, naming wheel0/).
+DatasetRun calibration_run_from_tracks(const dataset::Dataset& data,
+                                       const std::vector<TrackRow>& rows,
+                                       const DatasetRunOptions& options = {});
+
+// Options filled from the dataset: wheel base from wheel0/sensor.yaml, Chong-Kleeman K from
+// its odometry_k when given (else the default of Options), the rest from `base`.
+Options options_from_dataset(const dataset::Dataset& data, Options base = {});
+
+}  // namespace omnivert::calib

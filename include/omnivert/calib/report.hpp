@@ -1,0 +1,64 @@
+#pragma once
+// What `omnivert calibrate` writes besides extrinsics.yaml and states.csv:
+//   convergence.png  the paper's Fig. 25: phi, rho, psi and their sigmas against the frame
+//                    number (with the ground truth, when the dataset has it, dashed);
+//   summary.json     inputs, verdicts (Sec. 8.1), estimates with sigmas and Cramer-Rao
+//                    bounds, and the errors against the ground truth when there is one;
+//   report.html      one page: the same, plus the pictures (convergence.png, tracks.png).
+// No output contains a NaN: a value that does not exist is null (JSON), "not determined"
+// (HTML) or .inf (YAML, an unbounded Cramer-Rao bound).
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "omnivert/calib/calibrate.hpp"
+#include "omnivert/calib/dataset_run.hpp"
+
+namespace omnivert::calib {
+
+// Errors of an estimate against the truth (angles wrapped).
+struct ErrorsVsTruth {
+  double phi = 0, rho = 0, psi = 0;  // [rad, m, rad]
+  double x = 0, y = 0;               // camera position [m]
+  double position = 0;               // |(x, y)| [m]
+  double yaw = 0;                    // phi + psi [rad]
+  double nees = 0;                   // e^T C^-1 e over (phi, rho, psi); inf if C is singular
+};
+ErrorsVsTruth errors_vs_truth(const Extrinsics& estimate,
+                              const Eigen::Matrix3d& covariance,
+                              const Extrinsics& truth);
+
+// Fig. 25: two rows of three plots (phi [deg], rho [mm], psi [deg]; their sigmas), against
+// the frame number, with +-3 sigma dashed around the estimate, the truth and the refined
+// value (when given) as horizontal lines.
+cv::Mat draw_convergence(const std::vector<FrameEstimate>& history,
+                         const std::optional<Extrinsics>& truth = std::nullopt,
+                         const std::optional<Extrinsics>& refined = std::nullopt);
+
+// Everything the report shows, gathered by the caller.
+struct ReportInputs {
+  std::string dataset;      // the dataset folder
+  std::string command;      // the command line, for reproduction
+  std::int64_t frames = 0;  // images
+  std::int64_t frames_skipped = 0;
+  std::int64_t detections = 0;
+  std::int64_t tracks_total = 0;  // tracks found by the tracker
+  const DatasetRun* run = nullptr;
+  Options options;
+  std::optional<Extrinsics> truth;  // ground_truth/extrinsics.yaml
+  bool force = false;
+  int exit_code = 0;
+  double seconds_tracking = 0, seconds_calibration = 0;
+  std::vector<std::string> warnings;  // tracking's and the run's
+  bool wrote_extrinsics = false;
+};
+
+// summary.json's text (pretty-printed JSON).
+std::string summary_json(const CalibrationResult& result, const ReportInputs& inputs);
+// report.html's text: refers to convergence.png and tracks.png next to it.
+std::string report_html(const CalibrationResult& result, const ReportInputs& inputs);
+
+}  // namespace omnivert::calib

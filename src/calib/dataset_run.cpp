@@ -1,0 +1,170 @@
+#include "omnivert/calib/dataset_run.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+#include "omnivert/core/error.hpp"
+
+namespace omnivert::calib {
+
+namespace {
+
+std::string wheel_csv(const dataset::Dataset& d) { return d.root() + "/wheel0/data.csv"; }
+
+// Index of the last wheel sample at or before t (the wheel data covers every image: the
+// dataset reader checks it).
+std::size_t sample_before(const std::vector<dataset::WheelRecord>& w, std::int64_t t) {
+  auto it = std::upper_bound(w.begin(), w.end(), t, [](std::int64_t v, const dataset::WheelRecord& r) {
+    return v < r.timestamp_ns;
+  });
+  return it == w.begin() ? 0 : static_cast<std::size_t>(it - w.begin()) - 1;
+}
+
+}  // namespace
+
+DatasetRun calibration_run_from_tracks(const dataset::Dataset& data,
+                                       const std::vector<TrackRow>& rows,
+                                       const DatasetRunOptions& opt) {
+  if (!data.has_wheel())
+    throw InputError(data.root() + "/wheel0", 0,
+                     "calibration needs wheel odometry (wheel0/data.csv and wheel0/sensor.yaml)");
+  const auto& images = data.images();
+  const auto& travel = data.travel_at_images();
+  const auto& wheel = data.wheel();
+  const std::size_t n = images.size();
+  DatasetRun out;
+  out.run.frames.resize(n);
+
+  // Wheel travel per frame (eq. 14-15's inputs), and the heading for the motion summary.
+  const double e = data.wheel_sensor().wheel_base;
+  for (std::size_t i = 1; i < n; ++i) {
+    FrameInput& f = out.run.frames[i];
+    f.d_left = travel[i].left - travel[i - 1].left;
+    f.d_right = travel[i].right - travel[i - 1].right;
+    out.path_length += std::abs(0.5 * (f.d_left + f.d_right));
+    if (e > 0) out.rotation += std::abs((f.d_right - f.d_left) / e);
+  }
+
+  // Wheel gaps: an image whose bracketing wheel samples are further apart than the limit.
+  std::vector<char> gap(n, 0);
+  {
+    int gap_first = -1, gap_last = -1;
+    std::size_t gap_sample = 0;
+    auto flush = [&]() {
+      if (gap_first < 0) return;
+      const auto& a = wheel[gap_sample];
+      const auto& b = wheel[std::min(gap_sample + 1, wheel.size() - 1)];
+      char buf[400];
+      std::snprintf(buf, sizeof buf,
+                    "%s: lines %d-%d: no wheel sample for %.3g s (limit %.3g s); the bearings "
+                    "of frames %d-%d (cam0/data.csv lines %d-%d) are not used, their poses "
+                    "being unknown; the travel across the gap is kept",
+                    wheel_csv(data).c_str(), a.line, b.line,
+                    static_cast<double>(b.timestamp_ns - a.timestamp_ns) * 1e-9,
+                    opt.max_wheel_gap_s, gap_first, gap_last, images[gap_first].line,
+                    images[gap_last].line);
+      out.warnings.emplace_back(buf);
+      gap_first = gap_last = -1;
+    };
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t k = sample_before(wheel, images[i].timestamp_ns);
+      bool is_gap = false;
+      if (wheel[k].timestamp_ns != images[i].timestamp_ns && k + 1 < wheel.size()) {
+        const double dt = static_cast<double>(wheel[k + 1].timestamp_ns - wheel[k].timestamp_ns) * 1e-9;
+        is_gap = dt > opt.max_wheel_gap_s;
+      }
+      if (is_gap) {
+        gap[i] = 1;
+        ++out.frames_dropped_for_gaps;
+        if (gap_first >= 0 && k != gap_sample) flush();
+        if (gap_first < 0) {
+          gap_first = static_cast<int>(i);
+          gap_sample = k;
+        }
+        gap_last = static_cast<int>(i);
+      } else {
+        flush();
+      }
+    }
+    flush();
+  }
+
+  // Track lengths (short tracks carry no parallax) and double claims.
+  std::map<std::int64_t, int> length;
+  std::map<std::pair<std::int64_t, std::int64_t>, int> per_frame;  // (frame, track) -> count
+  for (const TrackRow& r : rows) {
+    if (r.frame < 0 || static_cast<std::size_t>(r.frame) >= n)
+      throw InputError("tracks: frame " + std::to_string(r.frame) + " outside the dataset's " +
+                       std::to_string(n) + " images");
+    ++length[r.track_id];
+    ++per_frame[{r.frame, r.track_id}];
+  }
+  std::map<std::int64_t, int> used_tracks;
+  for (const TrackRow& r : rows) {
+    if (length[r.track_id] < opt.min_track_length) continue;
+    if (gap[static_cast<std::size_t>(r.frame)]) continue;
+    if (!std::isfinite(r.bearing)) continue;
+    if (per_frame[{r.frame, r.track_id}] > 1) {
+      ++out.double_claims;
+      continue;
+    }
+    out.run.frames[static_cast<std::size_t>(r.frame)].observations.push_back(
+        {static_cast<int>(r.track_id), r.bearing});
+    ++used_tracks[r.track_id];
+    ++out.observations;
+  }
+  out.tracks = static_cast<int>(used_tracks.size());
+  if (out.double_claims > 0) {
+    out.warnings.push_back(std::to_string(out.double_claims) +
+                           " times a track held two lines of one frame (the paper's rules allow "
+                           "it); those bearings were not used (the recommended rules prevent it)");
+  }
+
+  // Starved stretches: too few lines for too long.
+  int starved_first = -1, frames_with_lines = 0;
+  auto starved_flush = [&](std::size_t end) {  // [starved_first, end)
+    if (starved_first < 0) return;
+    const double dt =
+        static_cast<double>(images[end - 1].timestamp_ns - images[starved_first].timestamp_ns) * 1e-9;
+    if (dt > opt.max_starved_s) {
+      char buf[300];
+      std::snprintf(buf, sizeof buf,
+                    "frames %d-%zu (cam0/data.csv lines %d-%d, %.1f s): fewer than %d tracked "
+                    "lines; the filter dead-reckons through them and the extrinsics learn "
+                    "nothing there",
+                    starved_first, end - 1, images[starved_first].line, images[end - 1].line, dt,
+                    opt.min_lines);
+      out.warnings.emplace_back(buf);
+    }
+    starved_first = -1;
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    if (static_cast<int>(out.run.frames[i].observations.size()) < opt.min_lines) {
+      ++out.starved_frames;
+      if (starved_first < 0) starved_first = static_cast<int>(i);
+    } else {
+      ++frames_with_lines;
+      starved_flush(i);
+    }
+  }
+  starved_flush(n);
+  if (frames_with_lines == 0) {
+    throw InputError(data.root(), 0,
+                     "no frame has " + std::to_string(opt.min_lines) +
+                         " or more tracked lines: nothing to calibrate from (check the images "
+                         "with `omnivert extract`, or the annulus in cam0/sensor.yaml)");
+  }
+  return out;
+}
+
+Options options_from_dataset(const dataset::Dataset& data, Options base) {
+  if (data.has_wheel()) {
+    base.wheel_base = data.wheel_sensor().wheel_base;
+    if (data.wheel_sensor().odometry_k) base.odometry_K = *data.wheel_sensor().odometry_k;
+  }
+  return base;
+}
+
+}  // namespace omnivert::calib

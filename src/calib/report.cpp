@@ -1,0 +1,350 @@
+#include "omnivert/calib/report.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <sstream>
+
+#include <Eigen/Cholesky>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "omnivert/core/angles.hpp"
+#include "omnivert/eval/study_plot.hpp"
+
+namespace omnivert::calib {
+
+ErrorsVsTruth errors_vs_truth(const Extrinsics& est, const Eigen::Matrix3d& C, const Extrinsics& truth) {
+  ErrorsVsTruth e;
+  e.phi = wrap_angle(est.phi - truth.phi);
+  e.rho = est.rho - truth.rho;
+  e.psi = wrap_angle(est.psi - truth.psi);
+  const Eigen::Vector2d d = est.position() - truth.position();
+  e.x = d(0);
+  e.y = d(1);
+  e.position = d.norm();
+  e.yaw = wrap_angle(est.yaw() - truth.yaw());
+  const Eigen::Vector3d v(e.phi, e.rho, e.psi);
+  Eigen::LDLT<Eigen::Matrix3d> ldlt(C);
+  if (C.allFinite() && ldlt.info() == Eigen::Success && ldlt.isPositive() &&
+      ldlt.vectorD().minCoeff() > 0.0) {
+    e.nees = v.dot(ldlt.solve(v));
+  } else {
+    e.nees = std::numeric_limits<double>::infinity();
+  }
+  return e;
+}
+
+cv::Mat draw_convergence(const std::vector<FrameEstimate>& history,
+                         const std::optional<Extrinsics>& truth,
+                         const std::optional<Extrinsics>& refined) {
+  // Units shown: degrees for the angles, millimetres for rho.
+  const double scale[3] = {rad2deg(1.0), 1000.0, rad2deg(1.0)};
+  const char* names[3] = {"phi [deg]", "rho [mm]", "psi [deg]"};
+  const char* sig_names[3] = {"sigma_phi [deg]", "sigma_rho [mm]", "sigma_psi [deg]"};
+  std::vector<cv::Mat> top, bottom;
+  // The first frame with an estimate of its own: while the delayed initialisation's window is
+  // open (Options::bootstrap_rotation) the filter holds the prior.
+  int start_frame = -1;
+  for (const FrameEstimate& h : history)
+    if (!history.empty() && h.covariance(0, 0) < 0.99 * history.front().covariance(0, 0)) {
+      start_frame = h.frame;
+      break;
+    }
+  for (int k = 0; k < 3; ++k) {
+    PlotSeries est{"estimate", {}, {}, plot_color(0), false, false};
+    PlotSeries hi{"+-3 sigma", {}, {}, plot_color(0), false, true};
+    PlotSeries lo{"-3 sigma", {}, {}, plot_color(0), false, true};
+    PlotSeries sig{"sigma", {}, {}, plot_color(1), false, false};
+    double vmin = std::numeric_limits<double>::infinity(), vmax = -vmin;
+    for (const FrameEstimate& h : history) {
+      const double v = h.extrinsics.vec()(k) * scale[k];
+      const double s = std::sqrt(std::max(h.covariance(k, k), 0.0)) * scale[k];
+      if (!std::isfinite(v) || !std::isfinite(s)) continue;
+      est.x.push_back(h.frame), est.y.push_back(v);
+      hi.x.push_back(h.frame), hi.y.push_back(v + 3 * s);
+      lo.x.push_back(h.frame), lo.y.push_back(v - 3 * s);
+      sig.x.push_back(h.frame), sig.y.push_back(s);
+      vmin = std::min(vmin, v), vmax = std::max(vmax, v);
+    }
+    lo.name.clear();  // one legend entry for both bands
+    std::vector<PlotSeries> s{est, hi, lo};
+    const double x0 = history.empty() ? 0.0 : history.front().frame;
+    const double x1 = history.empty() ? 1.0 : std::max<double>(history.back().frame, x0 + 1);
+    if (truth) {
+      const double t = truth->vec()(k) * scale[k];
+      s.push_back({"ground truth", {x0, x1}, {t, t}, plot_color(2), false, true});
+      vmin = std::min(vmin, t), vmax = std::max(vmax, t);
+    }
+    if (refined) {
+      const double r = refined->vec()(k) * scale[k];
+      s.push_back({"refined (batch)", {x0, x1}, {r, r}, plot_color(3), false, false});
+      vmin = std::min(vmin, r), vmax = std::max(vmax, r);
+    }
+    PlotOptions o;
+    o.title = k == 0 ? "phi" : k == 1 ? "rho" : "psi";
+    o.x_label = "frame";
+    o.y_label = names[k];
+    o.width = 560, o.height = 400;
+    o.x_lo = x0, o.x_hi = x1;
+    if (std::isfinite(vmin)) {
+      // The estimate's own range (the +-3 sigma bands of the prior would flatten it).
+      const double pad = std::max(0.1 * (vmax - vmin), k == 1 ? 2.0 : 0.5);
+      o.y_lo = vmin - pad, o.y_hi = vmax + pad;
+    }
+    o.legend_bottom = true;
+    if (start_frame >= 0) {
+      o.vertical_lines = {static_cast<double>(start_frame)};
+      o.vertical_labels = {"first estimate"};
+    }
+    top.push_back(draw_plot(s, o));
+    PlotOptions os;
+    os.title = std::string("sigma of ") + (k == 0 ? "phi" : k == 1 ? "rho" : "psi");
+    os.x_label = "frame";
+    os.y_label = sig_names[k];
+    os.width = 560, os.height = 300;
+    os.x_lo = x0, os.x_hi = x1;
+    os.log_y = true;  // the prior's sigma and the final one are orders of magnitude apart
+    os.vertical_lines = o.vertical_lines;
+    bottom.push_back(draw_plot({sig}, os));
+  }
+  cv::Mat a, b, out;
+  cv::hconcat(top, a);
+  cv::hconcat(bottom, b);
+  cv::vconcat(a, b, out);
+  return out;
+}
+
+namespace {
+
+using nlohmann::json;
+
+// A JSON number, or null when it is not finite (JSON has no NaN; we never write one).
+json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+json extrinsics_json(const Extrinsics& e, const Eigen::Matrix3d& C) {
+  json j;
+  j["phi"] = num(e.phi), j["rho"] = num(e.rho), j["psi"] = num(e.psi);
+  j["sigma_phi"] = num(std::sqrt(C(0, 0))), j["sigma_rho"] = num(std::sqrt(C(1, 1)));
+  j["sigma_psi"] = num(std::sqrt(C(2, 2)));
+  const Eigen::Vector2d p = e.position();
+  j["x"] = num(p(0)), j["y"] = num(p(1)), j["yaw"] = num(e.yaw());
+  json c = json::array();
+  for (int i = 0; i < 3; ++i)
+    for (int k = 0; k < 3; ++k) c.push_back(num(C(i, k)));
+  j["covariance"] = c;
+  return j;
+}
+
+json errors_json(const ErrorsVsTruth& e) {
+  return {{"phi_deg", num(rad2deg(e.phi))},   {"rho_mm", num(e.rho * 1e3)},
+          {"psi_deg", num(rad2deg(e.psi))},   {"x_mm", num(e.x * 1e3)},
+          {"y_mm", num(e.y * 1e3)},           {"position_mm", num(e.position * 1e3)},
+          {"yaw_deg", num(rad2deg(e.yaw))},   {"nees", num(e.nees)}};
+}
+
+json verdict_json(const ParameterVerdict& v) {
+  return {{"determined", v.determined}, {"crlb", num(v.crlb)}};
+}
+
+std::string html_escape(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    switch (c) {
+      case '&': o += "&amp;"; break;
+      case '<': o += "&lt;"; break;
+      case '>': o += "&gt;"; break;
+      case '"': o += "&quot;"; break;
+      default: o += c;
+    }
+  }
+  return o;
+}
+
+std::string f(const char* format, double v) {
+  if (!std::isfinite(v)) return "not determined";
+  char b[64];
+  std::snprintf(b, sizeof b, format, v);
+  return b;
+}
+
+}  // namespace
+
+std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
+  json j;
+  j["tool"] = "omnivert calibrate";
+  j["dataset"] = in.dataset;
+  j["command"] = in.command;
+  j["exit_code"] = in.exit_code;
+  j["forced"] = in.force;
+  j["wrote_extrinsics"] = in.wrote_extrinsics;
+  json inputs;
+  inputs["frames"] = in.frames;
+  inputs["frames_skipped"] = in.frames_skipped;
+  inputs["detections"] = in.detections;
+  inputs["tracks_found"] = in.tracks_total;
+  if (in.run) {
+    inputs["tracks_used"] = in.run->tracks;
+    inputs["bearings_used"] = in.run->observations;
+    inputs["path_length_m"] = num(in.run->path_length);
+    inputs["rotation_deg"] = num(rad2deg(in.run->rotation));
+    inputs["frames_dropped_for_wheel_gaps"] = in.run->frames_dropped_for_gaps;
+    inputs["frames_with_too_few_lines"] = in.run->starved_frames;
+  }
+  inputs["wheel_base_m"] = num(in.options.wheel_base);
+  inputs["odometry_K_m"] = num(in.options.odometry_K);
+  inputs["odometry_inflation"] = num(in.options.odometry_inflation);
+  inputs["bearing_sigma_deg"] = num(rad2deg(r.bearing_sigma));
+
+  inputs["prior"] = {{"phi", num(in.options.prior.phi)},
+                     {"rho", num(in.options.prior.rho)},
+                     {"psi", num(in.options.prior.psi)},
+                     {"sigma_phi", num(in.options.prior_sigma(0))},
+                     {"sigma_rho", num(in.options.prior_sigma(1))},
+                     {"sigma_psi", num(in.options.prior_sigma(2))}};
+  j["inputs"] = inputs;
+
+  const ObservabilityReport& o = r.observability;
+  j["observability"] = {{"observable", o.all_determined()},
+                        {"phi", verdict_json(o.phi)},
+                        {"rho", verdict_json(o.rho)},
+                        {"psi", verdict_json(o.psi)},
+                        {"yaw", verdict_json(o.yaw)},
+                        {"x", verdict_json(o.x)},
+                        {"y", verdict_json(o.y)},
+                        {"rank", o.rank},
+                        {"condition", num(o.condition)},
+                        {"message", o.message}};
+  j["filter"] = extrinsics_json(r.filter.extrinsics, r.filter.covariance);
+  if (r.refined) {
+    json ref = extrinsics_json(r.refinement.extrinsics, r.refinement.covariance);
+    ref["converged"] = r.refinement.converged;
+    ref["covariance_ok"] = r.refinement.covariance_ok;
+    ref["covariance_from_information"] = r.covariance_from_information;
+    ref["iterations"] = r.refinement.iterations;
+    ref["bearings_used"] = r.refinement.num_bearings;
+    ref["bearings_rejected"] = r.refinement.num_rejected;
+    ref["bearing_residual_sigma_deg"] = num(rad2deg(r.refinement.bearing_residual_sigma));
+    ref["initial_cost"] = num(r.refinement.initial_cost);
+    ref["final_cost"] = num(r.refinement.final_cost);
+    j["refinement"] = ref;
+  }
+  j["result"] = extrinsics_json(r.extrinsics, r.covariance);
+  j["result"]["source"] = r.refined && r.refinement.covariance_ok ? "refinement" : "filter";
+  if (in.truth) {
+    j["ground_truth"] = {{"phi", num(in.truth->phi)}, {"rho", num(in.truth->rho)}, {"psi", num(in.truth->psi)}};
+    json err;
+    err["filter"] = errors_json(errors_vs_truth(r.filter.extrinsics, r.filter.covariance, *in.truth));
+    if (r.refined && r.refinement.covariance_ok)
+      err["refinement"] =
+          errors_json(errors_vs_truth(r.refinement.extrinsics, r.refinement.covariance, *in.truth));
+    j["errors_vs_ground_truth"] = err;
+  }
+  j["seconds"] = {{"tracking", num(in.seconds_tracking)}, {"calibration", num(in.seconds_calibration)}};
+  j["warnings"] = in.warnings;
+  return j.dump(2) + "\n";
+}
+
+std::string report_html(const CalibrationResult& r, const ReportInputs& in) {
+  std::ostringstream h;
+  const ObservabilityReport& o = r.observability;
+  h << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>omnivert calibrate: "
+    << html_escape(in.dataset) << "</title>\n<style>body{font-family:sans-serif;max-width:1700px;"
+       "margin:1em auto;padding:0 1em}table{border-collapse:collapse;margin:0.5em 0}"
+       "td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}th{background:#eee}"
+       "td:first-child,th:first-child{text-align:left}.ok{color:#060}.bad{color:#a00}"
+       "img{max-width:100%;border:1px solid #ccc}</style></head><body>\n";
+  h << "<h1>Camera-to-odometry calibration</h1>\n";
+  h << "<p>Dataset <code>" << html_escape(in.dataset) << "</code>; command <code>"
+    << html_escape(in.command) << "</code>.</p>\n";
+  const bool obs = o.all_determined();
+  h << "<h2>Verdict</h2>\n<p class=\"" << (obs ? "ok" : "bad") << "\"><b>"
+    << (obs ? "phi, rho and psi are determined by this run."
+            : "This run does not determine every parameter.")
+    << "</b> " << html_escape(o.message) << "</p>\n";
+  if (!obs)
+    h << "<p>" << (in.force ? "--force was given: extrinsics.yaml was written anyway."
+                            : "extrinsics.yaml was not written (exit code 3); --force writes it.")
+      << "</p>\n";
+
+  h << "<h2>Estimates</h2>\n<table><tr><th></th><th>phi [deg]</th><th>rho [mm]</th><th>psi [deg]</th>"
+       "<th>camera x [mm]</th><th>camera y [mm]</th><th>camera yaw [deg]</th></tr>\n";
+  auto row = [&](const std::string& name, const Extrinsics& e, const Eigen::Matrix3d* C) {
+    const Eigen::Vector2d p = e.position();
+    h << "<tr><td>" << name << "</td><td>" << f("%.3f", rad2deg(e.phi));
+    if (C) h << " &plusmn; " << f("%.3f", rad2deg(std::sqrt((*C)(0, 0))));
+    h << "</td><td>" << f("%.2f", e.rho * 1e3);
+    if (C) h << " &plusmn; " << f("%.2f", std::sqrt((*C)(1, 1)) * 1e3);
+    h << "</td><td>" << f("%.3f", rad2deg(e.psi));
+    if (C) h << " &plusmn; " << f("%.3f", rad2deg(std::sqrt((*C)(2, 2))));
+    h << "</td><td>" << f("%.2f", p(0) * 1e3) << "</td><td>" << f("%.2f", p(1) * 1e3) << "</td><td>"
+      << f("%.3f", rad2deg(e.yaw())) << "</td></tr>\n";
+  };
+  row("prior (hand measurement)", in.options.prior, nullptr);
+  row("filter (Sec. 8.2)", r.filter.extrinsics, &r.filter.covariance);
+  if (r.refined && r.refinement.covariance_ok)
+    row("batch refinement (--refine)", r.refinement.extrinsics, &r.refinement.covariance);
+  if (in.truth) row("ground truth", *in.truth, nullptr);
+  h << "</table>\n";
+  h << "<table><tr><th>Cram&eacute;r-Rao bound (this run)</th><th>phi [deg]</th><th>rho [mm]</th>"
+       "<th>psi [deg]</th><th>camera x [mm]</th><th>camera y [mm]</th><th>camera yaw [deg]</th></tr>\n"
+    << "<tr><td>sigma</td><td>" << f("%.3f", rad2deg(o.phi.crlb)) << "</td><td>"
+    << f("%.2f", o.rho.crlb * 1e3) << "</td><td>" << f("%.3f", rad2deg(o.psi.crlb)) << "</td><td>"
+    << f("%.2f", o.x.crlb * 1e3) << "</td><td>" << f("%.2f", o.y.crlb * 1e3) << "</td><td>"
+    << f("%.3f", rad2deg(o.yaw.crlb)) << "</td></tr></table>\n";
+  if (in.truth) {
+    h << "<table><tr><th>error vs ground truth</th><th>phi [deg]</th><th>rho [mm]</th><th>psi [deg]</th>"
+         "<th>position [mm]</th><th>yaw [deg]</th><th>NEES (3 dof)</th></tr>\n";
+    auto erow = [&](const std::string& name, const ErrorsVsTruth& e) {
+      h << "<tr><td>" << name << "</td><td>" << f("%.3f", rad2deg(e.phi)) << "</td><td>"
+        << f("%.2f", e.rho * 1e3) << "</td><td>" << f("%.3f", rad2deg(e.psi)) << "</td><td>"
+        << f("%.2f", e.position * 1e3) << "</td><td>" << f("%.3f", rad2deg(e.yaw)) << "</td><td>"
+        << f("%.2f", e.nees) << "</td></tr>\n";
+    };
+    erow("filter", errors_vs_truth(r.filter.extrinsics, r.filter.covariance, *in.truth));
+    if (r.refined && r.refinement.covariance_ok)
+      erow("refinement", errors_vs_truth(r.refinement.extrinsics, r.refinement.covariance, *in.truth));
+    h << "</table>\n";
+  }
+
+  h << "<h2>Inputs</h2>\n<table>\n";
+  auto kv = [&](const std::string& k, const std::string& v) {
+    h << "<tr><td>" << k << "</td><td>" << html_escape(v) << "</td></tr>\n";
+  };
+  kv("images", std::to_string(in.frames) + " (" + std::to_string(in.frames_skipped) + " skipped)");
+  kv("line detections / tracks", std::to_string(in.detections) + " / " + std::to_string(in.tracks_total));
+  if (in.run) {
+    kv("tracks / bearings used", std::to_string(in.run->tracks) + " / " + std::to_string(in.run->observations));
+    kv("path driven / total rotation",
+       f("%.2f m", in.run->path_length) + " / " + f("%.0f deg", rad2deg(in.run->rotation)));
+    kv("frames with too few lines", std::to_string(in.run->starved_frames));
+    kv("frames dropped for wheel gaps", std::to_string(in.run->frames_dropped_for_gaps));
+  }
+  kv("wheel base e / Chong-Kleeman K (x inflation)",
+     f("%.4f m", in.options.wheel_base) + " / " + f("%.3g m", in.options.odometry_K) + " (x" +
+         f("%g", in.options.odometry_inflation) + ")");
+  kv("bearing sigma", f("%.4f deg", rad2deg(r.bearing_sigma)) +
+                          (r.refined ? f(" (residual scale at the batch solution %.4f deg)",
+                                          rad2deg(r.refinement.bearing_residual_sigma))
+                                      : std::string()));
+  if (r.refined)
+    kv("refinement", std::string(r.refinement.converged ? "converged" : "did not converge") + ", " +
+                         std::to_string(r.refinement.iterations) + " iterations, " +
+                         std::to_string(r.refinement.num_bearings) + " bearings (" +
+                         std::to_string(r.refinement.num_rejected) + " rejected as outliers)");
+  kv("time: tracking / calibration", f("%.1f s", in.seconds_tracking) + " / " + f("%.1f s", in.seconds_calibration));
+  h << "</table>\n";
+  if (!in.warnings.empty()) {
+    h << "<h2>Warnings</h2>\n<ul>\n";
+    for (const auto& w : in.warnings) h << "<li>" << html_escape(w) << "</li>\n";
+    h << "</ul>\n";
+  }
+  h << "<h2>Convergence (the paper's Fig. 25)</h2>\n<img src=\"convergence.png\" "
+       "alt=\"phi, rho, psi and their sigmas against the frame\">\n";
+  h << "<h2>Tracks (the paper's Fig. 22)</h2>\n<img src=\"tracks.png\" alt=\"bearing of every "
+       "tracked line against the frame\">\n";
+  h << "<p>Files: extrinsics.yaml, states.csv, tracks.csv, summary.json.</p>\n</body></html>\n";
+  return h.str();
+}
+
+}  // namespace omnivert::calib
