@@ -52,7 +52,12 @@ TrackerOptions recommended_tracker_options(double wheel_base) {
   TrackerOptions o;
   o.mutual = true;
   o.same_polarity = true;
-  o.continuity_tolerance = deg2rad(1.0);  // used when the gate (odometry) is on
+  // Measured on the rendered tours (docs/tracking.md Sec. 6): track continuity with the track
+  // model at 0.8 degree, F1 0.6 and 0.5 across a look-back gap.
+  o.continuity_tolerance = deg2rad(0.8);  // used when the gate (odometry) is on
+  o.continuity_model = TrackerOptions::ContinuityModel::kTrack;
+  o.match.f1 = 0.6;
+  o.look_back_f1 = 0.5;
   if (wheel_base > 0.0) {
     o.gate.enabled = true;
     o.gate.wheel_base = wheel_base;

@@ -92,9 +92,9 @@ struct TrackerOptions {
 
 // The paper's tracker alone: tests 1-3 with Table 2's factors, look-back 20 (Sec. 9.1).
 TrackerOptions paper_tracker_options();
-// What we recommend (docs/tracking.md, measured there): the paper's rules plus the mutual
-// constraint, same edge polarity, and the odometry gate with track continuity (1 degree)
-// when the wheel base is known
+// What we recommend (docs/tracking.md, measured there): the paper's rules with F1 = 0.6 and
+// 0.5 across a look-back gap, plus the mutual constraint, same edge polarity, and the odometry
+// gate with track continuity (track model, 0.8 degree) when the wheel base is known
 // (wheel_base > 0; pass 0 when there is no odometry).
 TrackerOptions recommended_tracker_options(double wheel_base);
 
