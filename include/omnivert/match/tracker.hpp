@@ -20,9 +20,10 @@
 //    take the same id (the paper's behaviour).
 //  - odometry gate (odometry_gate.hpp): an accepted match whose bearing change contradicts
 //    the wheel travel since the candidate frame is vetoed; the line goes on looking back.
-//  - same polarity, gate-restricted candidates, track continuity: see TrackerOptions and
-//    docs/tracking.md Sec. 3 (recommended_tracker_options() turns on mutual, the gate, same
-//    polarity and continuity).
+//  - same polarity, gate-restricted candidates, track continuity, look-back F1, heads only:
+//    see TrackerOptions and docs/tracking.md Sec. 3 (recommended_tracker_options() turns on
+//    mutual, the gate, same polarity and continuity with the track model, with F1 0.6 and
+//    look-back F1 0.5).
 //
 // Bookkeeping: a ring buffer holds the last `look_back` frames (descriptors, bearings, track
 // ids, accumulated odometry). Buffers grow to the largest frame seen and are then reused: no
