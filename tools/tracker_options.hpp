@@ -16,11 +16,16 @@ struct TrackerFlags {
   bool no_mutual = false;
   bool no_gate = false;
   int look_back = 20;
-  double f1 = 1.05, f2 = 0.75, f3 = 0.8;
+  double f1 = -1.0, f2 = -1.0, f3 = -1.0;  // < 0: the rule set's
   std::string gate_candidates = "default";                     // on|off|default (the rule set's)
   double gate_min_distance = -1.0, gate_tolerance_deg = -1.0;  // < 0: the default
   std::string same_polarity = "default";                       // on|off|default (the rule set's)
   double continuity_deg = -1.0;                                // < 0: the rule set's
+  std::string continuity_model = "default";                    // link|track|default
+  double continuity_path_curvature = -1.0;                     // < 0: the default
+  double continuity_turn_curvature = -1.0;                     // < 0: the default
+  double look_back_f1 = -1.0;                                  // < 0: the rule set's
+  std::string heads_only = "default";                          // on|off|default
 
   // The options these flags select (the wheel base is filled in from the dataset).
   TrackerOptions options() const {
@@ -28,11 +33,19 @@ struct TrackerFlags {
     if (no_mutual) o.mutual = false;
     if (no_gate) o.gate.enabled = false;
     o.look_back = look_back;
-    o.match.f1 = f1;
-    o.match.f2 = f2;
-    o.match.f3 = f3;
+    if (f1 > 0.0) o.match.f1 = f1;
+    if (f2 > 0.0) o.match.f2 = f2;
+    if (f3 > 0.0) o.match.f3 = f3;
     if (gate_candidates != "default") o.gate_candidates = gate_candidates == "on";
     if (continuity_deg >= 0.0) o.continuity_tolerance = deg2rad(continuity_deg);
+    if (continuity_model != "default") {
+      o.continuity_model = continuity_model == "track" ? TrackerOptions::ContinuityModel::kTrack
+                                                       : TrackerOptions::ContinuityModel::kLink;
+    }
+    if (continuity_path_curvature >= 0.0) o.continuity_path_curvature = continuity_path_curvature;
+    if (continuity_turn_curvature >= 0.0) o.continuity_turn_curvature = continuity_turn_curvature;
+    if (look_back_f1 >= 0.0) o.look_back_f1 = look_back_f1;
+    if (heads_only != "default") o.heads_only = heads_only == "on";
     if (same_polarity != "default") o.same_polarity = same_polarity == "on";
     if (gate_min_distance > 0.0) o.gate.min_feature_distance = gate_min_distance;
     if (gate_tolerance_deg >= 0.0) o.gate.bearing_tolerance = deg2rad(gate_tolerance_deg);
@@ -75,8 +88,43 @@ inline void add_tracker_options(CLI::App* cmd, TrackerFlags& t) {
   cmd->add_option("--continuity",
                   t.continuity_deg,
                   "Track continuity tolerance [degrees]: refuse links that deviate more from the "
-                  "track's predicted bearing (needs wheel data; 0: off; default: the rule set's)")
+                  "track's predicted bearing (needs wheel data; 0: off; default: the rule set's: "
+                  "recommended 0.8)")
       ->check(CLI::Range(0.0, 179.0))
+      ->group(g);
+  cmd->add_option("--continuity-model",
+                  t.continuity_model,
+                  "Track continuity prediction: link (parallax per metre of the observation "
+                  "linked to, from its own link) or track (per metre and per radian turned, "
+                  "inherited along the track; checks look-back links and turns too) (default: "
+                  "the rule set's)")
+      ->check(CLI::IsMember({"link", "track", "default"}))
+      ->capture_default_str()
+      ->group(g);
+  cmd->add_option("--continuity-path-curvature",
+                  t.continuity_path_curvature,
+                  "Track continuity (track model): unpredicted bearing change per metre^2 "
+                  "driven [rad/m^2] (default 0.5)")
+      ->check(CLI::NonNegativeNumber)
+      ->group(g);
+  cmd->add_option("--continuity-turn-curvature",
+                  t.continuity_turn_curvature,
+                  "Track continuity (track model): unpredicted bearing change per radian^2 "
+                  "turned [rad/rad^2] (default 0.3)")
+      ->check(CLI::NonNegativeNumber)
+      ->group(g);
+  cmd->add_option("--look-back-f1",
+                  t.look_back_f1,
+                  "Test 1 for links across a look-back gap (2+ frames back): min distance <= "
+                  "this (0: F1; default: the rule set's: paper 0, recommended 0.5)")
+      ->check(CLI::NonNegativeNumber)
+      ->group(g);
+  cmd->add_option("--heads-only",
+                  t.heads_only,
+                  "on: a look-back link only to a track's latest observation (no forks) "
+                  "(default: the rule set's)")
+      ->check(CLI::IsMember({"on", "off", "default"}))
+      ->capture_default_str()
       ->group(g);
   cmd->add_option("--gate-min-distance",
                   t.gate_min_distance,
@@ -88,9 +136,9 @@ inline void add_tracker_options(CLI::App* cmd, TrackerFlags& t) {
                   "Odometry gate: bearing detection tolerance [degrees] (default 2)")
       ->check(CLI::Range(0.0, 179.0))
       ->group(g);
-  cmd->add_option("--f1", t.f1, "Test 1, eq. (8): min distance <= F1")->check(CLI::PositiveNumber)->capture_default_str()->group(g);
-  cmd->add_option("--f2", t.f2, "Test 2, eq. (9): min <= F2 * mean")->check(CLI::Range(0.0, 1.0))->capture_default_str()->group(g);
-  cmd->add_option("--f3", t.f3, "Test 3, eq. (10): min <= F3 * second min")->check(CLI::Range(0.0, 1.0))->capture_default_str()->group(g);
+  cmd->add_option("--f1", t.f1, "Test 1, eq. (8): min distance <= F1 (default: the rule set's: paper 1.05, recommended 0.6)")->check(CLI::PositiveNumber)->group(g);
+  cmd->add_option("--f2", t.f2, "Test 2, eq. (9): min <= F2 * mean (default 0.75)")->check(CLI::Range(0.0, 1.0))->group(g);
+  cmd->add_option("--f3", t.f3, "Test 3, eq. (10): min <= F3 * second min (default 0.8)")->check(CLI::Range(0.0, 1.0))->group(g);
 }
 
 }  // namespace omnivert::cli

@@ -97,6 +97,43 @@ BENCHMARK(BM_TrackerPerFrame)
     ->ArgsProduct({{20, 30, 40}, {0, 1}})
     ->Unit(benchmark::kMicrosecond);
 
+// The recommended rule sets with wheel data (straight driving, 3.8 cm a frame): mutual, gate,
+// same polarity and track continuity. variant 0: the link model at 1 degree with the paper's
+// F1 (the recommended set before issue 4's second round); 1: the track model at 0.8 degree
+// with F1 0.6 and look-back F1 0.5 (recommended now); 2: 1 + heads_only.
+void BM_TrackerRecommended(benchmark::State& state) {
+  const auto seq = make_sequence(static_cast<int>(state.range(0)));
+  TrackerOptions o = recommended_tracker_options(0.4);
+  if (state.range(1) == 0) {
+    o.continuity_model = TrackerOptions::ContinuityModel::kLink;
+    o.continuity_tolerance = 1.0 * 3.14159265358979323846 / 180.0;
+    o.match.f1 = 1.05;
+    o.look_back_f1 = 0.0;
+  }
+  o.heads_only = state.range(1) == 2;
+  Tracker tracker(o);
+  std::vector<TrackAssignment> out;
+  const WheelIncrement straight{0.038, 0.038};
+  for (int f = 0; f < 40; ++f) tracker.add_frame(seq[static_cast<std::size_t>(f)], straight, &out);
+  std::size_t f = 40, lines = 0;
+  for (auto _ : state) {
+    const FrameFeatures& fr = seq[f % kFrames];
+    tracker.add_frame(fr, straight, &out);
+    benchmark::DoNotOptimize(out.data());
+    lines += fr.lines.size();
+    ++f;
+  }
+  const auto& s = tracker.stats();
+  state.counters["lines/frame"] =
+      static_cast<double>(lines) / static_cast<double>(std::max<std::size_t>(1, f - 40));
+  state.counters["look-back%"] =
+      100.0 * static_cast<double>(s.matched_look_back) / static_cast<double>(s.lines);
+}
+BENCHMARK(BM_TrackerRecommended)
+    ->ArgNames({"lines", "variant"})
+    ->ArgsProduct({{20, 30, 40}, {0, 1, 2}})
+    ->Unit(benchmark::kMicrosecond);
+
 // Our matcher alone, one frame against the previous one (tests 1-3 included).
 void BM_MatcherPreviousFrame(benchmark::State& state) {
   const auto seq = make_sequence(static_cast<int>(state.range(0)));

@@ -34,6 +34,15 @@ bool TrackerOptions::IsValid(std::string* error) const {
     if (error) *error = "continuity tolerance must be in [0, pi) radians (0: off)";
     return false;
   }
+  if (!(continuity_path_curvature >= 0.0 && continuity_turn_curvature >= 0.0 &&
+        std::isfinite(continuity_path_curvature) && std::isfinite(continuity_turn_curvature))) {
+    if (error) *error = "continuity curvature bounds must be finite and >= 0";
+    return false;
+  }
+  if (!(look_back_f1 >= 0.0 && std::isfinite(look_back_f1))) {
+    if (error) *error = "look-back F1 must be >= 0 (0: F1)";
+    return false;
+  }
   return gate.IsValid(error);
 }
 
@@ -43,7 +52,12 @@ TrackerOptions recommended_tracker_options(double wheel_base) {
   TrackerOptions o;
   o.mutual = true;
   o.same_polarity = true;
-  o.continuity_tolerance = deg2rad(1.0);  // used when the gate (odometry) is on
+  // Measured on the rendered tours (docs/tracking.md Sec. 6): track continuity with the track
+  // model at 0.8 degree, F1 0.6 and 0.5 across a look-back gap.
+  o.continuity_tolerance = deg2rad(0.8);  // used when the gate (odometry) is on
+  o.continuity_model = TrackerOptions::ContinuityModel::kTrack;
+  o.match.f1 = 0.6;
+  o.look_back_f1 = 0.5;
   if (wheel_base > 0.0) {
     o.gate.enabled = true;
     o.gate.wheel_base = wheel_base;
@@ -58,7 +72,7 @@ std::string TrackerStats::BriefReport() const {
     << " new tracks; rejected: test1 " << rejected_test1 << ", test2 " << rejected_test2
     << ", test3 " << rejected_test3 << ", mutual " << rejected_mutual << ", claimed "
     << rejected_claimed << ", odometry gate " << rejected_gate << ", continuity "
-    << rejected_continuity;
+    << rejected_continuity << ", fork " << rejected_fork;
   return s.str();
 }
 
@@ -110,6 +124,7 @@ void Tracker::add_frame(const FrameFeatures& frame,
     const auto cap = static_cast<std::size_t>(line_capacity(n));
     unmatched_.reserve(cap);
     rates_.reserve(cap);
+    turn_rates_.reserve(cap);
     still_unmatched_.reserve(cap);
     claimed_.reserve(cap);
   }
@@ -192,6 +207,10 @@ void Tracker::add_frame(const FrameFeatures& frame,
       const int i = unmatched_[static_cast<std::size_t>(q)];
       const MatchResult& r = results_[static_cast<std::size_t>(q)];
       bool ok = r.accepted();
+      if (ok && k > 1 && options_.look_back_f1 > 0.0 && r.min_distance > options_.look_back_f1) {
+        ++stats_.rejected_test1;  // test 1 with the look-back F1
+        ok = false;
+      }
       switch (r.verdict) {
         case MatchVerdict::kFailedTest1:
           ++stats_.rejected_test1;
@@ -259,6 +278,10 @@ void Tracker::add_frame(const FrameFeatures& frame,
         ++stats_.rejected_continuity;
         ok = false;
       }
+      if (ok && k > 1 && options_.heads_only && observed_since(id, k)) {
+        ++stats_.rejected_fork;
+        ok = false;
+      }
       if (!ok) {
         still_unmatched_.push_back(i);
         continue;
@@ -289,9 +312,48 @@ void Tracker::add_frame(const FrameFeatures& frame,
   stats_.lines += n;
 }
 
+bool Tracker::observed_since(std::int64_t id, int k) {
+  for (int m = 1; m < k; ++m) {
+    const Slot& s = slot_back(m);
+    const auto end = s.track_ids.begin() + s.num_lines;
+    if (std::find(s.track_ids.begin(), end, id) != end) return true;
+  }
+  return false;
+}
+
 bool Tracker::continues_track(int k, int j, double bearing) {
   const Slot& s1 = slot_back(k);
   const double rate = s1.parallax_rates[static_cast<std::size_t>(j)];
+  if (options_.continuity_model == TrackerOptions::ContinuityModel::kTrack) {
+    const double turn_rate = s1.turn_rates[static_cast<std::size_t>(j)];
+    const double u1 = s1.bearings[static_cast<std::size_t>(j)] + s1.odometry.theta;
+    const double u2 = bearing + odometry_.theta;
+    const double path = odometry_.path_length - s1.odometry.path_length;
+    const double d_theta = odometry_.theta - s1.odometry.theta;
+    const double d_min = options_.gate.min_feature_distance;
+    double predicted = u1;
+    double tol = options_.continuity_tolerance;
+    // Translation: the parallax the rate predicts, and what it cannot (curvature), at most the
+    // sound bound asin(path / D_min) (which is all there is without a rate).
+    const double path_bound = path < d_min ? std::asin(path / d_min) : kPi;
+    if (std::isnan(rate)) {
+      tol += path_bound;
+    } else {
+      predicted += rate * path;
+      tol += std::min(path_bound, options_.continuity_path_curvature * path * path);
+    }
+    // Rotation: the camera swings around the axle (at most rho_max from it).
+    const double swing = 2.0 * options_.gate.max_camera_offset * std::abs(std::sin(0.5 * d_theta));
+    const double swing_bound = swing < d_min ? std::asin(swing / d_min) : kPi;
+    if (std::isnan(turn_rate)) {
+      tol += swing_bound;
+    } else {
+      predicted += turn_rate * d_theta;
+      tol += std::min(swing_bound, options_.continuity_turn_curvature * d_theta * d_theta);
+    }
+    if (tol >= kPi) return true;
+    return std::abs(angle_diff(u2, predicted)) <= tol;
+  }
   if (std::isnan(rate)) return true;  // no recent history: nothing to predict from
   // u = bearing + theta is free of the robot's rotation (eq. 16); its change is parallax.
   const double u1 = s1.bearings[static_cast<std::size_t>(j)] + s1.odometry.theta;
@@ -309,8 +371,40 @@ void Tracker::store_frame(const FrameFeatures& frame, const std::vector<TrackAss
   const int n = static_cast<int>(frame.lines.size());
   // Track continuity: each line's parallax per metre, from its link when that spans at most 3
   // frames (NaN: unknown). Computed before the slot of frame t - look_back is overwritten.
-  rates_.assign(static_cast<std::size_t>(n), std::numeric_limits<double>::quiet_NaN());
-  if (options_.continuity_tolerance > 0.0 && options_.gate.enabled) {
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  rates_.assign(static_cast<std::size_t>(n), kNaN);
+  turn_rates_.assign(static_cast<std::size_t>(n), kNaN);
+  const bool track_model =
+      options_.continuity_model == TrackerOptions::ContinuityModel::kTrack;
+  if (track_model && options_.continuity_tolerance > 0.0 && options_.gate.enabled) {
+    // Each observation carries its track's rates: measured on its link when that spans at most
+    // 3 frames and the motion in between separates them (mostly translation: per metre; mostly
+    // rotation on the spot: per radian), otherwise inherited from the observation linked to.
+    for (int i = 0; i < n; ++i) {
+      const TrackAssignment& a = out[static_cast<std::size_t>(i)];
+      if (a.frames_back < 1 || a.matched_line < 0) continue;
+      const Slot& s0 = slot_back(a.frames_back);
+      const auto j = static_cast<std::size_t>(a.matched_line);
+      double rate = s0.parallax_rates[j], turn_rate = s0.turn_rates[j];
+      if (a.frames_back <= 3) {
+        const double u0 = s0.bearings[j] + s0.odometry.theta;
+        const double u1 = frame.lines[static_cast<std::size_t>(i)].bearing + odometry_.theta;
+        const double du = angle_diff(u1, u0);
+        const double path = odometry_.path_length - s0.odometry.path_length;
+        const double d_theta = odometry_.theta - s0.odometry.theta;
+        const bool moved = path > 0.01, turned = std::abs(d_theta) > 0.02;
+        if (moved && (!turned || !std::isnan(turn_rate))) {
+          rate = (du - (turned ? turn_rate * d_theta : 0.0)) / path;
+        } else if (turned && (path < 0.005 || !std::isnan(rate))) {
+          turn_rate = (du - (std::isnan(rate) ? 0.0 : rate * path)) / d_theta;
+        } else if (moved && turned) {
+          rate = turn_rate = kNaN;  // both unknown and not separable
+        }
+      }
+      rates_[static_cast<std::size_t>(i)] = rate;
+      turn_rates_[static_cast<std::size_t>(i)] = turn_rate;
+    }
+  } else if (options_.continuity_tolerance > 0.0 && options_.gate.enabled) {
     for (int i = 0; i < n; ++i) {
       const TrackAssignment& a = out[static_cast<std::size_t>(i)];
       if (a.frames_back < 1 || a.frames_back > 3 || a.matched_line < 0) continue;
@@ -331,12 +425,14 @@ void Tracker::store_frame(const FrameFeatures& frame, const std::vector<TrackAss
     slot.bearings.reserve(static_cast<std::size_t>(slot.descriptors.rows()));
     slot.polarities.reserve(static_cast<std::size_t>(slot.descriptors.rows()));
     slot.parallax_rates.reserve(static_cast<std::size_t>(slot.descriptors.rows()));
+    slot.turn_rates.reserve(static_cast<std::size_t>(slot.descriptors.rows()));
     slot.track_ids.reserve(static_cast<std::size_t>(slot.descriptors.rows()));
   }
   if (n > 0) slot.descriptors.topRows(n) = frame.descriptors;
   slot.bearings.resize(static_cast<std::size_t>(n));
   slot.polarities.resize(static_cast<std::size_t>(n));
   slot.parallax_rates.assign(rates_.begin(), rates_.end());
+  slot.turn_rates.assign(turn_rates_.begin(), turn_rates_.end());
   slot.track_ids.resize(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) {
     slot.bearings[static_cast<std::size_t>(i)] = frame.lines[static_cast<std::size_t>(i)].bearing;

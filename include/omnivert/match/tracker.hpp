@@ -20,9 +20,10 @@
 //    take the same id (the paper's behaviour).
 //  - odometry gate (odometry_gate.hpp): an accepted match whose bearing change contradicts
 //    the wheel travel since the candidate frame is vetoed; the line goes on looking back.
-//  - same polarity, gate-restricted candidates, track continuity: see TrackerOptions and
-//    docs/tracking.md Sec. 3 (recommended_tracker_options() turns on mutual, the gate, same
-//    polarity and continuity).
+//  - same polarity, gate-restricted candidates, track continuity, look-back F1, heads only:
+//    see TrackerOptions and docs/tracking.md Sec. 3 (recommended_tracker_options() turns on
+//    mutual, the gate, same polarity and continuity with the track model, with F1 0.6 and
+//    look-back F1 0.5).
 //
 // Bookkeeping: a ring buffer holds the last `look_back` frames (descriptors, bearings, track
 // ids, accumulated odometry). Buffers grow to the largest frame seen and are then reused: no
@@ -61,15 +62,40 @@ struct TrackerOptions {
   // observation's own link when it spans at most 3 frames (otherwise the link is not checked).
   // It targets two close edges that extraction finds in turn.
   double continuity_tolerance = 0.0;
+  // How track continuity predicts (docs/tracking.md Sec. 3):
+  //  - kLink: the parallax per metre of the observation linked to, measured on its own link
+  //    when that spans at most 3 frames; links to other observations are not checked, and
+  //    rotation is covered by the gate's camera-swing bound alone.
+  //  - kTrack: each observation carries its track's parallax per metre driven AND per radian
+  //    turned (the camera swings around the axle during turns on the spot), measured on its
+  //    link (at most 3 frames) and otherwise inherited along the track, so links across a
+  //    look-back gap and during turns are checked too. What the rates cannot predict is
+  //    bounded by continuity_path_curvature * path^2 + continuity_turn_curvature * d_theta^2
+  //    (each capped by the sound bound of the gate: asin(s / D_min)); an unknown rate falls
+  //    back to the sound bound of its motion.
+  enum class ContinuityModel { kLink, kTrack };
+  ContinuityModel continuity_model = ContinuityModel::kLink;
+  double continuity_path_curvature = 0.5;  // rad per m^2 (kTrack)
+  double continuity_turn_curvature = 0.3;  // rad per rad^2 (kTrack)
+  // Test 1 for links across a look-back gap (frames t-2 .. t-look_back): min D_i <= this
+  // (0 = F1, as in the paper). Descriptors of a line change with the viewpoint; a link across
+  // a gap is less certain and needs a closer descriptor (docs/tracking.md Sec. 3).
+  double look_back_f1 = 0.0;
+  // Look-back links only to a track's latest observation: a line of frame t-k (k >= 2) whose
+  // track was observed again in frames t-k+1 .. t-1 cannot be linked to (the line then goes on
+  // looking back). Look-back bridges frames where a line was missed; a link to an older
+  // observation of a track seen since would fork it (two lines that extraction finds in turn
+  // become one track; docs/tracking.md Sec. 3).
+  bool heads_only = false;
 
   bool IsValid(std::string* error) const;
 };
 
 // The paper's tracker alone: tests 1-3 with Table 2's factors, look-back 20 (Sec. 9.1).
 TrackerOptions paper_tracker_options();
-// What we recommend (docs/tracking.md, measured there): the paper's rules plus the mutual
-// constraint, same edge polarity, and the odometry gate with track continuity (1 degree)
-// when the wheel base is known
+// What we recommend (docs/tracking.md, measured there): the paper's rules with F1 = 0.6 and
+// 0.5 across a look-back gap, plus the mutual constraint, same edge polarity, and the odometry
+// gate with track continuity (track model, 0.8 degree) when the wheel base is known
 // (wheel_base > 0; pass 0 when there is no odometry).
 TrackerOptions recommended_tracker_options(double wheel_base);
 
@@ -100,6 +126,7 @@ struct TrackerStats {
   std::int64_t rejected_claimed = 0;  // track already taken in this frame (mutual on)
   std::int64_t rejected_gate = 0;     // odometry gate veto
   std::int64_t rejected_continuity = 0;  // track continuity veto
+  std::int64_t rejected_fork = 0;        // heads_only: track observed since that frame
   std::string BriefReport() const;
 };
 
@@ -130,6 +157,7 @@ class Tracker {
     std::vector<double> bearings;
     std::vector<int> polarities;
     std::vector<double> parallax_rates;  // continuity: rad per metre driven, NaN = unknown
+    std::vector<double> turn_rates;      // continuity (kTrack): rad per rad turned, NaN = unknown
     std::vector<std::int64_t> track_ids;
     int num_lines = 0;
     OdometryAccumulator odometry;
@@ -142,7 +170,9 @@ class Tracker {
   // TrackerOptions::continuity_tolerance: may line `bearing` of the new frame continue the
   // track of line j of frame t-k?
   bool continues_track(int k, int j, double bearing);
-  std::vector<double> rates_;  // work space of store_frame
+  // TrackerOptions::heads_only: was track `id` observed in frames t-k+1 .. t-1?
+  bool observed_since(std::int64_t id, int k);
+  std::vector<double> rates_, turn_rates_;  // work space of store_frame
 
   TrackerOptions options_;
   Matcher matcher_;
