@@ -244,7 +244,14 @@ RefinementResult refine_batch(const CalibrationRun& run,
   co.num_threads = 1;
   ceres::Covariance cov(co);
   std::vector<std::pair<const double*, const double*>> blocks = {{b.ex.data(), b.ex.data()}};
-  if (cov.Compute(blocks, b.problem.get())) {
+  // A rank-deficient problem is an expected outcome here (the caller falls back on the
+  // observability analysis), not an error for the user's terminal: Ceres' own log line
+  // ("Covariance matrix is near rank deficient ...") is silenced for this call.
+  const int saved_min_log_level = FLAGS_minloglevel;
+  FLAGS_minloglevel = google::GLOG_FATAL;
+  const bool cov_ok = cov.Compute(blocks, b.problem.get());
+  FLAGS_minloglevel = saved_min_log_level;
+  if (cov_ok) {
     double C[9];
     cov.GetCovarianceBlock(b.ex.data(), b.ex.data(), C);
     res.covariance = Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(C);
