@@ -459,7 +459,7 @@ bool bootstrap_filter_state(const CalibrationRun& window,
         b.ex.data());
 
   ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_QR;
+  so.linear_solver_type = ceres::SPARSE_SCHUR;  // as the refinement: poses and features eliminated
   so.max_num_iterations = 100;
   so.num_threads = 1;
   so.logging_type = ceres::SILENT;
