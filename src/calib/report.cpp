@@ -259,9 +259,8 @@ std::string report_html(const CalibrationResult& r, const ReportInputs& in) {
     << html_escape(in.command) << "</code>.</p>\n";
   const bool obs = o.all_determined();
   h << "<h2>Verdict</h2>\n<p class=\"" << (obs ? "ok" : "bad") << "\"><b>"
-    << (obs ? "phi, rho and psi are determined by this run."
-            : "This run does not determine every parameter.")
-    << "</b> " << html_escape(o.message) << "</p>\n";
+    << (obs ? "Determined." : "Not determined.") << "</b> " << html_escape(o.message)
+    << "</p>\n";
   if (!obs)
     h << "<p>" << (in.force ? "--force was given: extrinsics.yaml was written anyway."
                             : "extrinsics.yaml was not written (exit code 3); --force writes it.")
