@@ -227,6 +227,19 @@ TrackingEvaluation evaluate_tracking(const std::vector<TrackRow>& tracks,
       }
     }
   }
+  // Rule 8: track purity. Per track, the world line most of its associated detections belong
+  // to; the associated detections on any other line follow a wrong line (a slip between two
+  // close lines counts one false match, but every detection after it here).
+  for (const auto& [id, dets] : by_track) {
+    std::map<std::int64_t, std::int64_t> count;
+    std::int64_t associated = 0, majority = 0;
+    for (std::size_t i : dets)
+      if (assoc[i] >= 0) {
+        ++associated;
+        majority = std::max(majority, ++count[assoc[i]]);
+      }
+    ev.off_majority_detections += associated - majority;
+  }
   ev.total.first_frame = 0;
   ev.total.end_frame = std::max<std::int64_t>(num_frames, 1);
   for (const auto& c : ev.intervals) add(&ev.total, c);
@@ -278,6 +291,14 @@ std::string format_tracking_table(const TrackingEvaluation& ev, const std::strin
                 ev.detections > 0 ? 100.0 * ev.associated_detections / ev.detections : 0.0,
                 static_cast<long long>(ev.ambiguous_detections),
                 static_cast<long long>(ev.duplicate_ids));
+  s += buf;
+  std::snprintf(buf,
+                sizeof(buf),
+                "Detections off their track's majority world line: %lld (%.2f%% of associated)\n",
+                static_cast<long long>(ev.off_majority_detections),
+                ev.associated_detections > 0
+                    ? 100.0 * ev.off_majority_detections / ev.associated_detections
+                    : 0.0);
   s += buf;
   std::snprintf(buf,
                 sizeof(buf),

@@ -100,6 +100,28 @@ TEST(TrackingEval, HandBuiltCounts) {
   // Errors: 0.005 four times, 0.01 once, 0 three times: RMS sqrt(2e-4 / 8) = 0.005.
   EXPECT_NEAR(ev.bearing_rms, 0.005, 1e-9);
   EXPECT_EQ(ev.duplicate_ids, 0);
+  EXPECT_EQ(ev.off_majority_detections, 1);  // track 0's last detection, on B
+}
+
+// Rule 8: a track that slips from line A onto line B close behind it (bearings within the
+// tolerance of both around the slip, then apart) is no false match by rule 3 (while the two
+// lines are within the tolerance either could be the one followed), but its three detections
+// on A are off its majority line (B: five detections).
+TEST(TrackingEval, SlipOntoACloseLineCountsEveryDetectionAfterIt) {
+  std::vector<GroundTruthLine> truth;
+  std::vector<TrackRow> tracks;
+  for (int f = 0; f < 8; ++f) {
+    const double b = 0.002 + 0.004 * f;  // B drifts away from A at 0
+    truth.push_back(gt(f, 1, 0.0));
+    truth.push_back(gt(f, 2, b));
+    tracks.push_back(det(f, 7, f < 3 ? 0.0 : b, f > 0 ? f - 1 : -1));
+  }
+  const TrackingEvaluation ev = evaluate_tracking(tracks, truth, options());
+  EXPECT_EQ(ev.total.matches, 7);
+  EXPECT_EQ(ev.total.false_matches, 0);
+  EXPECT_EQ(ev.total.correct, 7);
+  EXPECT_EQ(ev.off_majority_detections, 3);
+  EXPECT_NE(format_tracking_table(ev).find("majority world line: 3"), std::string::npos);
 }
 
 TEST(TrackingEval, PerIntervalRows) {

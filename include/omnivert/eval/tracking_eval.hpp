@@ -29,6 +29,10 @@
 //     (60%) of the annulus R_max - R_min, the fraction with a detection associated to them.
 //  7. Bearing RMS: over associated detections, of wrap(detected - true); it is truncated by
 //     the association tolerance, so read it together with the association rate.
+//  8. Track purity: per track, the world line of most of its associated detections; the
+//     associated detections on other lines are "off the majority line". A track that slips
+//     onto a close line (a door leaf inside its frame) costs one false match by rule 3 but
+//     every detection after the slip here, and it is these that bias a calibration.
 //
 // Ground-truth rows come from ground_truth/lines.csv (read by the dataset stage).
 
@@ -98,6 +102,7 @@ struct TrackingEvaluation {
     return long_lines > 0 ? static_cast<double>(long_lines_detected) / long_lines : 0.0;
   }
   double bearing_rms = 0.0;  // radians, over associated detections
+  std::int64_t off_majority_detections = 0;  // rule 8
 };
 
 // Evaluates `tracks` against `ground_truth`. Throws InputError with the reason when the
