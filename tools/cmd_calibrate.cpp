@@ -48,6 +48,7 @@ struct CalibrateArgs {
   std::optional<double> bearing_sigma_deg;
   std::optional<double> odometry_inflation;
   double max_wheel_gap = 0.5;
+  double split_chi2 = calib::BatchOptions{}.split_chi2;
   FeaturePipelineOptions pipeline;
   TrackerFlags tracker;
 };
@@ -70,6 +71,12 @@ void read_prior_file(const std::string& path, calib::Options* o) {
 void remove_if_exists(const std::filesystem::path& p) {
   std::error_code ec;
   std::filesystem::remove(p, ec);
+}
+
+calib::BatchOptions batch_options(const CalibrateArgs& a) {
+  calib::BatchOptions b;
+  b.split_chi2 = a.split_chi2;
+  return b;
 }
 
 void run_calibrate(const CalibrateArgs& a) {
@@ -126,7 +133,7 @@ void run_calibrate(const CalibrateArgs& a) {
   warnings.insert(warnings.end(), run.warnings.begin(), run.warnings.end());
   for (const auto& w : warnings) spdlog::warn("{}", w);
   if (Progress::enabled()) std::fprintf(stderr, "calibrate: filter%s...\n", a.refine ? " and refinement" : "");
-  const calib::CalibrationResult result = calib::calibrate(run.run, opt, {.refine = a.refine});
+  const calib::CalibrationResult result = calib::calibrate(run.run, opt, {.refine = a.refine, .batch = batch_options(a)});
   const auto t2 = clock::now();
   if (!result.extrinsics.vec().allFinite() || !result.covariance.allFinite())
     throw std::runtime_error(
@@ -188,6 +195,9 @@ void run_calibrate(const CalibrateArgs& a) {
   if (result.refined)
     std::printf("bearing sigma %.3f deg (residual scale at the batch solution %.3f deg)\n",
                 rad2deg(result.bearing_sigma), rad2deg(result.refinement.bearing_residual_sigma));
+  if (result.refined && result.refinement.num_splits > 0)
+    std::printf("refinement: %d tracks split where they changed line (summary.json lists them)\n",
+                result.refinement.num_splits);
   std::printf("Cramer-Rao bound of this run: phi %.3f deg, rho %.2f mm, psi %.3f deg\n",
               rad2deg(o.phi.crlb), o.rho.crlb * 1e3, rad2deg(o.psi.crlb));
   if (truth) {
@@ -227,6 +237,12 @@ void add_calibrate_command(CLI::App& app) {
   cmd->add_option("--out", a->out, "Output folder")->required();
   cmd->add_flag("--refine", a->refine,
                 "Refine the filter's result by batch maximum likelihood over the whole run (Ceres)");
+  cmd->add_option("--split-chi2", a->split_chi2,
+                  "Refinement: split a track in two where two features explain its bearings "
+                  "better than one by this likelihood-ratio statistic (a track that slipped onto "
+                  "a neighbouring line); 0 turns splitting off")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   cmd->add_flag("--force", a->force,
                 "Write extrinsics.yaml (and exit 0) even when the run does not determine every "
                 "parameter");

@@ -6,8 +6,11 @@
 #include <cmath>
 #include <algorithm>
 #include <limits>
+#include <functional>
+#include <map>
 #include <memory>
 #include <sstream>
+#include <tuple>
 
 #include "omnivert/calib/model.hpp"
 #include "omnivert/calib/updater.hpp"
@@ -58,10 +61,11 @@ struct BearingResidual {
 struct Built {
   std::vector<std::array<double, 3>> poses;
   std::map<int, std::array<double, 2>> features;
-  std::array<double, 3> ex{};
+  std::vector<double> ex = std::vector<double>(3, 0.0);  // heap storage: Built moves keep the address Ceres holds
   std::unique_ptr<ceres::Problem> problem;
   int num_bearings = 0;
   std::vector<ceres::ResidualBlockId> bearing_blocks;
+  std::vector<std::pair<int, int>> bearing_keys;  // (track id, frame) of each bearing block
 };
 
 // Removes the bearings whose whitened residual exceeds `threshold` (the filter's chi-square
@@ -69,7 +73,9 @@ struct Built {
 int reject_outliers(Built* b, double threshold) {
   int n = 0;
   std::vector<ceres::ResidualBlockId> kept;
-  for (ceres::ResidualBlockId id : b->bearing_blocks) {
+  std::vector<std::pair<int, int>> kept_keys;
+  for (std::size_t i = 0; i < b->bearing_blocks.size(); ++i) {
+    const ceres::ResidualBlockId id = b->bearing_blocks[i];
     double r = 0.0, cost = 0.0;
     b->problem->EvaluateResidualBlock(id, /*apply_loss_function=*/false, &cost, &r, nullptr);
     if (!(std::abs(r) <= threshold)) {
@@ -77,11 +83,76 @@ int reject_outliers(Built* b, double threshold) {
       ++n;
     } else {
       kept.push_back(id);
+      if (i < b->bearing_keys.size()) kept_keys.push_back(b->bearing_keys[i]);
     }
   }
   b->bearing_blocks = std::move(kept);
+  b->bearing_keys = std::move(kept_keys);
   b->num_bearings -= n;
   return n;
+}
+
+// Track splitting (BatchOptions::split_chi2). A track that slipped onto a neighbouring line
+// (a door leaf 6 cm inside its frame) is two features glued together: from the frame of the
+// slip on, its bearings follow another point. For each track and each split frame j, the
+// likelihood-ratio statistic of "two features, before and after j" against "one feature"
+// with poses and extrinsics held at the current solution, linearised there: with the whitened
+// residuals r_i and their Jacobians J_i (1x2) on the feature point, each segment's best
+// feature step reduces the squared residuals by g^T H^-1 g (g = sum J_i^T r_i,
+// H = sum J_i^T J_i), computed for every j at once from prefix sums. Under no slip the
+// statistic at a fixed j is chi-square with 2 degrees of freedom. Returns track id -> first
+// frame of the second segment for tracks whose best statistic exceeds the threshold.
+std::map<int, int> find_splits(const Built& b, const BatchOptions& batch) {
+  struct Row {
+    int frame;
+    double r;
+    Eigen::Vector2d J;
+  };
+  std::map<int, std::vector<Row>> seq;
+  double jp[3], jf[2], je[3];
+  double* jac[3] = {jp, jf, je};
+  for (std::size_t i = 0; i < b.bearing_blocks.size() && i < b.bearing_keys.size(); ++i) {
+    double r = 0.0, cost = 0.0;
+    b.problem->EvaluateResidualBlock(b.bearing_blocks[i], /*apply_loss_function=*/false, &cost, &r,
+                                     jac);
+    seq[b.bearing_keys[i].first].push_back({b.bearing_keys[i].second, r, Eigen::Vector2d(jf[0], jf[1])});
+  }
+  std::vector<std::tuple<double, int, int>> candidates;  // (statistic, track id, split frame)
+  const int m = std::max(batch.split_min_bearings, 2);
+  auto gain = [](const Eigen::Matrix2d& H, const Eigen::Vector2d& g) {
+    const Eigen::Matrix2d Hr = H + 1e-9 * (H.trace() + 1e-12) * Eigen::Matrix2d::Identity();
+    return g.dot(Hr.ldlt().solve(g));
+  };
+  for (auto& [id, v] : seq) {
+    const int n = static_cast<int>(v.size());
+    if (n < 2 * m) continue;
+    std::sort(v.begin(), v.end(), [](const Row& x, const Row& y) { return x.frame < y.frame; });
+    std::vector<Eigen::Matrix2d> H(n + 1, Eigen::Matrix2d::Zero());
+    std::vector<Eigen::Vector2d> g(n + 1, Eigen::Vector2d::Zero());
+    for (int i = 0; i < n; ++i) {
+      H[i + 1] = H[i] + v[i].J * v[i].J.transpose();
+      g[i + 1] = g[i] + v[i].J * v[i].r;
+    }
+    const double whole = gain(H[n], g[n]);  // ~0 at a solution; kept for exactness
+    double best = 0.0;
+    int best_j = -1;
+    for (int j = m; j <= n - m; ++j) {
+      const double t = gain(H[j], g[j]) + gain(H[n] - H[j], g[n] - g[j]) - whole;
+      if (t > best) {
+        best = t;
+        best_j = j;
+      }
+    }
+    if (best_j > 0 && best > batch.split_chi2) candidates.push_back({best, id, v[best_j].frame});
+  }
+  // A slip biases the extrinsics, and a biased solution leaves structure in the residuals of
+  // clean tracks too: only the tracks within a factor split_keep_fraction of the strongest
+  // statistic are split in this round; the others are judged again after the re-solve.
+  std::sort(candidates.begin(), candidates.end(), std::greater<>());
+  std::map<int, int> out;
+  for (const auto& [t, id, frame] : candidates)
+    if (t >= batch.split_keep_fraction * std::get<0>(candidates.front())) out[id] = frame;
+  return out;
 }
 
 Built build(const CalibrationRun& run,
@@ -137,6 +208,7 @@ Built build(const CalibrationRun& run,
       ceres::LossFunction* loss = robust ? new ceres::HuberLoss(batch.huber_sigmas) : nullptr;
       b.bearing_blocks.push_back(b.problem->AddResidualBlock(
           cost, loss, b.poses[k].data(), it->second.data(), b.ex.data()));
+      b.bearing_keys.emplace_back(o.track_id, static_cast<int>(k));
       ++b.num_bearings;
     }
   }
@@ -199,11 +271,44 @@ RefinementResult refine_batch(const CalibrationRun& run,
   ceres::Solve(so, b.problem.get(), &summary);
   // Outlying bearings (false matches) out, at the filter's gate, then solve again.
   const double gate = std::sqrt(chi2_quantile(options.gate_probability, 1));
-  for (int round = 0; round < 3; ++round) {
-    const int n = reject_outliers(&b, gate);
-    res.num_rejected += n;
-    if (n == 0) break;
+  auto reject_and_solve = [&] {
+    res.num_rejected = 0;
+    for (int round = 0; round < 3; ++round) {
+      const int n = reject_outliers(&b, gate);
+      res.num_rejected += n;
+      if (n == 0) break;
+      ceres::Solve(so, b.problem.get(), &summary);
+    }
+  };
+  reject_and_solve();
+  // Tracks that slipped onto a neighbouring line are split in two and the problem is built
+  // and solved again from the current solution (all bearings back in, outliers re-judged).
+  CalibrationRun split_run;
+  std::map<int, int> origin;  // id given by a split -> the tracker's id
+  for (int round = 0; batch.split_chi2 > 0.0 && round < batch.split_rounds; ++round) {
+    const std::map<int, int> splits = find_splits(b, batch);
+    if (splits.empty()) break;
+    const CalibrationRun& current = round == 0 ? run : split_run;
+    int next_id = 0;
+    for (const FrameInput& f : current.frames)
+      for (const BearingObservation& o : f.observations) next_id = std::max(next_id, o.track_id + 1);
+    CalibrationRun next = current;
+    BatchPoint at = point_of(b);
+    for (const auto& [id, first_frame] : splits) {
+      const int nid = next_id++;
+      for (std::size_t k = static_cast<std::size_t>(first_frame); k < next.frames.size(); ++k)
+        for (BearingObservation& o : next.frames[k].observations)
+          if (o.track_id == id) o.track_id = nid;
+      at.features[nid] = at.features.at(id);
+      const int tracker_id = origin.count(id) ? origin.at(id) : id;
+      origin[nid] = tracker_id;
+      res.splits.emplace_back(tracker_id, first_frame);
+    }
+    res.num_splits += static_cast<int>(splits.size());
+    split_run = std::move(next);
+    b = build(split_run, options, at, batch, batch.robust);
     ceres::Solve(so, b.problem.get(), &summary);
+    reject_and_solve();
   }
   res.num_bearings = b.num_bearings;
   res.num_features = static_cast<int>(b.features.size());

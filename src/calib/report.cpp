@@ -224,6 +224,11 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
     ref["iterations"] = r.refinement.iterations;
     ref["bearings_used"] = r.refinement.num_bearings;
     ref["bearings_rejected"] = r.refinement.num_rejected;
+    ref["tracks_split"] = r.refinement.num_splits;
+    ref["features"] = r.refinement.num_features;
+    nlohmann::json sp = nlohmann::json::array();
+    for (const auto& [track, frame] : r.refinement.splits) sp.push_back({{"track_id", track}, {"frame", frame}});
+    ref["splits"] = sp;
     ref["bearing_residual_sigma_deg"] = num(rad2deg(r.refinement.bearing_residual_sigma));
     ref["initial_cost"] = num(r.refinement.initial_cost);
     ref["final_cost"] = num(r.refinement.final_cost);
@@ -330,7 +335,9 @@ std::string report_html(const CalibrationResult& r, const ReportInputs& in) {
     kv("refinement", std::string(r.refinement.converged ? "converged" : "did not converge") + ", " +
                          std::to_string(r.refinement.iterations) + " iterations, " +
                          std::to_string(r.refinement.num_bearings) + " bearings (" +
-                         std::to_string(r.refinement.num_rejected) + " rejected as outliers)");
+                         std::to_string(r.refinement.num_rejected) + " rejected as outliers), " +
+                         std::to_string(r.refinement.num_splits) + " tracks split where they " +
+                         "changed line");
   kv("time: tracking / calibration", f("%.1f s", in.seconds_tracking) + " / " + f("%.1f s", in.seconds_calibration));
   h << "</table>\n";
   if (!in.warnings.empty()) {

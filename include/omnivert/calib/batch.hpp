@@ -34,6 +34,15 @@ struct BatchOptions {
   bool robust = false;              // Huber loss on bearings
   double huber_sigmas = 3.0;        // Huber threshold in bearing sigmas
   int max_iterations = 100;
+  // Track splitting: a track whose bearings are better explained by two features (before
+  // and after one frame) than by one, with a likelihood-ratio statistic above split_chi2, is
+  // taken to have slipped onto a neighbouring line and is split in two (each part at least
+  // split_min_bearings long); 0 turns it off. docs/calib.md ("The office yaw bias").
+  double split_chi2 = 20.0;
+  int split_min_bearings = 5;
+  double split_keep_fraction = 0.5;  // a round splits the tracks within this factor of the
+                                     // strongest statistic (the rest are judged after re-solving)
+  int split_rounds = 10;
   // Only tracks with at least options.min_track_length bearings enter the batch.
 };
 
@@ -57,7 +66,9 @@ struct RefinementResult {
   int iterations = 0;
   int num_bearings = 0;  // bearings used
   int num_rejected = 0;  // bearings removed as outliers (|residual| > the filter's gate)
-  int num_features = 0;  // tracks in the problem
+  int num_features = 0;  // tracks in the problem (after splitting)
+  int num_splits = 0;    // tracks split in two (BatchOptions::split_chi2)
+  std::vector<std::pair<int, int>> splits;  // (tracker's track id, first frame of the new part)
   // Scale of the bearing residuals at the solution, outliers removed [rad]: 1.4826 x median
   // |residual| x sqrt(bearings / (bearings - 2 features - 3)); the bearing noise the data
   // has (infinity without redundancy).
