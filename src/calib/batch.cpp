@@ -337,6 +337,17 @@ RefinementResult refine_batch(const CalibrationRun& run,
   res.final_cost = summary.final_cost;
   res.iterations = static_cast<int>(summary.iterations.size());
   res.report = summary.BriefReport();
+  // (phi, rho, psi) and (phi + pi, -rho, psi - pi) place the camera identically (eq. 16-17):
+  // the solver may end on the second (seen from pixels, a start far from the truth); the
+  // answer is given with rho >= 0 and the angles wrapped, and the covariance below is
+  // computed there.
+  if (b.ex[1] < 0.0) {
+    b.ex[0] += kPi;
+    b.ex[1] = -b.ex[1];
+    b.ex[2] -= kPi;
+  }
+  b.ex[0] = wrap_angle(b.ex[0]);
+  b.ex[2] = wrap_angle(b.ex[2]);
   res.solution = point_of(b);
   res.extrinsics = res.solution.extrinsics;
 
