@@ -4,7 +4,7 @@
 #   cmake -DOV=<omnivert> -DPAPER=<paper dataset> -DSTRAIGHT=<straight dataset>
 #         -DWORK=<scratch dir> -DMODE=<mode> -P calibrate_cli.cmake
 # MODE: end_to_end | straight | straight_force | wheel_gap | wheel_short | wheel_decreasing |
-#       no_wheel | few_lines | no_lines | prior_file
+#       no_wheel | few_lines | no_lines | prior_file | few_tracks
 cmake_minimum_required(VERSION 3.20)
 
 function(fail msg)
@@ -194,6 +194,26 @@ elseif(MODE STREQUAL "no_wheel")
     fail("expected exit 2 naming wheel0, got ${rc}: ${err}")
   endif()
 
+elseif(MODE STREQUAL "few_tracks")
+  # Lines at least 70% of the annulus: 9 tracks in the paper's corridor run -> a warning
+  # that suggests shorter lines, on the terminal and in summary.json.
+  run_calibrate(${PAPER} ${out_dir} --length-fraction 0.7 --force)
+  if(NOT rc EQUAL 0)
+    fail("calibrate exited ${rc}: ${err}")
+  endif()
+  if(NOT err MATCHES "only [0-9]+ lines were tracked" OR NOT err MATCHES "--length-fraction 0.25")
+    fail("expected the few-lines warning with its advice: ${err}")
+  endif()
+  file(READ ${out_dir}/summary.json json)
+  if(NOT json MATCHES "only [0-9]+ lines were tracked")
+    fail("summary.json lacks the few-lines warning")
+  endif()
+  check_no_nan(${out_dir})
+  # The paper's own threshold on the same run: no such warning.
+  run_calibrate(${PAPER} ${out_dir}-default --force)
+  if(err MATCHES "lines were tracked")
+    fail("warning at the default threshold: ${err}")
+  endif()
 elseif(MODE STREQUAL "few_lines" OR MODE STREQUAL "no_lines")
   # Uniform grey frames (lens cap): no lines. few_lines: frames 10-49 (13 s) -> a warning
   # naming the frames; no_lines: every frame -> a clear error.
