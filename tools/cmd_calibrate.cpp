@@ -159,6 +159,10 @@ void run_calibrate(const CalibrateArgs& a) {
     throw std::runtime_error(
         "the calibration diverged (non-finite estimate); nothing written but tracks.csv. Check "
         "the wheel base and K in wheel0/sensor.yaml and the tracks in tracks.png");
+  for (const std::string& w : calib::result_warnings(result)) {
+    spdlog::warn("{}", w);
+    warnings.push_back(w);
+  }
 
   const bool observable = result.observable();
   const bool write_extrinsics = observable || a.force;

@@ -1,6 +1,8 @@
 #include "omnivert/calib/calibrate.hpp"
 
 #include <algorithm>
+
+#include <Eigen/Cholesky>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -51,6 +53,44 @@ CalibrationResult calibrate(const CalibrationRun& run,
                             const Options& options,
                             const CalibrateOptions& co) {
   return calibrate_once(run, options, co);
+}
+
+std::vector<std::string> result_warnings(const CalibrationResult& r) {
+  std::vector<std::string> out;
+  char buf[512];
+  long used = 0, refused = 0;
+  for (const FrameEstimate& h : r.filter.history) {
+    used += h.num_updates;
+    refused += h.num_rejected;
+  }
+  const long seen = used + refused;
+  if (seen >= 50 && refused > 0.2 * static_cast<double>(seen)) {
+    std::snprintf(buf, sizeof(buf),
+                  "the filter's chi-square gate refused %ld of %ld bearings (%.0f%%): the filter "
+                  "has probably diverged or the tracks mix lines; look at tracks.png%s",
+                  refused, seen, 100.0 * static_cast<double>(refused) / static_cast<double>(seen),
+                  r.refined ? "" : " and run with --refine");
+    out.emplace_back(buf);
+  }
+  if (r.refined && r.refinement.covariance_ok && r.filter.covariance.allFinite()) {
+    const Extrinsics& f = r.filter.extrinsics;
+    const Extrinsics& b = r.refinement.extrinsics;
+    const Eigen::Vector3d d(wrap_angle(b.phi - f.phi), b.rho - f.rho, wrap_angle(b.psi - f.psi));
+    const Eigen::LDLT<Eigen::Matrix3d> ldlt(r.filter.covariance);
+    const double m2 = ldlt.info() == Eigen::Success ? d.dot(ldlt.solve(d)) : 0.0;
+    constexpr double kChi2_3_999 = 16.27;  // chi-square, 3 dof, 99.9%
+    if (std::isfinite(m2) && m2 > kChi2_3_999) {
+      std::snprintf(buf, sizeof(buf),
+                    "the filter and the refinement disagree (squared Mahalanobis distance %.1f "
+                    "under the filter's covariance, 99.9%% limit %.1f; camera yaw %.3f vs %.3f "
+                    "deg): the filter is biased or overconfident on this run and the "
+                    "refinement's estimate is the one reported (tracks that slip onto a "
+                    "neighbouring line do this; docs/calib.md)",
+                    m2, kChi2_3_999, rad2deg(f.yaw()), rad2deg(b.yaw()));
+      out.emplace_back(buf);
+    }
+  }
+  return out;
 }
 
 namespace {

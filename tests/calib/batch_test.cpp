@@ -137,3 +137,43 @@ TEST(Refinement, MirroredExtrinsicsAreReportedWithPositiveRho) {
 
 }  // namespace
 }  // namespace omnivert::calib
+
+#include "omnivert/calib/calibrate.hpp"
+
+namespace omnivert::calib {
+namespace {
+
+// result_warnings: a filter that refused many bearings, and a refinement outside the filter's
+// 99.9% ellipsoid, are told; a consistent pair is not.
+TEST(ResultWarnings, DivergenceAndDisagreementAreTold) {
+  CalibrationResult r;
+  r.filter.extrinsics = {-0.34, 0.23, 0.33};
+  r.filter.covariance = Eigen::Vector3d(1e-4, 1e-6, 1e-4).asDiagonal();  // sigmas 0.57 deg, 1 mm
+  for (int k = 0; k < 10; ++k) {
+    FrameEstimate h;
+    h.num_updates = 8;
+    h.num_rejected = 2;  // 20%: not more than 20%
+    r.filter.history.push_back(h);
+  }
+  EXPECT_TRUE(result_warnings(r).empty());
+  r.filter.history[0].num_rejected = 3;
+  std::vector<std::string> w = result_warnings(r);
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_NE(w[0].find("refused 21 of 101 bearings"), std::string::npos) << w[0];
+  EXPECT_NE(w[0].find("--refine"), std::string::npos);
+  r.filter.history[0].num_rejected = 2;
+  r.refined = true;
+  r.refinement.covariance_ok = true;
+  r.refinement.extrinsics = {-0.34 + 0.02, 0.23 + 0.002, 0.33 - 0.02};  // (2 + 2 + 4) = 8
+  EXPECT_TRUE(result_warnings(r).empty());
+  r.refinement.extrinsics = {-0.34 + 0.03, 0.23 + 0.003, 0.33 - 0.03};  // 9 + 9 + 9 = 27
+  w = result_warnings(r);
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_NE(w[0].find("disagree (squared Mahalanobis distance 27.0"), std::string::npos) << w[0];
+  // Angles wrap: the same pair two turns apart is no disagreement.
+  r.refinement.extrinsics = {-0.34 + 4 * kPi, 0.23, 0.33 - 2 * kPi};
+  EXPECT_TRUE(result_warnings(r).empty());
+}
+
+}  // namespace
+}  // namespace omnivert::calib

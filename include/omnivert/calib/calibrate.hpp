@@ -11,6 +11,7 @@
 //   omnivert::calib::write_states_csv(dir + "/states.csv", result.filter.history);
 
 #include <string>
+#include <vector>
 
 #include "omnivert/calib/batch.hpp"
 #include "omnivert/calib/calibration_filter.hpp"
@@ -43,6 +44,14 @@ struct CalibrationResult {
 CalibrationResult calibrate(const CalibrationRun& run,
                             const Options& options,
                             const CalibrateOptions& calibrate_options = {});
+
+// What a user should be told about a result (empty when nothing): the filter's gate refused
+// more than 20% of the bearings (it has probably diverged, or the tracks mix lines), and,
+// when refined, the refinement lies outside the filter's 99.9% ellipsoid (squared Mahalanobis
+// distance under the filter's covariance above 16.27, chi-square with 3 degrees of freedom):
+// the filter is biased or overconfident on this run, and the refinement's answer is the one
+// to trust (seen where tracks slip onto a neighbouring line, docs/calib.md).
+std::vector<std::string> result_warnings(const CalibrationResult& result);
 
 // DIR/extrinsics.yaml of issue 5: phi, rho, psi, sigma_phi, sigma_rho, sigma_psi, covariance
 // (3x3, row-major), x, y, yaw (= phi + psi), T_base_cam (4x4), observable, crlb_phi,
