@@ -109,12 +109,16 @@ std::map<int, int> find_splits(const Built& b, const BatchOptions& batch) {
     Eigen::Vector2d J;
   };
   std::map<int, std::vector<Row>> seq;
-  double jp[3], jf[2], je[3];
-  double* jac[3] = {jp, jf, je};
+  // Only the feature's Jacobian: Ceres refuses (and logs) a Jacobian of a constant block, and
+  // frame 0's pose is constant (the gauge).
+  double jf[2];
+  double* jac[3] = {nullptr, jf, nullptr};
   for (std::size_t i = 0; i < b.bearing_blocks.size() && i < b.bearing_keys.size(); ++i) {
     double r = 0.0, cost = 0.0;
-    b.problem->EvaluateResidualBlock(b.bearing_blocks[i], /*apply_loss_function=*/false, &cost, &r,
-                                     jac);
+    if (!b.problem->EvaluateResidualBlock(b.bearing_blocks[i], /*apply_loss_function=*/false,
+                                          &cost, &r, jac) ||
+        !std::isfinite(r) || !std::isfinite(jf[0]) || !std::isfinite(jf[1]))
+      continue;
     seq[b.bearing_keys[i].first].push_back({b.bearing_keys[i].second, r, Eigen::Vector2d(jf[0], jf[1])});
   }
   std::vector<std::tuple<double, int, int>> candidates;  // (statistic, track id, split frame)
