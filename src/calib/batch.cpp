@@ -314,6 +314,7 @@ RefinementResult refine_batch(const CalibrationRun& run,
     ceres::Solve(so, b.problem.get(), &summary);
     reject_and_solve();
   }
+  if (res.num_splits > 0) res.split_run = std::move(split_run);
   res.num_bearings = b.num_bearings;
   res.num_features = static_cast<int>(b.features.size());
   {

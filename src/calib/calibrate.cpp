@@ -25,13 +25,15 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
   r.extrinsics = r.filter.extrinsics;
   r.covariance = r.filter.covariance;
   BatchPoint at = batch_point_from_filter(run, options, r.filter);
+  const CalibrationRun* analysed = &run;
   if (co.refine) {
     r.refinement = refine_batch(run, options, at, co.batch);
     r.refined = true;
     at = r.refinement.solution;
+    if (r.refinement.num_splits > 0) analysed = &r.refinement.split_run;  // the same problem
   }
   // Sec. 8.1 at the best estimate of the trajectory, the features and the extrinsics.
-  r.observability = analyse_observability(run, options, at, co.batch, co.observability);
+  r.observability = analyse_observability(*analysed, options, at, co.batch, co.observability);
   if (r.refined && !r.refinement.covariance_ok && r.observability.all_determined() &&
       r.observability.crlb_covariance.allFinite()) {
     // ceres::Covariance gives up on badly scaled problems (poses in metres, bearings whitened

@@ -76,6 +76,13 @@ TEST(TrackSplitting, SlippedTracksAreSplitAndTheirBiasRemoved) {
   EXPECT_EQ(whole.num_splits, 0);
   EXPECT_EQ(split.num_splits, 3);
   EXPECT_EQ(split.num_features, whole.num_features + split.num_splits);
+  // The run the solution refers to: the split parts under new ids, every feature of the
+  // solution observed in it (what calibrate() hands to the observability analysis).
+  std::map<int, int> seen;
+  for (const FrameInput& f : split.split_run.frames)
+    for (const BearingObservation& ob : f.observations) ++seen[ob.track_id];
+  EXPECT_EQ(seen.size(), clean.track_feature.size() + 3);
+  for (const auto& [id, p] : split.solution.features) EXPECT_GT(seen[id], 0) << "feature " << id;
   EXPECT_GT(nees_whole, 16.3);  // chi-square(3) 99.9% quantile: the slips bias the estimate
   EXPECT_LT(nees_split, 7.81);  // 95%: consistent again
   RecordProperty("nees_whole", std::to_string(nees_whole));

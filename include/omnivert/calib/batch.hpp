@@ -69,6 +69,7 @@ struct RefinementResult {
   int num_features = 0;  // tracks in the problem (after splitting)
   int num_splits = 0;    // tracks split in two (BatchOptions::split_chi2)
   std::vector<std::pair<int, int>> splits;  // (tracker's track id, first frame of the new part)
+  CalibrationRun split_run;  // with splits: the run `solution` refers to (split parts renamed)
   // Scale of the bearing residuals at the solution, outliers removed [rad]: 1.4826 x median
   // |residual| x sqrt(bearings / (bearings - 2 features - 3)); the bearing noise the data
   // has (infinity without redundancy).
