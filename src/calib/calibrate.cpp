@@ -1,14 +1,14 @@
 #include "omnivert/calib/calibrate.hpp"
 
 #include <algorithm>
-
-#include <Eigen/Cholesky>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iomanip>
 #include <limits>
 #include <sstream>
+
+#include <Eigen/Cholesky>
 
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
