@@ -3,6 +3,7 @@
 #include <ceres/ceres.h>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/SparseCore>
 #include <cmath>
 #include <algorithm>
 #include <limits>
@@ -157,6 +158,21 @@ std::map<int, int> find_splits(const Built& b, const BatchOptions& batch) {
   for (const auto& [t, id, frame] : candidates)
     if (t >= batch.split_keep_fraction * std::get<0>(candidates.front())) out[id] = frame;
   return out;
+}
+
+// J^T J of a Jacobian in Ceres' compressed-row form, as a dense matrix. Each row of J has a
+// handful of entries (a bearing touches one pose, one feature and the extrinsics), so the
+// product is formed sparse: O(rows x 8^2) instead of the dense O(rows x cols^2) (hall, 318
+// tracks: the filter's bootstrap window 10.5 s -> see docs/calib.md).
+Eigen::MatrixXd information_from_jacobian(const ceres::CRSMatrix& crs) {
+  std::vector<Eigen::Triplet<double>> t;
+  t.reserve(crs.values.size());
+  for (int r = 0; r < crs.num_rows; ++r)
+    for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k) t.emplace_back(r, crs.cols[k], crs.values[k]);
+  Eigen::SparseMatrix<double> J(crs.num_rows, crs.num_cols);
+  J.setFromTriplets(t.begin(), t.end());
+  const Eigen::SparseMatrix<double> F = J.transpose() * J;
+  return Eigen::MatrixXd(F);
 }
 
 Built build(const CalibrationRun& run,
@@ -398,10 +414,7 @@ ObservabilityReport analyse_observability(const CalibrationRun& run,
   eo.apply_loss_function = false;
   ceres::CRSMatrix crs;
   b.problem->Evaluate(eo, nullptr, nullptr, nullptr, &crs);
-  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
-  for (int r = 0; r < crs.num_rows; ++r)
-    for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k) J(r, crs.cols[k]) = crs.values[k];
-  const Eigen::MatrixXd F = J.transpose() * J;
+  const Eigen::MatrixXd F = information_from_jacobian(crs);
   const int n = static_cast<int>(F.rows()), no = n - 3;
 
   // Marginal information of the extrinsics: Schur complement of the nuisance block
@@ -609,10 +622,7 @@ bool bootstrap_filter_state(const CalibrationRun& window,
   eo.parameter_blocks = blocks;
   ceres::CRSMatrix crs;
   b.problem->Evaluate(eo, nullptr, nullptr, nullptr, &crs);
-  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
-  for (int r = 0; r < crs.num_rows; ++r)
-    for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k) J(r, crs.cols[k]) = crs.values[k];
-  const Eigen::MatrixXd F = J.transpose() * J;
+  const Eigen::MatrixXd F = information_from_jacobian(crs);
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(F);
   if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().array() > 0).all())
     return fail("window information is singular");

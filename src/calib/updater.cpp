@@ -20,9 +20,16 @@ bool joseph_update(const Eigen::MatrixXd& H,
   if (llt.info() != Eigen::Success) return false;
   // K = P H^T S^-1, i.e. K^T = S^-1 H P (S symmetric): a Cholesky solve, no inverse.
   const Eigen::MatrixXd K = llt.solve(PHt.transpose()).transpose();
-  Eigen::MatrixXd IKH = -K * H;
-  IKH.diagonal().array() += 1.0;
-  Eigen::MatrixXd Pn = IKH * (*P) * IKH.transpose() + K * R * K.transpose();
+  // (I - K H) P (I - K H)^T evaluated by associativity without forming the n x n matrix
+  // I - K H: A = (I - K H) P = P - K (H P), then A (I - K H)^T = A - (A H^T) K^T. Every
+  // product has the m bearings as a dimension: O(n^2 m) instead of O(n^3) (hall, 318 tracks:
+  // the filter 12.9 s -> see docs/calib.md).
+  Eigen::MatrixXd A = *P;
+  A.noalias() -= K * PHt.transpose();
+  const Eigen::MatrixXd AHt = A * H.transpose();
+  Eigen::MatrixXd Pn = A;
+  Pn.noalias() -= AHt * K.transpose();
+  Pn.noalias() += K * R * K.transpose();
   *P = 0.5 * (Pn + Pn.transpose());
   if (K_out) *K_out = K;
   return true;
