@@ -162,8 +162,8 @@ std::map<int, int> find_splits(const Built& b, const BatchOptions& batch) {
 
 // J^T J of a Jacobian in Ceres' compressed-row form, as a dense matrix. Each row of J has a
 // handful of entries (a bearing touches one pose, one feature and the extrinsics), so the
-// product is formed sparse: O(rows x 8^2) instead of the dense O(rows x cols^2) (hall, 318
-// tracks: the filter's bootstrap window 10.5 s -> see docs/calib.md).
+// product is formed sparse: O(rows x 8^2) instead of the dense O(rows x cols^2). Hall zigzag,
+// 318 tracks: filter (its bootstrap window) 12.97 -> 8.44 s, observability 2.62 -> 0.68 s.
 Eigen::MatrixXd information_from_jacobian(const ceres::CRSMatrix& crs) {
   std::vector<Eigen::Triplet<double>> t;
   t.reserve(crs.values.size());
