@@ -12,30 +12,16 @@
 #include "omnivert/calib/model.hpp"
 #include "omnivert/calib/synthetic_run.hpp"
 #include "omnivert/core/angles.hpp"
+#include "synthetic_support.hpp"
 
 namespace omnivert::calib {
 namespace {
 
-BatchPoint truth_point(const SyntheticRun& run) {
-  BatchPoint p;
-  p.poses = run.true_poses;
-  p.extrinsics = run.truth;
-  for (const auto& [id, j] : run.track_feature) p.features[id] = run.features[j];
-  return p;
-}
-
-Options options_for(const SyntheticRunOptions& so) {
-  Options o;
-  o.wheel_base = so.wheel_base;
-  o.odometry_K = so.odometry_K;
-  o.bearing_sigma = so.bearing_sigma;
-  return o;
-}
+using test_support::options_for;
+using test_support::truth_point;
 
 double nees(const RefinementResult& r, const Extrinsics& truth) {
-  const Eigen::Vector3d e(wrap_angle(r.extrinsics.phi - truth.phi), r.extrinsics.rho - truth.rho,
-                          wrap_angle(r.extrinsics.psi - truth.psi));
-  return e.dot(r.covariance.ldlt().solve(e));
+  return test_support::nees(r.extrinsics, r.covariance, truth);
 }
 
 // From frame `from` on, the track of feature `f` follows a second line `behind` metres further

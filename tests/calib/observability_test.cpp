@@ -7,25 +7,13 @@
 #include "omnivert/calib/batch.hpp"
 #include "omnivert/calib/synthetic_run.hpp"
 #include "omnivert/core/angles.hpp"
+#include "synthetic_support.hpp"
 
 namespace omnivert::calib {
 namespace {
 
-BatchPoint truth_point(const SyntheticRun& run) {
-  BatchPoint p;
-  p.poses = run.true_poses;
-  p.extrinsics = run.truth;
-  for (const auto& [id, j] : run.track_feature) p.features[id] = run.features[j];
-  return p;
-}
-
-Options options_for(const SyntheticRunOptions& so) {
-  Options o;
-  o.wheel_base = so.wheel_base;
-  o.odometry_K = so.odometry_K;
-  o.bearing_sigma = so.bearing_sigma;
-  return o;
-}
+using test_support::options_for;
+using test_support::truth_point;
 
 TEST(Observability, StraightRunDeterminesOnlyTheYaw) {
   SyntheticRunOptions so;
