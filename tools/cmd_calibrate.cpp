@@ -13,7 +13,6 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
-#include <set>
 
 #include <spdlog/spdlog.h>
 
@@ -136,12 +135,9 @@ void run_calibrate(const CalibrateArgs& a) {
     // Few lines: measured on the simulator's office (docs/calib.md, "Shorter lines"), about
     // 10 tracks at the paper's 50% length gave a median camera yaw error of 0.14-0.17 degree
     // over 50 runs; 25% lines with --refine gave 0.006 degree.
-    std::set<int> ids;
-    for (const auto& f : run.run.frames)
-      for (const auto& o : f.observations) ids.insert(o.track_id);
-    constexpr std::size_t kFewTracks = 15;
-    if (ids.size() < kFewTracks) {
-      std::string w = "only " + std::to_string(ids.size()) +
+    constexpr int kFewTracks = 15;
+    if (run.tracks < kFewTracks) {
+      std::string w = "only " + std::to_string(run.tracks) +
                       " lines were tracked: the estimate rests on few features and may be off by "
                       "more than its sigma";
       if (a.pipeline.lines.threshold == LineThreshold::kFractionOfAnnulus &&

@@ -84,7 +84,7 @@ int reject_outliers(Built* b, double threshold) {
       ++n;
     } else {
       kept.push_back(id);
-      if (i < b->bearing_keys.size()) kept_keys.push_back(b->bearing_keys[i]);
+      kept_keys.push_back(b->bearing_keys[i]);
     }
   }
   b->bearing_blocks = std::move(kept);
@@ -114,7 +114,7 @@ std::map<int, int> find_splits(const Built& b, const BatchOptions& batch) {
   // frame 0's pose is constant (the gauge).
   double jf[2];
   double* jac[3] = {nullptr, jf, nullptr};
-  for (std::size_t i = 0; i < b.bearing_blocks.size() && i < b.bearing_keys.size(); ++i) {
+  for (std::size_t i = 0; i < b.bearing_blocks.size(); ++i) {  // bearing_keys is parallel
     double r = 0.0, cost = 0.0;
     if (!b.problem->EvaluateResidualBlock(b.bearing_blocks[i], /*apply_loss_function=*/false,
                                           &cost, &r, jac) ||
