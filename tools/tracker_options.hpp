@@ -26,6 +26,8 @@ struct TrackerFlags {
   double continuity_turn_curvature = -1.0;                     // < 0: the default
   double look_back_f1 = -1.0;                                  // < 0: the rule set's
   std::string heads_only = "default";                          // on|off|default
+  double confirm_f1 = -1.0;                                    // < 0: the rule set's
+  double confirm_deg = -1.0;                                   // < 0: the rule set's
 
   // The options these flags select (the wheel base is filled in from the dataset).
   TrackerOptions options() const {
@@ -46,6 +48,8 @@ struct TrackerFlags {
     if (continuity_turn_curvature >= 0.0) o.continuity_turn_curvature = continuity_turn_curvature;
     if (look_back_f1 >= 0.0) o.look_back_f1 = look_back_f1;
     if (heads_only != "default") o.heads_only = heads_only == "on";
+    if (confirm_f1 >= 0.0) o.confirm_f1 = confirm_f1;
+    if (confirm_deg >= 0.0) o.confirm_tolerance = deg2rad(confirm_deg);
     if (same_polarity != "default") o.same_polarity = same_polarity == "on";
     if (gate_min_distance > 0.0) o.gate.min_feature_distance = gate_min_distance;
     if (gate_tolerance_deg >= 0.0) o.gate.bearing_tolerance = deg2rad(gate_tolerance_deg);
@@ -118,6 +122,20 @@ inline void add_tracker_options(CLI::App* cmd, TrackerFlags& t) {
                   "Test 1 for links across a look-back gap (2+ frames back): min distance <= "
                   "this (0: F1; default: the rule set's: paper 0, recommended 0.5)")
       ->check(CLI::NonNegativeNumber)
+      ->group(g);
+  cmd->add_option("--confirm-f1",
+                  t.confirm_f1,
+                  "Confirmed F1: accept a descriptor distance above F1 (or the look-back F1) up "
+                  "to this when the track's motion predicts the line to --confirm-tolerance and "
+                  "no other line is near the prediction (needs track continuity; 0: off; "
+                  "default: the rule set's)")
+      ->check(CLI::NonNegativeNumber)
+      ->group(g);
+  cmd->add_option("--confirm-tolerance",
+                  t.confirm_deg,
+                  "Confirmed F1: largest deviation from the track's predicted bearing [degrees] "
+                  "(default: the rule set's)")
+      ->check(CLI::Range(0.0, 179.0))
       ->group(g);
   cmd->add_option("--heads-only",
                   t.heads_only,

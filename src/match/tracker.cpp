@@ -39,6 +39,11 @@ bool TrackerOptions::IsValid(std::string* error) const {
     if (error) *error = "continuity curvature bounds must be finite and >= 0";
     return false;
   }
+  if (!(confirm_f1 >= 0.0 && std::isfinite(confirm_f1) && confirm_tolerance >= 0.0 &&
+        confirm_tolerance < kPi)) {
+    if (error) *error = "confirmed F1 must be >= 0 (0: off) and its tolerance in [0, pi) radians";
+    return false;
+  }
   if (!(look_back_f1 >= 0.0 && std::isfinite(look_back_f1))) {
     if (error) *error = "look-back F1 must be >= 0 (0: F1)";
     return false;
@@ -65,6 +70,36 @@ TrackerOptions recommended_tracker_options(double wheel_base) {
   return o;
 }
 
+const char* to_string(LinkVerdict v) {
+  switch (v) {
+    case LinkVerdict::kLinked:
+      return "linked";
+    case LinkVerdict::kNoFrame:
+      return "no-frame";
+    case LinkVerdict::kNoCandidates:
+      return "no-candidates";
+    case LinkVerdict::kTest1:
+      return "test1";
+    case LinkVerdict::kTest2:
+      return "test2";
+    case LinkVerdict::kTest3:
+      return "test3";
+    case LinkVerdict::kLookBackF1:
+      return "look-back-f1";
+    case LinkVerdict::kMutual:
+      return "mutual";
+    case LinkVerdict::kClaimed:
+      return "claimed";
+    case LinkVerdict::kGate:
+      return "gate";
+    case LinkVerdict::kContinuity:
+      return "continuity";
+    case LinkVerdict::kFork:
+      return "fork";
+  }
+  return "?";
+}
+
 std::string TrackerStats::BriefReport() const {
   std::ostringstream s;
   s << frames << " frames, " << lines << " lines: " << matched_previous
@@ -87,6 +122,10 @@ Tracker::Slot& Tracker::slot_back(int k) {
   const std::int64_t frame = frame_count_ - k;
   assert(k >= 1 && k <= options_.look_back && frame >= 0);
   return ring_[static_cast<std::size_t>(frame % options_.look_back)];
+}
+
+const Tracker::Slot& Tracker::slot_back(int k) const {
+  return const_cast<Tracker*>(this)->slot_back(k);
 }
 
 bool Tracker::track_claimed(std::int64_t id) const {
@@ -207,22 +246,44 @@ void Tracker::add_frame(const FrameFeatures& frame,
       const int i = unmatched_[static_cast<std::size_t>(q)];
       const MatchResult& r = results_[static_cast<std::size_t>(q)];
       bool ok = r.accepted();
+      LinkVerdict why = ok ? LinkVerdict::kLinked : LinkVerdict::kNoCandidates;
       if (ok && k > 1 && options_.look_back_f1 > 0.0 && r.min_distance > options_.look_back_f1) {
         ++stats_.rejected_test1;  // test 1 with the look-back F1
         ok = false;
+        why = LinkVerdict::kLookBackF1;
+      }
+      // Confirmed F1: a distance between F1 (or the look-back F1) and confirm_f1 is accepted
+      // when tests 2 and 3 pass and the track's prediction confirms the line (checked below).
+      bool needs_confirmation = false;
+      if (options_.confirm_f1 > 0.0 && r.best >= 0 && r.min_distance <= options_.confirm_f1 &&
+          (why == LinkVerdict::kLookBackF1 || r.verdict == MatchVerdict::kFailedTest1)) {
+        MatchOptions relaxed = options_.match;
+        relaxed.f1 = options_.confirm_f1;
+        const int nc = static_cast<int>(slot.num_lines);
+        if (apply_match_tests(relaxed, nc, r.min_distance, r.second_distance, r.mean_distance) ==
+            MatchVerdict::kAccepted) {
+          needs_confirmation = true;
+        }
       }
       switch (r.verdict) {
         case MatchVerdict::kFailedTest1:
           ++stats_.rejected_test1;
+          why = LinkVerdict::kTest1;
           break;
         case MatchVerdict::kFailedTest2:
           ++stats_.rejected_test2;
+          why = LinkVerdict::kTest2;
           break;
         case MatchVerdict::kFailedTest3:
           ++stats_.rejected_test3;
+          why = LinkVerdict::kTest3;
           break;
         default:
           break;
+      }
+      if (needs_confirmation) {
+        ok = true;
+        why = LinkVerdict::kLinked;
       }
       const std::int64_t id = ok ? slot.track_ids[static_cast<std::size_t>(r.best)] : -1;
       if (ok && options_.mutual) {
@@ -261,10 +322,12 @@ void Tracker::add_frame(const FrameFeatures& frame,
         if (nearest != i) {
           ++stats_.rejected_mutual;
           ok = false;
+          why = LinkVerdict::kMutual;
         } else if (track_claimed(id)) {
           // One line per track and frame: taken by a line matched in a more recent frame.
           ++stats_.rejected_claimed;
           ok = false;
+          why = LinkVerdict::kClaimed;
         }
       }
       if (ok && options_.gate.enabled &&
@@ -272,15 +335,32 @@ void Tracker::add_frame(const FrameFeatures& frame,
                        frame.lines[static_cast<std::size_t>(i)].bearing)) {
         ++stats_.rejected_gate;
         ok = false;
+        why = LinkVerdict::kGate;
       }
       if (ok && options_.gate.enabled && options_.continuity_tolerance > 0.0 &&
           !continues_track(k, r.best, frame.lines[static_cast<std::size_t>(i)].bearing)) {
         ++stats_.rejected_continuity;
         ok = false;
+        why = LinkVerdict::kContinuity;
+      }
+      if (ok && needs_confirmation &&
+          !(options_.gate.enabled && options_.continuity_tolerance > 0.0 &&
+            confirms_track(k, r.best, frame, i))) {
+        ok = false;
+        why = k > 1 && options_.look_back_f1 > 0.0 && r.min_distance > options_.look_back_f1
+                  ? LinkVerdict::kLookBackF1
+                  : LinkVerdict::kTest1;
       }
       if (ok && k > 1 && options_.heads_only && observed_since(id, k)) {
         ++stats_.rejected_fork;
         ok = false;
+        why = LinkVerdict::kFork;
+      }
+      if (k == 1) {
+        TrackAssignment& a = (*out)[static_cast<std::size_t>(i)];
+        a.previous_verdict = why;
+        a.previous_candidate = r.best;
+        a.previous_distance = r.min_distance;
       }
       if (!ok) {
         still_unmatched_.push_back(i);
@@ -321,50 +401,74 @@ bool Tracker::observed_since(std::int64_t id, int k) {
   return false;
 }
 
-bool Tracker::continues_track(int k, int j, double bearing) {
+Tracker::TrackPrediction Tracker::predict_track(int k, int j) const {
   const Slot& s1 = slot_back(k);
   const double rate = s1.parallax_rates[static_cast<std::size_t>(j)];
+  TrackPrediction p;
+  // u = bearing + theta is free of the robot's rotation (eq. 16); its change is parallax.
+  p.u = s1.bearings[static_cast<std::size_t>(j)] + s1.odometry.theta;
+  const double path = odometry_.path_length - s1.odometry.path_length;
+  const double d_theta = odometry_.theta - s1.odometry.theta;
+  const double d_min = options_.gate.min_feature_distance;
+  // Camera swing under rotation (the camera is at most rho_max from the axle), as in the gate.
+  const double swing = 2.0 * options_.gate.max_camera_offset * std::abs(std::sin(0.5 * d_theta));
+  const double swing_bound = swing < d_min ? std::asin(swing / d_min) : kPi;
   if (options_.continuity_model == TrackerOptions::ContinuityModel::kTrack) {
     const double turn_rate = s1.turn_rates[static_cast<std::size_t>(j)];
-    const double u1 = s1.bearings[static_cast<std::size_t>(j)] + s1.odometry.theta;
-    const double u2 = bearing + odometry_.theta;
-    const double path = odometry_.path_length - s1.odometry.path_length;
-    const double d_theta = odometry_.theta - s1.odometry.theta;
-    const double d_min = options_.gate.min_feature_distance;
-    double predicted = u1;
-    double tol = options_.continuity_tolerance;
     // Translation: the parallax the rate predicts, and what it cannot (curvature), at most the
     // sound bound asin(path / D_min) (which is all there is without a rate).
     const double path_bound = path < d_min ? std::asin(path / d_min) : kPi;
     if (std::isnan(rate)) {
-      tol += path_bound;
+      p.spread += path_bound;
+      p.rates_known = path <= 0.005;
     } else {
-      predicted += rate * path;
-      tol += std::min(path_bound, options_.continuity_path_curvature * path * path);
+      p.u += rate * path;
+      p.spread += std::min(path_bound, options_.continuity_path_curvature * path * path);
     }
-    // Rotation: the camera swings around the axle (at most rho_max from it).
-    const double swing = 2.0 * options_.gate.max_camera_offset * std::abs(std::sin(0.5 * d_theta));
-    const double swing_bound = swing < d_min ? std::asin(swing / d_min) : kPi;
     if (std::isnan(turn_rate)) {
-      tol += swing_bound;
+      p.spread += swing_bound;
+      p.rates_known = p.rates_known && std::abs(d_theta) <= 0.01;
     } else {
-      predicted += turn_rate * d_theta;
-      tol += std::min(swing_bound, options_.continuity_turn_curvature * d_theta * d_theta);
+      p.u += turn_rate * d_theta;
+      p.spread += std::min(swing_bound, options_.continuity_turn_curvature * d_theta * d_theta);
     }
-    if (tol >= kPi) return true;
-    return std::abs(angle_diff(u2, predicted)) <= tol;
+    return p;
   }
-  if (std::isnan(rate)) return true;  // no recent history: nothing to predict from
-  // u = bearing + theta is free of the robot's rotation (eq. 16); its change is parallax.
-  const double u1 = s1.bearings[static_cast<std::size_t>(j)] + s1.odometry.theta;
-  const double u2 = bearing + odometry_.theta;
-  const double predicted = u1 + rate * (odometry_.path_length - s1.odometry.path_length);
-  // Camera swing under rotation (rho_max), as in the gate, bounds what is not predicted.
-  const double d_theta = odometry_.theta - s1.odometry.theta;
-  const double swing = 2.0 * options_.gate.max_camera_offset * std::abs(std::sin(0.5 * d_theta));
-  const double tol = options_.continuity_tolerance +
-                     std::asin(std::min(1.0, swing / options_.gate.min_feature_distance));
-  return std::abs(angle_diff(u2, predicted)) <= tol;
+  if (std::isnan(rate)) {  // no recent history: nothing to predict from
+    p.spread = kPi;
+    p.rates_known = false;
+    return p;
+  }
+  p.u += rate * path;
+  p.spread = std::asin(std::min(1.0, swing / d_min));
+  return p;
+}
+
+bool Tracker::continues_track(int k, int j, double bearing) {
+  const TrackPrediction p = predict_track(k, j);
+  const double tol = options_.continuity_tolerance + p.spread;
+  if (tol >= kPi) return true;
+  return std::abs(angle_diff(bearing + odometry_.theta, p.u)) <= tol;
+}
+
+bool Tracker::confirms_track(int k, int j, const FrameFeatures& frame, int line) {
+  const TrackPrediction p = predict_track(k, j);
+  // Only where the model predicts well: rates measured, and what it cannot predict (curvature)
+  // no larger than the tolerance itself.
+  if (!p.rates_known || p.spread > options_.confirm_tolerance) return false;
+  const double tight = options_.confirm_tolerance + p.spread;
+  const double wide = options_.continuity_tolerance + p.spread;
+  if (tight >= kPi || wide >= kPi) return false;
+  if (std::abs(angle_diff(frame.lines[static_cast<std::size_t>(line)].bearing + odometry_.theta,
+                          p.u)) > tight) {
+    return false;
+  }
+  // Unambiguous: no other line of the new frame could continue the track.
+  for (std::size_t a = 0; a < frame.lines.size(); ++a) {
+    if (static_cast<int>(a) == line) continue;
+    if (std::abs(angle_diff(frame.lines[a].bearing + odometry_.theta, p.u)) <= wide) return false;
+  }
+  return true;
 }
 
 void Tracker::store_frame(const FrameFeatures& frame, const std::vector<TrackAssignment>& out) {

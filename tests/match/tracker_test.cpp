@@ -685,6 +685,77 @@ TEST(Tracker, LookBackF1RefusesADistantLinkAcrossAGap) {
   }
 }
 
+// Confirmed F1: driving straight, line 2 drifts by 0.2 degree a frame (parallax); in frame 3
+// its descriptor has changed to 0.48 from frame 2's, beyond F1 = 0.4 (tests 2 and 3 pass). Without
+// the rule it is refused by test 1 (a new track, verdict kTest1 at frame t-1). With confirm_f1
+// = 1.05 it is linked when its bearing is where the track predicts it (0.05 degree off, within
+// 0.3), and still refused when it is 0.5 degree off (beyond 0.3, within continuity's 0.8), or when
+// a second line of the new frame sits 0.6 degree from the prediction (ambiguous).
+TEST(Tracker, ConfirmedF1LinksAChangedDescriptorWhereTheTrackPredictsIt) {
+  const double deg = kPi / 180.0;
+  struct Case {
+    double cf1, off_deg;
+    bool neighbour, linked;
+  };
+  for (const Case c : {Case{0.0, 0.05, false, false},
+                       Case{1.05, 0.05, false, true},
+                       Case{1.05, 0.5, false, false},
+                       Case{1.05, 0.05, true, false}}) {
+    std::mt19937 rng(59);
+    std::vector<Eigen::RowVectorXf> d;
+    for (int k = 0; k < 6; ++k) d.push_back(random_descriptor(rng));
+    const Eigen::RowVectorXf changed = at_distance(d[2], random_descriptor(rng), 0.48);
+    auto frame = [&](int f) {
+      FrameFeatures fr;
+      const bool last = f == 3;
+      const int n = last && c.neighbour ? 7 : 6;
+      fr.descriptors.resize(n, kPaperDescriptorSize);
+      for (int k = 0; k < n; ++k) {
+        VerticalLine v;
+        if (k < 6) {
+          v.bearing = -2.5 + k + (k == 2 ? 0.2 * deg * f + (last ? c.off_deg * deg : 0.0) : 0.0);
+          fr.descriptors.row(k) =
+              k == 2 && last ? changed : perturb(d[static_cast<std::size_t>(k)], 0.004f, rng);
+        } else {  // a line far from line 2 in descriptor space, next to its prediction
+          v.bearing = -2.5 + 2 + 0.2 * deg * f + 0.6 * deg;
+          fr.descriptors.row(k) = random_descriptor(rng);
+        }
+        fr.lines.push_back(v);
+      }
+      return fr;
+    };
+    TrackerOptions o = recommended_tracker_options(0.4);
+    o.look_back = 2;
+    o.match.f1 = 0.4;
+    o.look_back_f1 = 0.0;
+    o.confirm_f1 = c.cf1;
+    o.confirm_tolerance = 0.3 * deg;
+    Tracker tracker(o);
+    std::vector<TrackAssignment> out0, out;
+    tracker.add_frame(frame(0), WheelIncrement{}, &out0);
+    const WheelIncrement straight{0.038, 0.038};
+    for (int f = 1; f <= 2; ++f) {
+      tracker.add_frame(frame(f), straight, &out);
+      for (int k = 0; k < 6; ++k)
+        EXPECT_EQ(out[static_cast<std::size_t>(k)].track_id, out0[k].track_id);
+      EXPECT_EQ(out[2].previous_verdict, LinkVerdict::kLinked);
+    }
+    tracker.add_frame(frame(3), straight, &out);
+    for (int k : {0, 1, 3, 4, 5})
+      EXPECT_EQ(out[static_cast<std::size_t>(k)].track_id, out0[k].track_id);
+    SCOPED_TRACE(testing::Message() << "confirm_f1 " << c.cf1 << ", off " << c.off_deg
+                                    << " deg, neighbour " << c.neighbour);
+    if (c.linked) {
+      EXPECT_EQ(out[2].track_id, out0[2].track_id);
+      EXPECT_NEAR(out[2].distance, 0.48f, 0.01f);
+    } else {
+      EXPECT_TRUE(out[2].is_new());
+      EXPECT_EQ(out[2].previous_verdict, LinkVerdict::kTest1);
+      EXPECT_EQ(out[2].previous_candidate, 2);
+    }
+  }
+}
+
 // A fork: line A (track T) in frame 0; in frame 1 extraction finds its look-alike B instead
 // (0.3 from A: linked to T); in frame 2 A again, 0.3 from A@0 but 0.42 from B, beyond F1 =
 // 0.35, so it is not linked to B and looks back to A@0, forking T. heads_only refuses that

@@ -87,6 +87,15 @@ struct TrackerOptions {
   // observation of a track seen since would fork it (two lines that extraction finds in turn
   // become one track; docs/tracking.md Sec. 3).
   bool heads_only = false;
+  // Confirmed F1 (needs track continuity; 0 = off): a link whose descriptor distance fails
+  // test 1 (F1, or look_back_f1 across a gap) but is at most confirm_f1 is accepted when tests
+  // 2 and 3 pass with F1 = confirm_f1 and the track's motion confirms it: its rates are known,
+  // the new bearing is within confirm_tolerance (plus the model's curvature terms) of the
+  // prediction, and no other line of the new frame is within continuity_tolerance of it. A
+  // line's descriptor changes fastest where its bearing does (near lines); there the
+  // geometry is most telling (docs/tracking.md Sec. 3).
+  double confirm_f1 = 0.0;
+  double confirm_tolerance = 0.0;  // radians
 
   bool IsValid(std::string* error) const;
 };
@@ -99,6 +108,24 @@ TrackerOptions paper_tracker_options();
 // (wheel_base > 0; pass 0 when there is no odometry).
 TrackerOptions recommended_tracker_options(double wheel_base);
 
+// Why a line of frame t was or was not linked to a line of an earlier frame (TrackerOptions:
+// the first rule that refused it).
+enum class LinkVerdict : std::int8_t {
+  kLinked,
+  kNoFrame,       // no such frame, or it has no lines
+  kNoCandidates,  // no admissible candidate (edge polarity, gate-restricted candidates)
+  kTest1,
+  kTest2,
+  kTest3,
+  kLookBackF1,
+  kMutual,
+  kClaimed,
+  kGate,
+  kContinuity,
+  kFork,
+};
+const char* to_string(LinkVerdict v);
+
 // What the tracker decided for one line of a frame.
 struct TrackAssignment {
   std::int64_t track_id = -1;
@@ -107,6 +134,11 @@ struct TrackAssignment {
   // Index of the matched line in that frame; -1 for a new track.
   int matched_line = -1;
   float distance = 0.0f;  // descriptor distance of the match (0 for a new track)
+  // Frame t-1: why the line was not linked there (kLinked when it was), and the candidate
+  // looked at (index in frame t-1, -1 when none) with its descriptor distance.
+  LinkVerdict previous_verdict = LinkVerdict::kNoFrame;
+  int previous_candidate = -1;
+  float previous_distance = 0.0f;
   bool is_new() const { return frames_back == 0; }
 };
 
@@ -165,11 +197,24 @@ class Tracker {
 
   // The slot of frame (frame_count_ - k), k = 1..look_back; requires k <= frames held.
   Slot& slot_back(int k);
+  const Slot& slot_back(int k) const;
   void store_frame(const FrameFeatures& frame, const std::vector<TrackAssignment>& out);
   bool track_claimed(std::int64_t id) const;
   // TrackerOptions::continuity_tolerance: may line `bearing` of the new frame continue the
   // track of line j of frame t-k?
   bool continues_track(int k, int j, double bearing);
+  // The rotation-free bearing u = beta + theta that track continuity predicts for the track of
+  // line j of frame t-k in the new frame, and the spread its model allows on top of the
+  // tolerance (curvature and sound bounds).
+  struct TrackPrediction {
+    double u = 0.0;
+    double spread = 0.0;
+    bool rates_known = true;  // the motion since frame t-k is covered by measured rates
+  };
+  TrackPrediction predict_track(int k, int j) const;
+  // TrackerOptions::confirm_f1: does the track of line j of frame t-k predict line `line` of
+  // `frame`, and no other line of it?
+  bool confirms_track(int k, int j, const FrameFeatures& frame, int line);
   // TrackerOptions::heads_only: was track `id` observed in frames t-k+1 .. t-1?
   bool observed_since(std::int64_t id, int k);
   std::vector<double> rates_, turn_rates_;  // work space of store_frame
