@@ -22,6 +22,19 @@ inline void add_pipeline_options(CLI::App* cmd, FeaturePipelineOptions& o) {
                   "paper's), adaptive (mean + 3 sigma of candidate lengths), topk")
       ->transform(CLI::CheckedTransformer(kThreshold, CLI::ignore_case))
       ->group(g);
+  cmd->add_option("--peak-window",
+                  o.lines.peak_window,
+                  "Line peaks: the score of a 0.5-degree sector adds the votes of this many "
+                  "sectors on each side")
+      ->check(CLI::Range(0, 10))
+      ->capture_default_str()
+      ->group(g);
+  cmd->add_option("--nms-radius",
+                  o.lines.nms_radius,
+                  "Line peaks: a peak's score beats those of this many sectors on each side")
+      ->check(CLI::Range(1, 10))
+      ->capture_default_str()
+      ->group(g);
   cmd->add_option("--length-fraction", o.lines.length_fraction, "Line length threshold as a fraction of the annulus")
       ->check(CLI::Range(0.01, 1.0))
       ->capture_default_str()

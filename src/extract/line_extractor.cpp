@@ -20,6 +20,8 @@ bool LineExtractorOptions::IsValid(std::string* why) const {
   if (!(lateral_tolerance_px > 0)) return fail("lateral_tolerance_px must be positive");
   if (!(max_gap_px >= 0)) return fail("max_gap_px must not be negative");
   if (!(min_separation_deg >= 0)) return fail("min_separation_deg must not be negative");
+  if (peak_window < 0 || peak_window > 10) return fail("peak_window must be in [0, 10] sectors");
+  if (nms_radius < 1 || nms_radius > 10) return fail("nms_radius must be in [1, 10] sectors");
   if (!(length_fraction > 0 && length_fraction <= 1)) return fail("length_fraction must be in (0, 1]");
   if (!(adaptive_k >= 0)) return fail("adaptive_k must not be negative");
   if (top_k < 1) return fail("top_k must be at least 1");
@@ -176,12 +178,17 @@ void LineExtractor::extract(const cv::Mat& gray,
   score.resize(N);
   for (int pol = 0; pol < 2; ++pol) {
     const auto& h = hist_[pol];
-    for (int k = 0; k < N; ++k) score[k] = h[(k + N - 1) % N] + h[k] + h[(k + 1) % N];
+    const int pw = options_.peak_window;
+    for (int k = 0; k < N; ++k) {
+      float sum = 0.0f;
+      for (int j = -pw; j <= pw; ++j) sum += h[(k + j + N) % N];
+      score[k] = sum;
+    }
     for (int k = 0; k < N; ++k) {
       const float sc = score[k];
       if (sc < peak_min) continue;
       bool is_max = true;
-      for (int j = 1; j <= 2 && is_max; ++j) {
+      for (int j = 1; j <= options_.nms_radius && is_max; ++j) {
         if (score[(k + j) % N] > sc || score[(k + N - j) % N] >= sc) is_max = false;
       }
       if (!is_max) continue;

@@ -53,6 +53,14 @@ struct LineExtractorOptions {
   double max_gap_px = 4.0;
   // Two lines of the same polarity closer than this are one line (degrees).
   double min_separation_deg = 0.75;
+  // Step 4's peak score sums the votes of 2 * peak_window + 1 sectors, and a peak must beat
+  // the scores of the nms_radius sectors on each side. The defaults (0 and 1: the votes of one
+  // sector, peaks at least 2 sectors = 1 degree apart) resolve two edges 1 degree apart, which
+  // a door frame and its leaf often are; with 1 and 2 (a 1.5-degree score, peaks 1.5 degrees
+  // apart) extraction finds one of the two in each frame, whichever is stronger, and trackers
+  // link them (docs/extraction.md, "Angular resolution").
+  int peak_window = 0;
+  int nms_radius = 1;
 
   LineThreshold threshold = LineThreshold::kFractionOfAnnulus;
   double length_fraction = 0.5;  // kFractionOfAnnulus (the paper's 50%)
