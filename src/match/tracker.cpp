@@ -63,6 +63,10 @@ TrackerOptions recommended_tracker_options(double wheel_base) {
   o.continuity_model = TrackerOptions::ContinuityModel::kTrack;
   o.match.f1 = 0.6;
   o.look_back_f1 = 0.5;
+  // Confirmed F1 (docs/tracking.md Sec. 3): with the finer peaks of extraction (session 5) it
+  // brings the corridor's false new entries under target at little cost in false matches.
+  o.confirm_f1 = 1.05;
+  o.confirm_tolerance = deg2rad(0.3);
   if (wheel_base > 0.0) {
     o.gate.enabled = true;
     o.gate.wheel_base = wheel_base;
