@@ -261,7 +261,7 @@ void add_calibrate_command(CLI::App& app) {
                   "Refinement: split a track in two where two features explain its bearings "
                   "better than one by this likelihood-ratio statistic (a track that slipped onto "
                   "a neighbouring line); 0 turns splitting off")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kNonNegative)
       ->capture_default_str();
   cmd->add_flag("--force", a->force,
                 "Write extrinsics.yaml (and exit 0) even when the run does not determine every "
@@ -274,33 +274,33 @@ void add_calibrate_command(CLI::App& app) {
       ->check(CLI::ExistingFile)
       ->group(g);
   cmd->add_option("--phi", a->phi, "Prior phi [rad] (default 0)")->group(g);
-  cmd->add_option("--rho", a->rho, "Prior rho [m] (default 0.2)")->check(CLI::NonNegativeNumber)->group(g);
+  cmd->add_option("--rho", a->rho, "Prior rho [m] (default 0.2)")->check(kNonNegative)->group(g);
   cmd->add_option("--psi", a->psi, "Prior psi [rad] (default 0)")->group(g);
   cmd->add_option("--sigma-phi", a->sigma_phi, "Prior sigma of phi [rad] (default 0.8)")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->group(g);
   cmd->add_option("--sigma-rho", a->sigma_rho, "Prior sigma of rho [m] (default 0.1)")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->group(g);
   cmd->add_option("--sigma-psi", a->sigma_psi, "Prior sigma of psi [rad] (default 0.8)")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->group(g);
   const std::string gm = "Models";
   cmd->add_option("--bearing-sigma", a->bearing_sigma_deg,
                   "Bearing noise sigma [degrees] of the observation model, eq. (30). The default "
                   "(0.05) is what makes the estimate consistent (NEES) on rendered images with "
                   "our extractor (docs/calib.md); the paper used 0.3")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->group(gm);
   cmd->add_option("--odometry-inflation", a->odometry_inflation,
                   "Factor on the Chong-Kleeman K of wheel0/sensor.yaml, eq. (31) (default 5, the "
                   "paper's)")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->group(gm);
   cmd->add_option("--max-wheel-gap", a->max_wheel_gap,
                   "Wheel samples further apart than this [s] are a gap: the bearings of the "
                   "images inside it are not used")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str()
       ->group(gm);
   add_pipeline_options(cmd, a->pipeline);

@@ -34,10 +34,10 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_flag("--force", opt->force, "Replace the output directory if it exists");
   cmd->add_option("--seed", c.seed, "Seed of every random draw (noise)")->capture_default_str();
   cmd->add_option("--frames", c.max_frames, "At most this many frames (0: whole trajectory)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
   cmd->add_option("--rate", c.frame_rate, "Frame rate [Hz]")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   // Camera and mounting.
   cmd->add_option("--width", c.camera.width, "Image width [px]")->capture_default_str();
   cmd->add_option("--height", c.camera.height, "Image height [px]")->capture_default_str();
@@ -62,13 +62,13 @@ void add_simulate_command(CLI::App& app) {
   // Wheels.
   cmd->add_option("--wheel-rate", c.wheel.rate_hz, "Wheel data rate [Hz]")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   cmd->add_option("--wheel-base", c.wheel.wheel_base, "Nominal wheel base e [m]")
       ->capture_default_str();
   cmd->add_option(
          "--odometry-k", c.wheel.odometry_k, "Chong-Kleeman K [m]: increment variance K|d|")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
   cmd->add_option("--radius-error-left",
                   c.wheel.radius_error_left,
                   "Systematic scale error of the left wheel (0.01: reports 1% too much)");
@@ -83,22 +83,22 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_option(
          "--ticks-per-meter", opt->ticks_per_meter, "Ticks per meter, left [right] (default 20000)")
       ->expected(1, 2)
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   cmd->add_option("--counter-bits", c.wheel.counter_bits, "Tick counters wrap at 2^bits (0: never)")
       ->check(CLI::Range(0, 62));
   // Image sensor.
   cmd->add_option("--noise", c.image.noise_sigma, "Image noise sigma [grey levels]")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
   cmd->add_option("--gain-flicker", c.image.gain_flicker, "Per-frame gain sigma (relative)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
   cmd->add_option("--exposure", c.image.exposure, "Mean gain; > 1 saturates bright areas")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   cmd->add_option("--blur", c.image.blur_sigma, "Gaussian blur sigma [px]")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
 
   cmd->callback([opt]() {
     sim::SimConfig& cfg = opt->cfg;

@@ -524,13 +524,13 @@ void add_dataset_options(CLI::App* cmd, DatasetArgs& a) {
   cmd->add_option("--max-baseline",
                   a.max_baseline,
                   "Compare frames up to this far apart [m] (Sec. 6.0.1: 2)")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   cmd->add_option("--stride", a.stride, "Use every n-th image")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   cmd->add_option("--max-frames", a.max_frames, "Use at most this many images (0: all)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kNonNegative)
       ->capture_default_str();
   cmd->add_option("--seed", a.seed, "Seed of the image noise (Fig. 14)")->capture_default_str();
   add_pipeline_options(cmd, a.pipeline);

@@ -16,6 +16,22 @@ inline constexpr int kExitFailure = 1;
 inline constexpr int kExitBadInput = 2;
 inline constexpr int kExitUndetermined = 3;
 
+// Number checks with plain messages ("--x: must be a number >= 0, got -1"); CLI11's own
+// NonNegativeNumber prints the largest double as the upper end of its range.
+inline CLI::Validator number_at_least(double low, bool strict) {
+  const std::string what = std::string(strict ? "> " : ">= ") + CLI::detail::to_string(low);
+  return CLI::Validator(
+      [low, strict, what](std::string& in) -> std::string {
+        double v = 0.0;
+        if (!CLI::detail::lexical_cast(in, v) || !(strict ? v > low : v >= low))
+          return "must be a number " + what + ", got " + in;
+        return std::string();
+      },
+      "NUMBER " + what);
+}
+inline const CLI::Validator kNonNegative = number_at_least(0.0, false);
+inline const CLI::Validator kPositive = number_at_least(0.0, true);
+
 // Thrown by a command's callback to end with a given code after printing `what()`.
 struct CommandExit {
   int code;

@@ -7,6 +7,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "commands.hpp"
+
 #include "omnivert/describe/feature_pipeline.hpp"
 
 namespace omnivert::cli {
@@ -40,12 +42,12 @@ inline void add_pipeline_options(CLI::App* cmd, FeaturePipelineOptions& o) {
       ->capture_default_str()
       ->group(g);
   cmd->add_option("--top-k", o.lines.top_k, "Lines kept per frame with --line-threshold topk")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str()
       ->group(g);
   cmd->add_option("--gradient-threshold", o.lines.gradient_threshold,
                   "Sobel magnitude of an edge pixel (4x the grey-level step)")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str()
       ->group(g);
   cmd->add_flag("!--fixed-center", o.track_center, "Keep the first frame's centre instead of detecting it on every frame")

@@ -6,6 +6,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "commands.hpp"
+
 #include "omnivert/core/angles.hpp"
 #include "omnivert/match/tracker.hpp"
 
@@ -109,19 +111,19 @@ inline void add_tracker_options(CLI::App* cmd, TrackerFlags& t) {
                   t.continuity_path_curvature,
                   "Track continuity (track model): unpredicted bearing change per metre^2 "
                   "driven [rad/m^2] (default 0.5)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kNonNegative)
       ->group(g);
   cmd->add_option("--continuity-turn-curvature",
                   t.continuity_turn_curvature,
                   "Track continuity (track model): unpredicted bearing change per radian^2 "
                   "turned [rad/rad^2] (default 0.3)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kNonNegative)
       ->group(g);
   cmd->add_option("--look-back-f1",
                   t.look_back_f1,
                   "Test 1 for links across a look-back gap (2+ frames back): min distance <= "
                   "this (0: F1; default: the rule set's: paper 0, recommended 0.5)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kNonNegative)
       ->group(g);
   cmd->add_option("--confirm-f1",
                   t.confirm_f1,
@@ -129,7 +131,7 @@ inline void add_tracker_options(CLI::App* cmd, TrackerFlags& t) {
                   "to this when the track's motion predicts the line to --confirm-tolerance and "
                   "no other line is near the prediction (needs track continuity; 0: off; "
                   "default: the rule set's)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kNonNegative)
       ->group(g);
   cmd->add_option("--confirm-tolerance",
                   t.confirm_deg,
@@ -147,14 +149,14 @@ inline void add_tracker_options(CLI::App* cmd, TrackerFlags& t) {
   cmd->add_option("--gate-min-distance",
                   t.gate_min_distance,
                   "Odometry gate: nearest distance of a line from the camera [m] (default 0.5)")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->group(g);
   cmd->add_option("--gate-tolerance",
                   t.gate_tolerance_deg,
                   "Odometry gate: bearing detection tolerance [degrees] (default 2)")
       ->check(CLI::Range(0.0, 179.0))
       ->group(g);
-  cmd->add_option("--f1", t.f1, "Test 1, eq. (8): min distance <= F1 (default: the rule set's: paper 1.05, recommended 0.6)")->check(CLI::PositiveNumber)->group(g);
+  cmd->add_option("--f1", t.f1, "Test 1, eq. (8): min distance <= F1 (default: the rule set's: paper 1.05, recommended 0.6)")->check(kPositive)->group(g);
   cmd->add_option("--f2", t.f2, "Test 2, eq. (9): min <= F2 * mean (default 0.75)")->check(CLI::Range(0.0, 1.0))->group(g);
   cmd->add_option("--f3", t.f3, "Test 3, eq. (10): min <= F3 * second min (default 0.8)")->check(CLI::Range(0.0, 1.0))->group(g);
 }
