@@ -6,6 +6,7 @@
 #include <Eigen/SparseCore>
 #include <cmath>
 #include <algorithm>
+#include <array>
 #include <limits>
 #include <functional>
 #include <map>
@@ -618,8 +619,10 @@ bool bootstrap_filter_state(const CalibrationRun& window,
   Built b;
   bool have = false;
   double best_cost = std::numeric_limits<double>::infinity();
-  for (double d : {0.0, -0.5, 0.5, -1.0, 1.0}) {
-    if (d != 0.0 && options.bootstrap_starts <= 1) break;
+  constexpr std::array<double, 5> kStarts{0.0, -0.5, 0.5, -1.0, 1.0};
+  const int starts = std::min<int>(options.bootstrap_starts, static_cast<int>(kStarts.size()));
+  for (int i = 0; i < starts; ++i) {
+    const double d = kStarts[static_cast<std::size_t>(i)];
     Extrinsics ex0 = options.prior;
     ex0.phi += d;
     ex0.psi -= d;

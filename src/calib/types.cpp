@@ -54,7 +54,8 @@ bool Options::IsValid(std::string* why) const {
   if (!std::isfinite(bootstrap_rotation)) return fail(why, "bootstrap_rotation must be finite");
   if (bootstrap_min_frames < 2 || bootstrap_max_frames < bootstrap_min_frames)
     return fail(why, "need 2 <= bootstrap_min_frames <= bootstrap_max_frames");
-  if (bootstrap_starts < 1) return fail(why, "bootstrap_starts must be at least 1");
+  if (bootstrap_starts < 1 || bootstrap_starts > 5)
+    return fail(why, "bootstrap_starts must be between 1 and 5");
   if (!finite_positive(bootstrap_depth_prior_scale))
     return fail(why, "bootstrap_depth_prior_scale must be > 0");
   if (update_iterations < 1) return fail(why, "update_iterations must be >= 1");

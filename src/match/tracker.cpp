@@ -252,12 +252,12 @@ void Tracker::add_frame(const FrameFeatures& frame,
       bool ok = r.accepted();
       LinkVerdict why = ok ? LinkVerdict::kLinked : LinkVerdict::kNoCandidates;
       if (ok && k > 1 && options_.look_back_f1 > 0.0 && r.min_distance > options_.look_back_f1) {
-        ++stats_.rejected_test1;  // test 1 with the look-back F1
-        ok = false;
+        ok = false;  // test 1 with the look-back F1
         why = LinkVerdict::kLookBackF1;
       }
       // Confirmed F1: a distance between F1 (or the look-back F1) and confirm_f1 is accepted
-      // when tests 2 and 3 pass and the track's prediction confirms the line (checked below).
+      // when tests 2 and 3 pass and the track's prediction confirms the line (checked below;
+      // counted as a test 1 rejection only if that fails).
       bool needs_confirmation = false;
       if (options_.confirm_f1 > 0.0 && r.best >= 0 && r.min_distance <= options_.confirm_f1 &&
           (why == LinkVerdict::kLookBackF1 || r.verdict == MatchVerdict::kFailedTest1)) {
@@ -269,9 +269,10 @@ void Tracker::add_frame(const FrameFeatures& frame,
           needs_confirmation = true;
         }
       }
+      if (why == LinkVerdict::kLookBackF1 && !needs_confirmation) ++stats_.rejected_test1;
       switch (r.verdict) {
         case MatchVerdict::kFailedTest1:
-          ++stats_.rejected_test1;
+          if (!needs_confirmation) ++stats_.rejected_test1;
           why = LinkVerdict::kTest1;
           break;
         case MatchVerdict::kFailedTest2:
@@ -350,6 +351,7 @@ void Tracker::add_frame(const FrameFeatures& frame,
       if (ok && needs_confirmation &&
           !(options_.gate.enabled && options_.continuity_tolerance > 0.0 &&
             confirms_track(k, r.best, frame, i))) {
+        ++stats_.rejected_test1;
         ok = false;
         why = k > 1 && options_.look_back_f1 > 0.0 && r.min_distance > options_.look_back_f1
                   ? LinkVerdict::kLookBackF1

@@ -98,8 +98,8 @@ struct Options {
   int bootstrap_min_frames = 5;
   int bootstrap_max_frames = 300;
   double bootstrap_depth_prior_scale = 100.0;  // window's inverse-depth prior sigma, x sigma_q
-  // Starts of the window's solve: 1 = from the prior only; otherwise also from phi moved by
-  // -0.5, +0.5, -1 and +1 rad (psi the other way), the lowest cost kept (docs/calib.md).
+  // Starts of the window's solve (1-5): the prior, then phi moved by -0.5, +0.5, -1 and +1 rad
+  // (psi the other way), in that order; the lowest cost is kept (docs/calib.md).
   int bootstrap_starts = 5;
   // Updates.
   bool second_order_noise = true;   // add 1/2 tr(Hxx P Hxx P) to each bearing's variance
