@@ -65,8 +65,8 @@ inline void add_tracker_options(CLI::App* cmd, TrackerFlags& t) {
          "--rules",
          t.rules,
          "paper: the three matching rules alone; recommended: plus mutual (one-to-one), same "
-         "edge polarity, track continuity "
-         "matching and the odometry bearing gate (docs/tracking.md)")
+         "edge polarity, the odometry bearing gate, track continuity, F1 0.6 (0.5 across a "
+         "look-back gap) and confirmed F1 (docs/tracking.md)")
       ->check(CLI::IsMember({"paper", "recommended"}))
       ->capture_default_str()
       ->group(g);
@@ -130,13 +130,13 @@ inline void add_tracker_options(CLI::App* cmd, TrackerFlags& t) {
                   "Confirmed F1: accept a descriptor distance above F1 (or the look-back F1) up "
                   "to this when the track's motion predicts the line to --confirm-tolerance and "
                   "no other line is near the prediction (needs track continuity; 0: off; "
-                  "default: the rule set's)")
+                  "default: the rule set's: paper 0, recommended 1.05)")
       ->check(kNonNegative)
       ->group(g);
   cmd->add_option("--confirm-tolerance",
                   t.confirm_deg,
                   "Confirmed F1: largest deviation from the track's predicted bearing [degrees] "
-                  "(default: the rule set's)")
+                  "(default: the rule set's: recommended 0.3)")
       ->check(CLI::Range(0.0, 179.0))
       ->group(g);
   cmd->add_option("--heads-only",

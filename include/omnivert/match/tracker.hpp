@@ -20,10 +20,10 @@
 //    take the same id (the paper's behaviour).
 //  - odometry gate (odometry_gate.hpp): an accepted match whose bearing change contradicts
 //    the wheel travel since the candidate frame is vetoed; the line goes on looking back.
-//  - same polarity, gate-restricted candidates, track continuity, look-back F1, heads only:
-//    see TrackerOptions and docs/tracking.md Sec. 3 (recommended_tracker_options() turns on
-//    mutual, the gate, same polarity and continuity with the track model, with F1 0.6 and
-//    look-back F1 0.5).
+//  - same polarity, gate-restricted candidates, track continuity, look-back F1, heads only,
+//    confirmed F1: see TrackerOptions and docs/tracking.md Sec. 3 (recommended_tracker_options()
+//    turns on mutual, the gate, same polarity and continuity with the track model, with F1 0.6,
+//    look-back F1 0.5 and confirmed F1 1.05 at 0.3 degree).
 //
 // Bookkeeping: a ring buffer holds the last `look_back` frames (descriptors, bearings, track
 // ids, accumulated odometry). Buffers grow to the largest frame seen and are then reused: no
@@ -104,8 +104,9 @@ struct TrackerOptions {
 TrackerOptions paper_tracker_options();
 // What we recommend (docs/tracking.md, measured there): the paper's rules with F1 = 0.6 and
 // 0.5 across a look-back gap, plus the mutual constraint, same edge polarity, and the odometry
-// gate with track continuity (track model, 0.8 degree) when the wheel base is known
-// (wheel_base > 0; pass 0 when there is no odometry).
+// gate with track continuity (track model, 0.8 degree) and confirmed F1 (1.05 where the track
+// predicts the line to 0.3 degree) when the wheel base is known (wheel_base > 0; pass 0 when
+// there is no odometry).
 TrackerOptions recommended_tracker_options(double wheel_base);
 
 // Why a line of frame t was or was not linked to a line of an earlier frame (TrackerOptions:
