@@ -286,6 +286,7 @@ void Tracker::add_frame(const FrameFeatures& frame,
         default:
           break;
       }
+      const LinkVerdict f1_verdict = why;  // what refuses the link if confirmation fails
       if (needs_confirmation) {
         ok = true;
         why = LinkVerdict::kLinked;
@@ -342,20 +343,19 @@ void Tracker::add_frame(const FrameFeatures& frame,
         ok = false;
         why = LinkVerdict::kGate;
       }
-      if (ok && options_.gate.enabled && options_.continuity_tolerance > 0.0 &&
-          !continues_track(k, r.best, frame.lines[static_cast<std::size_t>(i)].bearing)) {
-        ++stats_.rejected_continuity;
-        ok = false;
-        why = LinkVerdict::kContinuity;
-      }
-      if (ok && needs_confirmation &&
-          !(options_.gate.enabled && options_.continuity_tolerance > 0.0 &&
-            confirms_track(k, r.best, frame, i))) {
-        ++stats_.rejected_test1;
-        ok = false;
-        why = k > 1 && options_.look_back_f1 > 0.0 && r.min_distance > options_.look_back_f1
-                  ? LinkVerdict::kLookBackF1
-                  : LinkVerdict::kTest1;
+      const bool continuity = options_.gate.enabled && options_.continuity_tolerance > 0.0;
+      if (ok && (continuity || needs_confirmation)) {
+        // One prediction of the track serves both checks; confirmation needs continuity.
+        const TrackPrediction p = continuity ? predict_track(k, r.best) : TrackPrediction{};
+        if (continuity && !continues_track(p, frame.lines[static_cast<std::size_t>(i)].bearing)) {
+          ++stats_.rejected_continuity;
+          ok = false;
+          why = LinkVerdict::kContinuity;
+        } else if (needs_confirmation && !(continuity && confirms_track(p, frame, i))) {
+          ++stats_.rejected_test1;
+          ok = false;
+          why = f1_verdict;
+        }
       }
       if (ok && k > 1 && options_.heads_only && observed_since(id, k)) {
         ++stats_.rejected_fork;
@@ -450,15 +450,13 @@ Tracker::TrackPrediction Tracker::predict_track(int k, int j) const {
   return p;
 }
 
-bool Tracker::continues_track(int k, int j, double bearing) {
-  const TrackPrediction p = predict_track(k, j);
+bool Tracker::continues_track(const TrackPrediction& p, double bearing) const {
   const double tol = options_.continuity_tolerance + p.spread;
   if (tol >= kPi) return true;
   return std::abs(angle_diff(bearing + odometry_.theta, p.u)) <= tol;
 }
 
-bool Tracker::confirms_track(int k, int j, const FrameFeatures& frame, int line) {
-  const TrackPrediction p = predict_track(k, j);
+bool Tracker::confirms_track(const TrackPrediction& p, const FrameFeatures& frame, int line) const {
   // Only where the model predicts well: rates measured, and what it cannot predict (curvature)
   // no larger than the tolerance itself.
   if (!p.rates_known || p.spread > options_.confirm_tolerance) return false;

@@ -201,9 +201,6 @@ class Tracker {
   const Slot& slot_back(int k) const;
   void store_frame(const FrameFeatures& frame, const std::vector<TrackAssignment>& out);
   bool track_claimed(std::int64_t id) const;
-  // TrackerOptions::continuity_tolerance: may line `bearing` of the new frame continue the
-  // track of line j of frame t-k?
-  bool continues_track(int k, int j, double bearing);
   // The rotation-free bearing u = beta + theta that track continuity predicts for the track of
   // line j of frame t-k in the new frame, and the spread its model allows on top of the
   // tolerance (curvature and sound bounds).
@@ -213,9 +210,12 @@ class Tracker {
     bool rates_known = true;  // the motion since frame t-k is covered by measured rates
   };
   TrackPrediction predict_track(int k, int j) const;
-  // TrackerOptions::confirm_f1: does the track of line j of frame t-k predict line `line` of
-  // `frame`, and no other line of it?
-  bool confirms_track(int k, int j, const FrameFeatures& frame, int line);
+  // TrackerOptions::continuity_tolerance: may line `bearing` of the new frame continue the
+  // track predicted by p?
+  bool continues_track(const TrackPrediction& p, double bearing) const;
+  // TrackerOptions::confirm_f1: does the track predicted by p predict line `line` of `frame`,
+  // and no other line of it?
+  bool confirms_track(const TrackPrediction& p, const FrameFeatures& frame, int line) const;
   // TrackerOptions::heads_only: was track `id` observed in frames t-k+1 .. t-1?
   bool observed_since(std::int64_t id, int k);
   std::vector<double> rates_, turn_rates_;  // work space of store_frame
