@@ -32,7 +32,7 @@ SyntheticRun make_synthetic_run(const SyntheticRunOptions& o) {
   if (!(o.straight_length > 0.0) || !(o.step > 0.0) || !(o.turn_step > 0.0) ||
       !(o.wheel_base > 0.0) || o.num_features < 1 || !(o.min_distance > o.truth.rho) ||
       !(o.max_distance > o.min_distance) || !(o.bearing_sigma >= 0.0) || !(o.odometry_K >= 0.0) ||
-      o.zigzag_legs < 1)
+      o.zigzag_legs < 1 || !(o.bearing_correlation >= 0.0 && o.bearing_correlation < 1.0))
     throw InputError("synthetic run: invalid options");
   std::mt19937_64 rng(o.seed);
   std::normal_distribution<double> normal(0.0, 1.0);
@@ -81,6 +81,8 @@ SyntheticRun make_synthetic_run(const SyntheticRunOptions& o) {
 
   // Frames: odometry with Chong-Kleeman noise (eq. 31), bearings with Gaussian noise.
   std::vector<int> track_of(out.features.size());
+  std::vector<double> error(out.features.size(), 0.0);  // AR(1) bearing error per feature
+  const double a = o.bearing_correlation, innovation = std::sqrt(1.0 - a * a);
   int next_id = 0;
   for (std::size_t j = 0; j < out.features.size(); ++j) {
     track_of[j] = next_id++;
@@ -98,8 +100,9 @@ SyntheticRun make_synthetic_run(const SyntheticRunOptions& o) {
         track_of[j] = next_id++;
         out.track_feature[track_of[j]] = static_cast<int>(j);
       }
-      const double beta = bearing_from_geometry(out.true_poses[k], out.features[j], o.truth) +
-                          o.bearing_sigma * normal(rng);
+      const double n = normal(rng);
+      error[j] = k == 0 ? o.bearing_sigma * n : a * error[j] + innovation * o.bearing_sigma * n;
+      const double beta = bearing_from_geometry(out.true_poses[k], out.features[j], o.truth) + error[j];
       f.observations.push_back({track_of[j], wrap_angle(beta)});
     }
     out.run.frames.push_back(std::move(f));

@@ -55,6 +55,24 @@ BatchPoint batch_point_from_filter(const CalibrationRun& run,
                                    const Options& options,
                                    const FilterResult& filter);
 
+// How large the extrinsics' error is, measured by the data (batch.cpp, noise_check). The
+// model covariance of (phi, rho, psi) assumes independent bearings of sigma
+// options.bearing_sigma; `bearing_part` is the share of it due to the bearings. The
+// cluster-robust (jackknife) estimate of that share, with each track's bearings as one
+// cluster, is `bearing_clustered`; scale = tr(bearing_part^-1 bearing_clustered) / 3 is 1 on
+// average when the assumed noise is right and above 1 when the bearings are noisier or
+// correlated along tracks (then sigma x sqrt(scale) is the independent noise that would do
+// the same harm). covariance = model + (scale - 1) bearing_part.
+struct BatchNoiseCheck {
+  bool ok = false;
+  double scale = std::numeric_limits<double>::quiet_NaN();
+  int clusters = 0;  // tracks
+  Eigen::Matrix3d model_covariance = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d bearing_part = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d bearing_clustered = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+};
+
 struct RefinementResult {
   bool converged = false;
   BatchPoint solution;
@@ -74,6 +92,7 @@ struct RefinementResult {
   // |residual| x sqrt(bearings / (bearings - 2 features - 3)); the bearing noise the data
   // has (infinity without redundancy).
   double bearing_residual_sigma = std::numeric_limits<double>::infinity();
+  BatchNoiseCheck noise;  // at the solution (outliers removed, splits made)
   std::string report;    // Ceres' brief report
 };
 

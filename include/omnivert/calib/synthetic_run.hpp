@@ -34,6 +34,9 @@ struct SyntheticRunOptions {
   double wheel_base = 0.5;                                      // e [m]
   double odometry_K = 1e-5;                                     // true K of eq. (31) [m]
   double bearing_sigma = 0.3 * 3.14159265358979323846 / 180.0;  // [rad]
+  // Correlation of a track's bearing errors from one frame to the next (AR(1) coefficient;
+  // the variance stays bearing_sigma^2): an extracted edge's error changes slowly. 0: white.
+  double bearing_correlation = 0.0;
   Extrinsics truth{-0.34, 0.23, 0.33};                          // the paper's estimate (Sec. 9.2)
   // Each track is cut into pieces (new track ids) with this probability per frame; 0: every
   // feature is one track over the whole run (the camera sees all around).
