@@ -42,6 +42,7 @@ struct CalibrateArgs {
   std::string dataset;
   std::string out;
   bool refine = false;
+  bool noise_check = true;
   bool force = false;
   std::string prior_file;
   std::optional<double> phi, rho, psi, sigma_phi, sigma_rho, sigma_psi;
@@ -149,7 +150,8 @@ void run_calibrate(const CalibrateArgs& a) {
   }
   for (const auto& w : warnings) spdlog::warn("{}", w);
   if (Progress::enabled()) std::fprintf(stderr, "calibrate: filter%s...\n", a.refine ? " and refinement" : "");
-  const calib::CalibrationResult result = calib::calibrate(run.run, opt, {.refine = a.refine, .batch = batch_options(a)});
+  const calib::CalibrationResult result = calib::calibrate(
+      run.run, opt, {.refine = a.refine, .noise_check = a.noise_check, .batch = batch_options(a)});
   const auto t2 = clock::now();
   if (!result.extrinsics.vec().allFinite() || !result.covariance.allFinite())
     throw std::runtime_error(
@@ -212,9 +214,15 @@ void run_calibrate(const CalibrateArgs& a) {
   const Eigen::Vector2d p = e.position();
   std::printf("camera in the robot frame: x %.2f mm, y %.2f mm, yaw %.3f deg\n", p(0) * 1e3,
               p(1) * 1e3, rad2deg(e.yaw()));
-  if (result.refined)
-    std::printf("bearing sigma %.3f deg (residual scale at the batch solution %.3f deg)\n",
-                rad2deg(result.bearing_sigma), rad2deg(result.refinement.bearing_residual_sigma));
+  if (result.noise_checked)
+    std::printf("bearing sigma %.3f deg; noise check over %d tracks: the errors along the tracks "
+                "act as %.3f deg of independent noise (sigmas above scaled by %.2f)\n",
+                rad2deg(result.bearing_sigma), result.noise.clusters,
+                rad2deg(result.bearing_sigma * std::sqrt(result.noise.scale)),
+                std::sqrt(result.noise_ratio));
+  else
+    std::printf("bearing sigma %.3f deg (no noise check%s)\n", rad2deg(result.bearing_sigma),
+                a.noise_check ? ": the run does not determine the extrinsics" : "");
   if (result.refined && result.refinement.num_splits > 0)
     std::printf("refinement: %d tracks split where they changed line (summary.json lists them)\n",
                 result.refinement.num_splits);
@@ -263,6 +271,9 @@ void add_calibrate_command(CLI::App& app) {
                   "a neighbouring line); 0 turns splitting off")
       ->check(kNonNegative)
       ->capture_default_str();
+  cmd->add_flag("!--no-noise-check", a->noise_check,
+                "Report the model's covariances as they are, without the data's check of the "
+                "bearing noise (errors summed along each track; docs/calib.md, \"The noise check\")");
   cmd->add_flag("--force", a->force,
                 "Write extrinsics.yaml (and exit 0) even when the run does not determine every "
                 "parameter");

@@ -1,15 +1,17 @@
 // Monte-Carlo study of the self-calibration (issue 5): many synthetic runs of the paper's
 // trajectory from the paper's rough prior; errors against truth, RMS against the
 // Cramer-Rao bound, NEES against the chi-square interval. Filter alone and with the batch
-// refinement.
+// refinement; with --refine also both with the covariances after the noise check
+// (calib::calibrate, docs/calib.md "The noise check").
 //
 //   calib_monte_carlo [--runs 50] [--sigma-deg 0.3] [--init anchored|inverse|naive]
 //                     [--inflation 5] [--iterations 3] [--trajectory paper|zigzag]
-//                     [--bootstrap RAD] [--refine] [--seed 1]
+//                     [--bootstrap RAD] [--refine] [--seed 1] [--correlation A]
 // --init anchored (default): anchored inverse depth + camera-pose extrinsics, with the batch
 //   window up to the first turn (--bootstrap, rad of rotation; 0: no window);
 // --init inverse: the paper's state eq. (28) with undelayed inverse-distance features;
 // --init naive: NOTES Sec. 5's naive initialisation.
+// --correlation A: AR(1) coefficient of each track's bearing errors from frame to frame.
 // Diagnostics (environment): PRIOR_AT_TRUTH=s (prior centred on truth, sigma s), PRIOR_SIGMA=s,
 // DMIN/DMAX (feature distance prior), CONVERT (convert_ratio), NO_SECOND_ORDER, VERBOSE.
 #include <Eigen/Cholesky>
@@ -22,6 +24,7 @@
 #include <vector>
 
 #include "omnivert/calib/batch.hpp"
+#include "omnivert/calib/calibrate.hpp"
 #include "omnivert/calib/calibration_filter.hpp"
 #include "omnivert/calib/synthetic_run.hpp"
 #include "omnivert/calib/updater.hpp"
@@ -92,7 +95,7 @@ int main(int argc, char** argv) {
   int runs = 50, iterations = 3;
   bool refine = false;
   double bootstrap = Options{}.bootstrap_rotation;
-  double sigma_deg = 0.3, inflation = 5.0;
+  double sigma_deg = 0.3, inflation = 5.0, correlation = 0.0;
   std::string init = "anchored", trajectory = "paper";
   std::uint64_t seed = 1;
   for (int i = 1; i < argc; ++i) {
@@ -107,6 +110,8 @@ int main(int argc, char** argv) {
       runs = std::atoi(next());
     else if (!std::strcmp(argv[i], "--sigma-deg"))
       sigma_deg = std::atof(next());
+    else if (!std::strcmp(argv[i], "--correlation"))
+      correlation = std::atof(next());
     else if (!std::strcmp(argv[i], "--init"))
       init = next();
     else if (!std::strcmp(argv[i], "--inflation"))
@@ -128,6 +133,7 @@ int main(int argc, char** argv) {
   }
   SyntheticRunOptions so;
   so.bearing_sigma = deg2rad(sigma_deg);
+  so.bearing_correlation = correlation;
   so.trajectory = trajectory == "zigzag" ? Trajectory::kZigzag : Trajectory::kPaper;
   Options fo;
   fo.wheel_base = so.wheel_base;
@@ -150,7 +156,8 @@ int main(int argc, char** argv) {
   if (const char* c = std::getenv("CONVERT")) fo.convert_ratio = std::atof(c);
   if (std::getenv("NO_SECOND_ORDER")) fo.second_order_noise = false;
   fo.bootstrap_rotation = bootstrap;
-  Stats filt, ref;
+  Stats filt, ref, ref_checked, filt_checked;
+  std::vector<double> scales;
   Eigen::Vector3d crlb_sq = Eigen::Vector3d::Zero();
   double crlb_yaw_sq = 0, crlb_pos_sq = 0;
   Progress progress("monte carlo", runs);
@@ -176,12 +183,19 @@ int main(int argc, char** argv) {
     crlb_yaw_sq += obs.yaw.crlb * obs.yaw.crlb;
     crlb_pos_sq += obs.x.crlb * obs.x.crlb + obs.y.crlb * obs.y.crlb;
     if (refine) {
-      const RefinementResult rr =
-          refine_batch(run.run, fo, batch_point_from_filter(run.run, fo, fr));
-      if (rr.covariance_ok)
-        ref.add(rr.extrinsics, rr.covariance, run.truth);
-      else
+      // The tool's pipeline (calib::calibrate): refinement, and the noise checks of the filter
+      // (its tracks unsplit) and of the refinement; the model's covariances are kept aside.
+      const CalibrationResult cr = calibrate(run.run, fo, {.refine = true});
+      if (cr.refinement.covariance_ok) {
+        ref.add(cr.refinement.extrinsics, cr.refinement_model_covariance, run.truth);
+        if (cr.noise_checked) {
+          scales.push_back(cr.noise.scale);
+          ref_checked.add(cr.refinement.extrinsics, cr.refinement.covariance, run.truth);
+          filt_checked.add(cr.filter.extrinsics, cr.filter.covariance, run.truth);
+        }
+      } else {
         ++ref.failures;
+      }
     }
     progress.update(r + 1);
   }
@@ -208,5 +222,14 @@ int main(int argc, char** argv) {
       1e3 * std::sqrt(crlb_pos_sq / runs));
   print("filter", filt, crlb);
   if (refine) print("filter + refinement", ref, crlb);
+  if (refine && !scales.empty()) {
+    double ms = 0;
+    for (double v : scales) ms += v;
+    std::sort(scales.begin(), scales.end());
+    std::printf("noise check (refinement's): scale mean %.3f, quartiles %.3f %.3f %.3f\n", ms / scales.size(),
+                scales[scales.size() / 4], median(scales), scales[3 * scales.size() / 4]);
+    print("filter, checked", filt_checked, crlb);
+    print("refinement, checked", ref_checked, crlb);
+  }
   return 0;
 }

@@ -234,6 +234,36 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
     ref["final_cost"] = num(r.refinement.final_cost);
     j["refinement"] = ref;
   }
+  {
+    const BatchNoiseCheck& n = r.noise;
+    json nc;
+    nc["applied"] = r.noise_checked;
+    nc["scale"] = num(n.ok ? n.scale : NAN);
+    nc["tracks"] = n.clusters;
+    nc["effective_bearing_sigma_deg"] = num(n.ok ? rad2deg(r.bearing_sigma * std::sqrt(n.scale)) : NAN);
+    nc["variance_ratio"] = num(r.noise_checked ? r.noise_ratio : NAN);
+    nc["of"] = r.refined && r.refinement.covariance_ok ? "refinement" : "filter";
+    nc["filter_scale"] = num(r.filter_noise.ok ? r.filter_noise.scale : NAN);
+    nc["filter_variance_ratio"] = num(r.filter_noise.ok ? r.filter_noise_ratio : NAN);
+    auto mat = [&](const Eigen::Matrix3d& m, bool ok) {
+      json a = json::array();
+      for (int i = 0; i < 9; ++i) a.push_back(num(ok && m.allFinite() ? m(i / 3, i % 3) : NAN));
+      return a;
+    };
+    nc["filter_model_covariance"] = mat(r.filter_model_covariance, true);
+    nc["refinement_model_covariance"] = mat(r.refinement_model_covariance, r.refined);
+    nc["batch_model_covariance"] = mat(n.model_covariance, n.ok);
+    nc["batch_checked_covariance"] = mat(n.covariance, n.ok);
+    // The Cramer-Rao bounds at the noise the check found: each bound times the square root of
+    // the checked over the model variance of that parameter.
+    auto checked = [&](double crlb, int i) {
+      return num(r.noise_checked ? crlb * std::sqrt(n.covariance(i, i) / n.model_covariance(i, i)) : NAN);
+    };
+    nc["crlb_checked"] = {{"phi", checked(r.observability.phi.crlb, 0)},
+                          {"rho", checked(r.observability.rho.crlb, 1)},
+                          {"psi", checked(r.observability.psi.crlb, 2)}};
+    j["noise_check"] = nc;
+  }
   j["result"] = extrinsics_json(r.extrinsics, r.covariance);
   j["result"]["source"] = r.refined && r.refinement.covariance_ok ? "refinement" : "filter";
   if (in.truth) {
@@ -327,10 +357,14 @@ std::string report_html(const CalibrationResult& r, const ReportInputs& in) {
   kv("wheel base e / Chong-Kleeman K (x inflation)",
      f("%.4f m", in.options.wheel_base) + " / " + f("%.3g m", in.options.odometry_K) + " (x" +
          f("%g", in.options.odometry_inflation) + ")");
-  kv("bearing sigma", f("%.4f deg", rad2deg(r.bearing_sigma)) +
-                          (r.refined ? f(" (residual scale at the batch solution %.4f deg)",
-                                          rad2deg(r.refinement.bearing_residual_sigma))
-                                      : std::string()));
+  kv("bearing sigma", f("%.4f deg", rad2deg(r.bearing_sigma)));
+  kv("noise check",
+     r.noise_checked
+         ? std::to_string(r.noise.clusters) + " tracks: the errors along the tracks act as " +
+               f("%.4f deg", rad2deg(r.bearing_sigma * std::sqrt(r.noise.scale))) +
+               " of independent noise (variance x" + f("%.2f", r.noise.scale) +
+               "); sigmas scaled by " + f("%.2f", std::sqrt(r.noise_ratio))
+         : std::string("not applied"));
   if (r.refined)
     kv("refinement", std::string(r.refinement.converged ? "converged" : "did not converge") + ", " +
                          std::to_string(r.refinement.iterations) + " iterations, " +

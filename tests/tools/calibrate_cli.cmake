@@ -4,7 +4,7 @@
 #   cmake -DOV=<omnivert> -DPAPER=<paper dataset> -DSTRAIGHT=<straight dataset>
 #         -DWORK=<scratch dir> -DMODE=<mode> -P calibrate_cli.cmake
 # MODE: end_to_end | straight | straight_force | wheel_gap | wheel_short | wheel_decreasing |
-#       no_wheel | few_lines | no_lines | prior_file | few_tracks
+#       no_wheel | few_lines | no_lines | prior_file | few_tracks | no_noise_check
 cmake_minimum_required(VERSION 3.20)
 
 function(fail msg)
@@ -92,6 +92,36 @@ if(MODE STREQUAL "end_to_end")
   endif()
   if(NOT out MATCHES "error vs ground truth \\(refinement\\)")
     fail("stdout lacks the comparison with the ground truth: ${out}")
+  endif()
+  # The noise check (docs/calib.md): applied, a positive scale over the tracks, and the
+  # refinement's reported covariance is the checked one.
+  string(JSON applied GET "${json}" noise_check applied)
+  string(JSON scale GET "${json}" noise_check scale)
+  string(JSON tracks GET "${json}" noise_check tracks)
+  string(JSON c0 GET "${json}" noise_check batch_checked_covariance 0)
+  string(JSON r0 GET "${json}" result covariance 0)
+  if(NOT applied OR NOT scale GREATER 0 OR tracks LESS 2 OR NOT c0 EQUAL r0)
+    fail("noise check: applied ${applied}, scale ${scale}, tracks ${tracks}, checked ${c0} vs result ${r0}")
+  endif()
+  if(NOT out MATCHES "noise check over [0-9]+ tracks")
+    fail("stdout lacks the noise check: ${out}")
+  endif()
+
+elseif(MODE STREQUAL "no_noise_check")
+  run_calibrate(${PAPER} ${out_dir} --refine --no-noise-check)
+  if(NOT rc EQUAL 0)
+    fail("calibrate exited ${rc}: ${err}")
+  endif()
+  check_no_nan(${out_dir})
+  file(READ ${out_dir}/summary.json json)
+  string(JSON applied GET "${json}" noise_check applied)
+  string(JSON m0 GET "${json}" noise_check refinement_model_covariance 0)
+  string(JSON r0 GET "${json}" result covariance 0)
+  if(applied OR NOT m0 EQUAL r0)
+    fail("--no-noise-check: applied ${applied}, model ${m0} vs result ${r0}")
+  endif()
+  if(NOT out MATCHES "no noise check")
+    fail("stdout should say there was no noise check: ${out}")
   endif()
 
 elseif(MODE STREQUAL "straight" OR MODE STREQUAL "straight_force")

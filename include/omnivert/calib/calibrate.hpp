@@ -21,6 +21,11 @@ namespace omnivert::calib {
 
 struct CalibrateOptions {
   bool refine = false;
+  // The data's check of the bearing noise (BatchNoiseCheck, at a batch solution): the
+  // reported covariances become the checked ones. The refinement's: model + (scale - 1) x its
+  // bearing part. The filter's: scaled by the overall variance ratio of a check on its own
+  // (unsplit) tracks, a batch solved for the check alone. false: the model's covariances.
+  bool noise_check = true;
   BatchOptions batch;
   ObservabilityOptions observability;
 };
@@ -37,6 +42,18 @@ struct CalibrationResult {
   // Refinement only: its covariance came from the Fisher information of the observability
   // analysis (the inverse of the same information) because ceres::Covariance failed.
   bool covariance_from_information = false;
+  // CalibrateOptions::noise_check: whether it was applied to the reported estimate, its check
+  // and the overall variance ratio tr(model^-1 checked) / 3 (the refinement's when refined:
+  // its covariance is the checked one; else the filter's); the filter's own check (its
+  // tracks unsplit) and the ratio its covariance was scaled by; the covariances before the
+  // checks (the model's).
+  bool noise_checked = false;
+  BatchNoiseCheck noise;
+  double noise_ratio = 1.0;
+  BatchNoiseCheck filter_noise;
+  double filter_noise_ratio = 1.0;
+  Eigen::Matrix3d filter_model_covariance = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d refinement_model_covariance = Eigen::Matrix3d::Zero();
   bool observable() const { return observability.all_determined(); }
 };
 
