@@ -216,10 +216,12 @@ void run_calibrate(const CalibrateArgs& a) {
               p(1) * 1e3, rad2deg(e.yaw()));
   if (result.noise_checked)
     std::printf("bearing sigma %.3f deg; noise check over %d tracks: the errors along the tracks "
-                "act as %.3f deg of independent noise (sigmas above scaled by %.2f)\n",
+                "act as %.3f deg of independent noise (%s%.2f)\n",
                 rad2deg(result.bearing_sigma), result.noise.clusters,
                 rad2deg(result.bearing_sigma * std::sqrt(result.noise.scale)),
-                std::sqrt(result.noise_ratio));
+                result.noise_applied ? "the model is rejected: sigmas above scaled by "
+                                     : "within the model's range: sigmas kept, variance x",
+                result.noise_applied ? std::sqrt(result.noise_ratio) : result.noise.scale);
   else
     std::printf("bearing sigma %.3f deg (no noise check%s)\n", rad2deg(result.bearing_sigma),
                 a.noise_check ? ": the run does not determine the extrinsics" : "");

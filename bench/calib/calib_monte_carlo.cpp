@@ -158,6 +158,7 @@ int main(int argc, char** argv) {
   fo.bootstrap_rotation = bootstrap;
   Stats filt, ref, ref_checked, filt_checked;
   std::vector<double> scales;
+  int applied = 0, filter_applied = 0;
   Eigen::Vector3d crlb_sq = Eigen::Vector3d::Zero();
   double crlb_yaw_sq = 0, crlb_pos_sq = 0;
   Progress progress("monte carlo", runs);
@@ -185,11 +186,15 @@ int main(int argc, char** argv) {
     if (refine) {
       // The tool's pipeline (calib::calibrate): refinement, and the noise checks of the filter
       // (its tracks unsplit) and of the refinement; the model's covariances are kept aside.
-      const CalibrationResult cr = calibrate(run.run, fo, {.refine = true});
+      CalibrateOptions co{.refine = true};
+      if (const char* c = std::getenv("LATERAL")) co.batch.lateral_sigma = std::atof(c);  // diagnostics
+      const CalibrationResult cr = calibrate(run.run, fo, co);
       if (cr.refinement.covariance_ok) {
         ref.add(cr.refinement.extrinsics, cr.refinement_model_covariance, run.truth);
         if (cr.noise_checked) {
           scales.push_back(cr.noise.scale);
+          applied += cr.noise_applied ? 1 : 0;
+          filter_applied += cr.filter_noise_ratio != 1.0 ? 1 : 0;
           ref_checked.add(cr.refinement.extrinsics, cr.refinement.covariance, run.truth);
           filt_checked.add(cr.filter.extrinsics, cr.filter.covariance, run.truth);
         }
@@ -226,8 +231,10 @@ int main(int argc, char** argv) {
     double ms = 0;
     for (double v : scales) ms += v;
     std::sort(scales.begin(), scales.end());
-    std::printf("noise check (refinement's): scale mean %.3f, quartiles %.3f %.3f %.3f\n", ms / scales.size(),
-                scales[scales.size() / 4], median(scales), scales[3 * scales.size() / 4]);
+    std::printf("noise check (refinement's): scale mean %.3f, quartiles %.3f %.3f %.3f; model "
+                "rejected in %d runs (filter's check: %d)\n", ms / scales.size(),
+                scales[scales.size() / 4], median(scales), scales[3 * scales.size() / 4],
+                applied, filter_applied);
     print("filter, checked", filt_checked, crlb);
     print("refinement, checked", ref_checked, crlb);
   }

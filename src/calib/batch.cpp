@@ -226,12 +226,9 @@ BatchNoiseCheck noise_check(Built& b) {
   Eigen::SparseMatrix<double> J(m, n);
   J.setFromTriplets(t.begin(), t.end());
   Eigen::SparseMatrix<double> F = J.transpose() * J;
-  // A tiny ridge keeps a feature seen without parallax from making F singular; it does not
-  // change the extrinsics' block at the printed digits.
-  double mean_diag = 0.0;
-  for (int i = 0; i < n; ++i) mean_diag += F.coeff(i, i);
-  mean_diag /= n;
-  for (int i = 0; i < n; ++i) F.coeffRef(i, i) += 1e-10 * mean_diag;
+  // A tiny ridge, relative to each variable's own information (their scales differ by
+  // orders of magnitude), keeps a feature seen without parallax from making F singular.
+  for (int i = 0; i < n; ++i) F.coeffRef(i, i) *= 1.0 + 1e-10;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(F);
   if (ldlt.info() != Eigen::Success) return out;
   Eigen::MatrixXd E = Eigen::MatrixXd::Zero(n, 3);
@@ -361,6 +358,12 @@ BatchPoint point_of(const Built& b) {
 }
 
 }  // namespace
+
+bool noise_check_rejects_model(const BatchNoiseCheck& check, double level) {
+  if (!check.ok || check.clusters < 2 || !(level > 0.0 && level < 0.5)) return false;
+  const int g = check.clusters;
+  return check.scale > chi2_quantile(1.0 - level, g) / g || check.scale < chi2_quantile(level, g) / g;
+}
 
 std::vector<Eigen::Vector3d> dead_reckoning(const CalibrationRun& run, double wheel_base) {
   std::vector<Eigen::Vector3d> poses;

@@ -237,14 +237,16 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
   {
     const BatchNoiseCheck& n = r.noise;
     json nc;
-    nc["applied"] = r.noise_checked;
+    nc["checked"] = r.noise_checked;
+    nc["applied"] = r.noise_applied;  // the check rejected the model: covariance replaced
     nc["scale"] = num(n.ok ? n.scale : NAN);
     nc["tracks"] = n.clusters;
     nc["effective_bearing_sigma_deg"] = num(n.ok ? rad2deg(r.bearing_sigma * std::sqrt(n.scale)) : NAN);
-    nc["variance_ratio"] = num(r.noise_checked ? r.noise_ratio : NAN);
+    nc["variance_ratio"] = num(r.noise_checked ? r.noise_ratio : NAN);  // 1 when not applied
     nc["of"] = r.refined && r.refinement.covariance_ok ? "refinement" : "filter";
     nc["filter_scale"] = num(r.filter_noise.ok ? r.filter_noise.scale : NAN);
     nc["filter_variance_ratio"] = num(r.filter_noise.ok ? r.filter_noise_ratio : NAN);
+    nc["filter_applied"] = r.filter_noise_ratio != 1.0;
     auto mat = [&](const Eigen::Matrix3d& m, bool ok) {
       json a = json::array();
       for (int i = 0; i < 9; ++i) a.push_back(num(ok && m.allFinite() ? m(i / 3, i % 3) : NAN));
@@ -362,9 +364,11 @@ std::string report_html(const CalibrationResult& r, const ReportInputs& in) {
      r.noise_checked
          ? std::to_string(r.noise.clusters) + " tracks: the errors along the tracks act as " +
                f("%.4f deg", rad2deg(r.bearing_sigma * std::sqrt(r.noise.scale))) +
-               " of independent noise (variance x" + f("%.2f", r.noise.scale) +
-               "); sigmas scaled by " + f("%.2f", std::sqrt(r.noise_ratio))
-         : std::string("not applied"));
+               " of independent noise (variance x" + f("%.2f", r.noise.scale) + "); " +
+               (r.noise_applied ? "the model is rejected, sigmas scaled by " +
+                                      f("%.2f", std::sqrt(r.noise_ratio))
+                                : std::string("within the model's range, sigmas kept"))
+         : std::string("not made"));
   if (r.refined)
     kv("refinement", std::string(r.refinement.converged ? "converged" : "did not converge") + ", " +
                          std::to_string(r.refinement.iterations) + " iterations, " +

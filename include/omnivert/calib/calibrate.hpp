@@ -21,11 +21,13 @@ namespace omnivert::calib {
 
 struct CalibrateOptions {
   bool refine = false;
-  // The data's check of the bearing noise (BatchNoiseCheck, at a batch solution): the
-  // reported covariances become the checked ones. The refinement's: model + (scale - 1) x its
-  // bearing part. The filter's: scaled by the overall variance ratio of a check on its own
-  // (unsplit) tracks, a batch solved for the check alone. false: the model's covariances.
+  // The data's check of the bearing noise (BatchNoiseCheck, at a batch solution): where it
+  // rejects the model, the reported covariance becomes the checked one. The refinement's:
+  // model + (scale - 1) x its bearing part. The filter's: scaled by the overall variance
+  // ratio of a check on its own (unsplit) tracks, a batch solved for the check alone.
+  // false: no check, the model's covariances.
   bool noise_check = true;
+  double noise_check_level = 0.01;  // each tail of noise_check_rejects_model
   BatchOptions batch;
   ObservabilityOptions observability;
 };
@@ -42,12 +44,15 @@ struct CalibrationResult {
   // Refinement only: its covariance came from the Fisher information of the observability
   // analysis (the inverse of the same information) because ceres::Covariance failed.
   bool covariance_from_information = false;
-  // CalibrateOptions::noise_check: whether it was applied to the reported estimate, its check
-  // and the overall variance ratio tr(model^-1 checked) / 3 (the refinement's when refined:
-  // its covariance is the checked one; else the filter's); the filter's own check (its
-  // tracks unsplit) and the ratio its covariance was scaled by; the covariances before the
-  // checks (the model's).
+  // CalibrateOptions::noise_check. noise: the check of the reported estimate (the
+  // refinement's when refined, else the filter's), valid when noise_checked; noise_applied:
+  // it rejected the model and the reported covariance is the checked one (the refinement's:
+  // model + (scale - 1) x bearing part; the filter's: scaled by noise_ratio, the overall
+  // variance ratio tr(model^-1 checked) / 3). filter_noise: the check of the filter on its own
+  // (unsplit) tracks, and the ratio its covariance was scaled by (1 when not). The model's
+  // covariances before any check are kept.
   bool noise_checked = false;
+  bool noise_applied = false;
   BatchNoiseCheck noise;
   double noise_ratio = 1.0;
   BatchNoiseCheck filter_noise;
