@@ -362,7 +362,7 @@ BatchPoint point_of(const Built& b) {
 bool noise_check_rejects_model(const BatchNoiseCheck& check, double level) {
   if (!check.ok || check.clusters < 2 || !(level > 0.0 && level < 0.5)) return false;
   const int g = check.clusters;
-  return check.scale > chi2_quantile(1.0 - level, g) / g || check.scale < chi2_quantile(level, g) / g;
+  return check.scale > chi2_quantile(1.0 - level, g) / g;
 }
 
 std::vector<Eigen::Vector3d> dead_reckoning(const CalibrationRun& run, double wheel_base) {

@@ -50,9 +50,9 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
     // filter is checked on its own tracks (unsplit: it treats a track that slipped onto a
     // neighbouring line as one feature, and the check should see that), the refinement on
     // the problem it solved (tracks split). A covariance is replaced by the checked one only
-    // when the check rejects the model (noise_check_rejects_model): with 10-15 tracks one
-    // run's scale is uncertain, and applied always it made the refinement's NEES worse where
-    // the model is right (synthetic 0.3 degree, 50 runs: 3.50 -> 5.18).
+    // when the check shows more noise than the model allows (noise_check_rejects_model): with
+    // 10-15 tracks one run's scale is uncertain, and applied always it made the refinement's
+    // NEES worse where the model is right (synthetic 0.3 degree, 50 runs: 3.50 -> 5.18).
     auto ratio_of = [](const BatchNoiseCheck& n) {
       const Eigen::LDLT<Eigen::Matrix3d> model(n.model_covariance);
       if (!n.ok || model.info() != Eigen::Success) return 0.0;
@@ -121,9 +121,8 @@ std::vector<std::string> result_warnings(const CalibrationResult& r) {
     out.emplace_back(buf);
   }
   if (r.noise_checked && r.noise.clusters >= 2) {
-    // The upper side of noise_check_rejects_model.
-    // Under the model the check's scale is about chi-square(G) / G over G tracks (50
-    // synthetic runs with 10 tracks: quartiles 0.68 / 0.90 / 1.18 against 0.73 / 0.93 / 1.22).
+    // noise_check_rejects_model at its default level: under the model the check's scale is
+    // about chi-square(G) / G over G tracks.
     const int g = r.noise.clusters;
     const double limit = chi2_quantile(0.99, g) / g;
     if (r.noise.scale > limit) {

@@ -27,7 +27,7 @@ struct CalibrateOptions {
   // ratio of a check on its own (unsplit) tracks, a batch solved for the check alone.
   // false: no check, the model's covariances.
   bool noise_check = true;
-  double noise_check_level = 0.01;  // each tail of noise_check_rejects_model
+  double noise_check_level = 0.01;  // of noise_check_rejects_model
   BatchOptions batch;
   ObservabilityOptions observability;
 };
