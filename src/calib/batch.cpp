@@ -192,7 +192,7 @@ Eigen::MatrixXd information_from_jacobian(const ceres::CRSMatrix& crs) {
 // factor). A track's own feature point absorbs the part of its errors along its own columns
 // of J, and that part does not reach the extrinsics (A F_{:,f} = 0), so the fitted residuals
 // stand in for the true errors up to the leverage of the shared variables.
-BatchNoiseCheck noise_check(Built& b) {
+BatchNoiseCheck noise_check(Built& b, int dense_limit) {
   BatchNoiseCheck out;
   ceres::Problem::EvaluateOptions eo;
   for (std::size_t k = 1; k < b.poses.size(); ++k) eo.parameter_blocks.push_back(b.poses[k].data());
@@ -227,14 +227,35 @@ BatchNoiseCheck noise_check(Built& b) {
   J.setFromTriplets(t.begin(), t.end());
   Eigen::SparseMatrix<double> F = J.transpose() * J;
   // A tiny ridge, relative to each variable's own information (their scales differ by
-  // orders of magnitude), keeps a feature seen without parallax from making F singular.
-  for (int i = 0; i < n; ++i) F.coeffRef(i, i) *= 1.0 + 1e-10;
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(F);
-  if (ldlt.info() != Eigen::Success) return out;
-  Eigen::MatrixXd E = Eigen::MatrixXd::Zero(n, 3);
-  for (int k = 0; k < 3; ++k) E(n - 3 + k, k) = 1.0;
-  const Eigen::MatrixXd At = ldlt.solve(E);  // n x 3: A^T
-  if (ldlt.info() != Eigen::Success || !At.allFinite()) return out;
+  // orders of magnitude), keeps a feature seen without parallax from making F singular. A
+  // variable without any residual left (a feature whose bearings were all removed as
+  // outliers: hall zigzag, seed 1) has an empty row and column; a unit diagonal leaves it
+  // out of everything else.
+  for (int i = 0; i < n; ++i) {
+    double& d = F.coeffRef(i, i);
+    d = d > 0.0 ? d * (1.0 + 1e-10) : 1.0;
+  }
+  // F^-1 is needed column by column for every bearing (the leverage below). Below a few
+  // thousand variables the dense inverse is the cheaper way (hall zigzag, 316 tracks, 1440
+  // variables: the sparse solves took 60 s, their factor fills in); above, sparse solves.
+  const bool dense = n <= dense_limit;
+  Eigen::MatrixXd Finv;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
+  Eigen::MatrixXd At;  // n x 3: A^T
+  if (dense) {
+    const Eigen::LDLT<Eigen::MatrixXd> dl{Eigen::MatrixXd(F)};
+    if (dl.info() != Eigen::Success) return out;
+    Finv = dl.solve(Eigen::MatrixXd::Identity(n, n));
+    if (!Finv.allFinite()) return out;
+    At = Finv.rightCols(3);
+  } else {
+    ldlt.compute(F);
+    if (ldlt.info() != Eigen::Success) return out;
+    Eigen::MatrixXd E = Eigen::MatrixXd::Zero(n, 3);
+    for (int k = 0; k < 3; ++k) E(n - 3 + k, k) = 1.0;
+    At = ldlt.solve(E);
+    if (ldlt.info() != Eigen::Success || !At.allFinite()) return out;
+  }
   const Eigen::Matrix3d model = At.bottomRows<3>();
   const Eigen::MatrixXd U = J * At;  // m x 3: row i is A J_i^T
   std::vector<std::vector<int>> rows_of(next);
@@ -252,11 +273,33 @@ BatchNoiseCheck noise_check(Built& b) {
     // (I - H_cc)^-1/2 r_c stands in for the track's errors (Bell and McCaffrey's bias-reduced
     // sandwich, "CR2": unbiased when the model is right; the jackknife's (I - H_cc)^-1 gave
     // 2.8 times the model's covariance on white bearings with 10 tracks).
-    Eigen::MatrixXd JcT = Eigen::MatrixXd::Zero(n, nc);
-    for (int k = 0; k < nc; ++k)
-      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Jr, rows[k]); it; ++it)
-        JcT(it.col(), k) = it.value();
-    const Eigen::MatrixXd H = JcT.transpose() * ldlt.solve(JcT);
+    Eigen::MatrixXd H;
+    if (dense) {
+      // Only the variables the track touches (its feature, its frames' poses, the
+      // extrinsics): H_cc = J_cS [F^-1]_SS J_cS^T.
+      std::vector<int> cols;
+      for (int k = 0; k < nc; ++k)
+        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Jr, rows[k]); it; ++it)
+          cols.push_back(static_cast<int>(it.col()));
+      std::sort(cols.begin(), cols.end());
+      cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
+      const int ns = static_cast<int>(cols.size());
+      Eigen::MatrixXd Jc = Eigen::MatrixXd::Zero(nc, ns);
+      for (int k = 0; k < nc; ++k)
+        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Jr, rows[k]); it; ++it)
+          Jc(k, std::lower_bound(cols.begin(), cols.end(), static_cast<int>(it.col())) - cols.begin()) =
+              it.value();
+      Eigen::MatrixXd Fs(ns, ns);
+      for (int a = 0; a < ns; ++a)
+        for (int c2 = 0; c2 < ns; ++c2) Fs(a, c2) = Finv(cols[a], cols[c2]);
+      H = Jc * Fs * Jc.transpose();
+    } else {
+      Eigen::MatrixXd JcT = Eigen::MatrixXd::Zero(n, nc);
+      for (int k = 0; k < nc; ++k)
+        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Jr, rows[k]); it; ++it)
+          JcT(it.col(), k) = it.value();
+      H = JcT.transpose() * ldlt.solve(JcT);
+    }
     Eigen::VectorXd rc(nc);
     Eigen::MatrixXd Uc(nc, 3);
     for (int k = 0; k < nc; ++k) {
@@ -473,7 +516,7 @@ RefinementResult refine_batch(const CalibrationRun& run,
           mad * std::sqrt(static_cast<double>(a.size()) / dof) * options.bearing_sigma;
     }
   }
-  res.noise = noise_check(b);
+  res.noise = noise_check(b, batch.noise_check_dense_limit);
   res.converged = summary.termination_type == ceres::CONVERGENCE;
   res.initial_cost = summary.initial_cost;
   res.final_cost = summary.final_cost;

@@ -230,6 +230,25 @@ TEST(NoiseCheck, AgreesWithTheModelWhenTheModelIsRight) {
     EXPECT_NEAR(r.noise.model_covariance(i, i), r.covariance(i, i), 1e-3 * r.covariance(i, i));
 }
 
+// The dense inverse (small problems) and the sparse solves (large ones) give the same check.
+TEST(NoiseCheck, DenseAndSparseLeverageAgree) {
+  SyntheticRunOptions so;
+  so.bearing_sigma = deg2rad(0.05);
+  so.bearing_correlation = 0.5;
+  so.seed = 9;
+  const SyntheticRun run = make_synthetic_run(so);
+  BatchOptions sparse;
+  sparse.noise_check_dense_limit = 0;
+  const RefinementResult d = refine_batch(run.run, options_for(so), truth_point(run));
+  const RefinementResult s = refine_batch(run.run, options_for(so), truth_point(run), sparse);
+  ASSERT_TRUE(d.noise.ok);
+  ASSERT_TRUE(s.noise.ok);
+  EXPECT_EQ(d.noise.clusters, s.noise.clusters);
+  EXPECT_NEAR(d.noise.scale, s.noise.scale, 1e-6 * d.noise.scale);
+  for (int i = 0; i < 3; ++i)
+    EXPECT_NEAR(d.noise.covariance(i, i), s.noise.covariance(i, i), 1e-6 * d.noise.covariance(i, i));
+}
+
 // Bearings twice as noisy as assumed: the variance is four times the model's. Without the
 // outlier gate and the track splitting, whose thresholds are in assumed sigmas: at the
 // default gate (3.3 sigmas) a tenth of these bearings would be cut off and the rest would

@@ -48,6 +48,9 @@ struct BatchOptions {
   double split_keep_fraction = 0.5;  // a round splits the tracks within this factor of the
                                      // strongest statistic (the rest are judged after re-solving)
   int split_rounds = 10;
+  // The noise check (BatchNoiseCheck) inverts the information matrix densely up to this many
+  // variables, and uses sparse solves above (the same numbers; tested).
+  int noise_check_dense_limit = 3000;
   // Only tracks with at least options.min_track_length bearings enter the batch.
 };
 
