@@ -220,7 +220,7 @@ void run_calibrate(const CalibrateArgs& a) {
                 rad2deg(result.bearing_sigma), result.noise.clusters,
                 rad2deg(result.bearing_sigma * std::sqrt(result.noise.scale)),
                 result.noise_applied ? "the model is rejected: sigmas above scaled by "
-                                     : "within the model's range: sigmas kept, variance x",
+                                     : "not more than the model allows: sigmas kept, variance x",
                 result.noise_applied ? std::sqrt(result.noise_ratio) : result.noise.scale);
   else
     std::printf("bearing sigma %.3f deg (no noise check%s)\n", rad2deg(result.bearing_sigma),

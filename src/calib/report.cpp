@@ -367,7 +367,7 @@ std::string report_html(const CalibrationResult& r, const ReportInputs& in) {
                " of independent noise (variance x" + f("%.2f", r.noise.scale) + "); " +
                (r.noise_applied ? "the model is rejected, sigmas scaled by " +
                                       f("%.2f", std::sqrt(r.noise_ratio))
-                                : std::string("within the model's range, sigmas kept"))
+                                : std::string("not more than the model allows, sigmas kept"))
          : std::string("not made"));
   if (r.refined)
     kv("refinement", std::string(r.refinement.converged ? "converged" : "did not converge") + ", " +
