@@ -23,7 +23,8 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
   CalibrationResult r;
   r.bearing_sigma = options.bearing_sigma;
   r.filter = run_filter(run, options);
-  BatchPoint at = batch_point_from_filter(run, options, r.filter);
+  const BatchPoint filter_point = batch_point_from_filter(run, options, r.filter);
+  BatchPoint at = filter_point;
   const CalibrationRun* analysed = &run;
   if (co.refine) {
     r.refinement = refine_batch(run, options, at, co.batch);
@@ -61,7 +62,10 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
     };
     BatchOptions unsplit = co.batch;
     unsplit.split_chi2 = 0.0;
-    r.filter_noise = refine_batch(run, options, batch_point_from_filter(run, options, r.filter), unsplit).noise;
+    // (With splitting off, the refinement already solved this very problem.)
+    r.filter_noise = r.refined && co.batch.split_chi2 <= 0.0
+                         ? r.refinement.noise
+                         : refine_batch(run, options, filter_point, unsplit).noise;
     if (const double ratio = ratio_of(r.filter_noise); ratio > 0.0) {
       r.noise_checked = true;
       r.noise = r.filter_noise;
