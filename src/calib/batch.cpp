@@ -169,15 +169,30 @@ std::map<int, int> find_splits(const Built& b, const BatchOptions& batch) {
 // handful of entries (a bearing touches one pose, one feature and the extrinsics), so the
 // product is formed sparse: O(rows x 8^2) instead of the dense O(rows x cols^2). Hall zigzag,
 // 318 tracks: filter (its bootstrap window) 12.97 -> 8.44 s, observability 2.62 -> 0.68 s.
-Eigen::MatrixXd information_from_jacobian(const ceres::CRSMatrix& crs) {
+Eigen::SparseMatrix<double> sparse_jacobian(const ceres::CRSMatrix& crs) {
   std::vector<Eigen::Triplet<double>> t;
   t.reserve(crs.values.size());
   for (int r = 0; r < crs.num_rows; ++r)
     for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k) t.emplace_back(r, crs.cols[k], crs.values[k]);
   Eigen::SparseMatrix<double> J(crs.num_rows, crs.num_cols);
   J.setFromTriplets(t.begin(), t.end());
+  return J;
+}
+
+Eigen::MatrixXd information_from_jacobian(const ceres::CRSMatrix& crs) {
+  const Eigen::SparseMatrix<double> J = sparse_jacobian(crs);
   const Eigen::SparseMatrix<double> F = J.transpose() * J;
   return Eigen::MatrixXd(F);
+}
+
+// The variables of the batch problem in the order of its Jacobian's columns: poses of frames
+// 1..N (frame 0 is the gauge), features, extrinsics (the last three columns).
+std::vector<double*> variable_blocks(Built& b) {
+  std::vector<double*> v;
+  for (std::size_t k = 1; k < b.poses.size(); ++k) v.push_back(b.poses[k].data());
+  for (auto& [id, f] : b.features) v.push_back(f.data());
+  v.push_back(b.ex.data());
+  return v;
 }
 
 // The error of the extrinsics measured by the data themselves (BatchNoiseCheck): at the
@@ -195,9 +210,7 @@ Eigen::MatrixXd information_from_jacobian(const ceres::CRSMatrix& crs) {
 BatchNoiseCheck noise_check(Built& b, int dense_limit) {
   BatchNoiseCheck out;
   ceres::Problem::EvaluateOptions eo;
-  for (std::size_t k = 1; k < b.poses.size(); ++k) eo.parameter_blocks.push_back(b.poses[k].data());
-  for (auto& [id, f] : b.features) eo.parameter_blocks.push_back(f.data());
-  eo.parameter_blocks.push_back(b.ex.data());
+  eo.parameter_blocks = variable_blocks(b);
   eo.residual_blocks = b.odometry_blocks;
   eo.residual_blocks.insert(eo.residual_blocks.end(), b.bearing_blocks.begin(), b.bearing_blocks.end());
   eo.apply_loss_function = false;
@@ -219,12 +232,7 @@ BatchNoiseCheck noise_check(Built& b, int dense_limit) {
     cluster[row++] = it->second;
   }
   if (row != m) return out;
-  std::vector<Eigen::Triplet<double>> t;
-  t.reserve(crs.values.size());
-  for (int i = 0; i < m; ++i)
-    for (int k = crs.rows[i]; k < crs.rows[i + 1]; ++k) t.emplace_back(i, crs.cols[k], crs.values[k]);
-  Eigen::SparseMatrix<double> J(m, n);
-  J.setFromTriplets(t.begin(), t.end());
+  const Eigen::SparseMatrix<double> J = sparse_jacobian(crs);
   Eigen::SparseMatrix<double> F = J.transpose() * J;
   // A tiny ridge, relative to each variable's own information (their scales differ by
   // orders of magnitude), keeps a feature seen without parallax from making F singular. A
@@ -572,9 +580,7 @@ ObservabilityReport analyse_observability(const CalibrationRun& run,
   // The Jacobian of the whitened residuals: Fisher information F = J^T J (the residuals are
   // already divided by their sigmas). Frame 0 is not a variable (gauge).
   ceres::Problem::EvaluateOptions eo;
-  for (std::size_t k = 1; k < b.poses.size(); ++k) eo.parameter_blocks.push_back(b.poses[k].data());
-  for (auto& [id, f] : b.features) eo.parameter_blocks.push_back(f.data());
-  eo.parameter_blocks.push_back(b.ex.data());
+  eo.parameter_blocks = variable_blocks(b);
   eo.apply_loss_function = false;
   ceres::CRSMatrix crs;
   b.problem->Evaluate(eo, nullptr, nullptr, nullptr, &crs);
