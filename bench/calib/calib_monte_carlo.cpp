@@ -165,8 +165,17 @@ int main(int argc, char** argv) {
   for (int r = 0; r < runs; ++r) {
     so.seed = seed + r;
     const SyntheticRun run = make_synthetic_run(so);
-    const FilterResult fr = run_filter(run.run, fo);
-    filt.add(fr.extrinsics, fr.covariance, run.truth);
+    // With --refine, the tool's pipeline (calib::calibrate): the filter, the refinement, and
+    // the noise checks of the filter (its tracks unsplit) and of the refinement; the model's
+    // covariances are kept aside. The filter is run once either way.
+    CalibrationResult cr;
+    if (refine) {
+      CalibrateOptions co{.refine = true};
+      if (const char* c = std::getenv("LATERAL")) co.batch.lateral_sigma = std::atof(c);  // diagnostics
+      cr = calibrate(run.run, fo, co);
+    }
+    const FilterResult fr = refine ? cr.filter : run_filter(run.run, fo);
+    filt.add(fr.extrinsics, refine ? cr.filter_model_covariance : fr.covariance, run.truth);
     if (std::getenv("VERBOSE") && !filt.nees.empty())
       std::printf("run %d: nees %.1f  phi %.4f rho %.4f psi %.4f\n",
                   r,
@@ -184,11 +193,6 @@ int main(int argc, char** argv) {
     crlb_yaw_sq += obs.yaw.crlb * obs.yaw.crlb;
     crlb_pos_sq += obs.x.crlb * obs.x.crlb + obs.y.crlb * obs.y.crlb;
     if (refine) {
-      // The tool's pipeline (calib::calibrate): refinement, and the noise checks of the filter
-      // (its tracks unsplit) and of the refinement; the model's covariances are kept aside.
-      CalibrateOptions co{.refine = true};
-      if (const char* c = std::getenv("LATERAL")) co.batch.lateral_sigma = std::atof(c);  // diagnostics
-      const CalibrationResult cr = calibrate(run.run, fo, co);
       if (cr.refinement.covariance_ok) {
         ref.add(cr.refinement.extrinsics, cr.refinement_model_covariance, run.truth);
         if (cr.noise_checked) {
