@@ -34,8 +34,10 @@ int main(int argc, char** argv) {
   CLI::App app{"omnivert: vertical lines in omnidirectional images (extraction, description, "
                "tracking, camera-odometry self-calibration)"};
   app.require_subcommand(1);
-  bool verbose = false;
-  app.add_flag("-v,--verbose", verbose, "More log output");
+  // Set while parsing, before the subcommand's callback runs.
+  app.add_flag_callback("-v,--verbose", [] { spdlog::set_level(spdlog::level::debug); },
+                        "More log output (each calibration stage's time, for one)")
+      ->trigger_on_parse();
   app.set_version_flag("--version", "omnivert 0.1.0");
 
   omnivert::cli::add_extract_command(app);
@@ -61,6 +63,5 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "omnivert: error: %s\n", e.what());
     return omnivert::cli::kExitFailure;
   }
-  (void)verbose;
   return 0;
 }

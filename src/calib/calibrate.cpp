@@ -1,6 +1,7 @@
 #include "omnivert/calib/calibrate.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -9,6 +10,7 @@
 #include <sstream>
 
 #include <Eigen/Cholesky>
+#include <spdlog/spdlog.h>
 
 #include "omnivert/calib/updater.hpp"
 #include "omnivert/core/angles.hpp"
@@ -22,7 +24,15 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
                                  const CalibrateOptions& co) {
   CalibrationResult r;
   r.bearing_sigma = options.bearing_sigma;
+  // Each stage's time, on the log's debug level (omnivert -v).
+  auto t = std::chrono::steady_clock::now();
+  auto lap = [&t](const char* stage) {
+    const auto now = std::chrono::steady_clock::now();
+    spdlog::debug("calibrate: {} {:.2f} s", stage, std::chrono::duration<double>(now - t).count());
+    t = now;
+  };
   r.filter = run_filter(run, options);
+  lap("filter");
   const BatchPoint filter_point = batch_point_from_filter(run, options, r.filter);
   BatchPoint at = filter_point;
   const CalibrationRun* analysed = &run;
@@ -31,9 +41,11 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
     r.refined = true;
     at = r.refinement.solution;
     if (r.refinement.num_splits > 0) analysed = &r.refinement.split_run;  // the same problem
+    lap("refinement");
   }
   // Sec. 8.1 at the best estimate of the trajectory, the features and the extrinsics.
   r.observability = analyse_observability(*analysed, options, at, co.batch, co.observability);
+  lap("observability");
   if (r.refined && !r.refinement.covariance_ok && r.observability.all_determined() &&
       r.observability.crlb_covariance.allFinite()) {
     // ceres::Covariance gives up on badly scaled problems (poses in metres, bearings whitened
@@ -66,6 +78,7 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
     r.filter_noise = r.refined && co.batch.split_chi2 <= 0.0
                          ? r.refinement.noise
                          : refine_batch(run, options, filter_point, unsplit).noise;
+    lap("the filter's noise check");
     if (const double ratio = ratio_of(r.filter_noise); ratio > 0.0) {
       r.noise_checked = true;
       r.noise = r.filter_noise;
