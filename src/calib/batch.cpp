@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <algorithm>
 #include <array>
+#include <set>
 #include <limits>
 #include <functional>
 #include <map>
@@ -74,9 +75,41 @@ struct Built {
   std::vector<ceres::ResidualBlockId> odometry_blocks;
 };
 
+// Removes the features left with fewer than `min_bearings` bearings (with their remaining
+// bearings and any prior on them): their information is singular. Measured: hall zigzag,
+// seed 1, every bearing of one track was an outlier in the filter's bootstrap window, whose
+// information matrix then could not be inverted; the filter fell back on the undelayed
+// initialisation over 252 frames and ended 124 mm off (docs/calib.md, "The noise check").
+// Returns how many features.
+int drop_unobserved_features(Built* b, int min_bearings) {
+  std::map<int, int> count;
+  for (const auto& [id, frame] : b->bearing_keys) ++count[id];
+  std::vector<int> drop;
+  for (const auto& [id, f] : b->features)
+    if (count[id] < min_bearings) drop.push_back(id);
+  if (drop.empty()) return 0;
+  const std::set<int> dropped(drop.begin(), drop.end());
+  std::vector<ceres::ResidualBlockId> kept;
+  std::vector<std::pair<int, int>> kept_keys;
+  for (std::size_t i = 0; i < b->bearing_blocks.size(); ++i) {
+    if (dropped.count(b->bearing_keys[i].first)) continue;
+    kept.push_back(b->bearing_blocks[i]);
+    kept_keys.push_back(b->bearing_keys[i]);
+  }
+  b->num_bearings -= static_cast<int>(b->bearing_blocks.size() - kept.size());
+  b->bearing_blocks = std::move(kept);
+  b->bearing_keys = std::move(kept_keys);
+  for (int id : drop) {
+    b->problem->RemoveParameterBlock(b->features.at(id).data());  // and its residual blocks
+    b->features.erase(id);
+  }
+  return static_cast<int>(drop.size());
+}
+
 // Removes the bearings whose whitened residual exceeds `threshold` (the filter's chi-square
-// gate, in sigmas) at the current solution. Returns how many.
-int reject_outliers(Built* b, double threshold) {
+// gate, in sigmas) at the current solution, then the features left with fewer than
+// `min_bearings` bearings (drop_unobserved_features). Returns how many bearings.
+int reject_outliers(Built* b, double threshold, int min_bearings) {
   int n = 0;
   std::vector<ceres::ResidualBlockId> kept;
   std::vector<std::pair<int, int>> kept_keys;
@@ -95,6 +128,7 @@ int reject_outliers(Built* b, double threshold) {
   b->bearing_blocks = std::move(kept);
   b->bearing_keys = std::move(kept_keys);
   b->num_bearings -= n;
+  if (n > 0) drop_unobserved_features(b, min_bearings);
   return n;
 }
 
@@ -451,7 +485,11 @@ RefinementResult refine_batch(const CalibrationRun& run,
   res.num_bearings = b.num_bearings;
 
   ceres::Solver::Options so;
-  so.linear_solver_type = ceres::SPARSE_SCHUR;  // poses/features eliminated, extrinsics kept
+  // Sparse Cholesky of the whole normal equations: the poses form a chain and each feature
+  // ties many poses, so the Schur complement on either is nearly dense. Hall zigzag, 252
+  // frames and 114 tracks in the filter's window: 17.7 s against 40.8 s with SPARSE_SCHUR,
+  // the same solution.
+  so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   so.max_num_iterations = batch.max_iterations;
   so.function_tolerance = 1e-10;
   so.gradient_tolerance = 1e-12;
@@ -465,7 +503,8 @@ RefinementResult refine_batch(const CalibrationRun& run,
   auto reject_and_solve = [&] {
     res.num_rejected = 0;
     for (int round = 0; round < 3; ++round) {
-      const int n = reject_outliers(&b, gate);
+      // Two bearings at least determine a feature point.
+      const int n = reject_outliers(&b, gate, 2);
       res.num_rejected += n;
       if (n == 0) break;
       ceres::Solve(so, b.problem.get(), &summary);
@@ -547,7 +586,10 @@ RefinementResult refine_batch(const CalibrationRun& run,
   // Covariance of (phi, rho, psi): the inverse of the Fisher information at the solution
   // (of the problem without robust loss, as it is the Gaussian model's bound), marginal.
   ceres::Covariance::Options co;
-  co.algorithm_type = ceres::DENSE_SVD;  // small problem; detects rank deficiency
+  // Sparse QR: fails on a rank-deficient problem (then the caller falls back on the
+  // observability analysis). DENSE_SVD gave the same covariance to 13 digits but took 15 s
+  // on the hall zigzag (1440 variables) against 0.15 s.
+  co.algorithm_type = ceres::SPARSE_QR;
   co.min_reciprocal_condition_number = 1e-14;
   co.null_space_rank = 0;
   co.num_threads = 1;
@@ -715,7 +757,8 @@ struct InverseDepthPrior {
 bool bootstrap_filter_state(const CalibrationRun& window,
                             const Options& options,
                             FilterState* state,
-                            std::string* why) {
+                            std::string* why,
+                            std::map<int, TrackEstimate>* window_tracks) {
   auto fail = [why](const std::string& m) {
     if (why) *why = m;
     return false;
@@ -736,7 +779,7 @@ bool bootstrap_filter_state(const CalibrationRun& window,
   Options opt = options;
   opt.min_track_length = 2;
   ceres::Solver::Options so;
-  so.linear_solver_type = ceres::SPARSE_SCHUR;  // as the refinement: poses and features eliminated
+  so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;  // as the refinement
   so.max_num_iterations = 100;
   so.num_threads = 1;
   so.logging_type = ceres::SILENT;
@@ -808,7 +851,8 @@ bool bootstrap_filter_state(const CalibrationRun& window,
   if (!have) return fail("window solve failed: " + summary.BriefReport());
   const double gate = std::sqrt(chi2_quantile(options.gate_probability, 1));
   for (int round = 0; round < 3; ++round) {
-    if (reject_outliers(&b, gate) == 0) break;
+    // One bearing and the inverse-depth prior determine a feature point.
+    if (reject_outliers(&b, gate, 1) == 0) break;
     ceres::Solve(so, b.problem.get(), &summary);
   }
   if (!summary.IsSolutionUsable()) return fail("window solve failed: " + summary.BriefReport());
@@ -886,6 +930,46 @@ bool bootstrap_filter_state(const CalibrationRun& window,
   }
   const Eigen::MatrixXd Ps = T * Pv * T.transpose();
   if (!s0.allFinite() || !Ps.allFinite()) return fail("window solution is not finite");
+
+  if (window_tracks) {
+    // Every track of the window as the window solved it, (D, theta) from the robot at the
+    // track's last window frame (model.hpp, feature_from_world), with its covariance (central
+    // differences, as above). Tracks that ended inside the window do not enter the filter's
+    // state; without these the refinement would start without them and leave them out
+    // (hall zigzag seed 1, a 252-frame window: 130 of 316 tracks refined).
+    window_tracks->clear();
+    for (auto& [id, f] : b.features) {
+      const int k = last_frame[id];
+      const int pc = k > 0 ? 3 * (k - 1) : -1;  // frame 0's pose is the constant origin
+      auto d_theta = [&](const Eigen::VectorXd& v) {
+        const Eigen::Vector3d pose =
+            pc >= 0 ? Eigen::Vector3d(v.segment<3>(pc)) : Eigen::Vector3d::Zero();
+        return feature_from_world(pose, v.segment<2>(feature_col[id]));
+      };
+      std::vector<int> dc = {feature_col[id], feature_col[id] + 1};
+      if (pc >= 0) dc.insert(dc.end(), {pc, pc + 1, pc + 2});
+      Eigen::MatrixXd Jt(2, static_cast<int>(dc.size()));
+      for (std::size_t j = 0; j < dc.size(); ++j) {
+        const double h = 1e-6;
+        Eigen::VectorXd vp = v0, vm = v0;
+        vp(dc[j]) += h;
+        vm(dc[j]) -= h;
+        Eigen::Vector2d d = d_theta(vp) - d_theta(vm);
+        d(1) = wrap_angle(d(1));
+        Jt.col(static_cast<int>(j)) = d / (2 * h);
+      }
+      Eigen::MatrixXd Pd(dc.size(), dc.size());
+      for (std::size_t i = 0; i < dc.size(); ++i)
+        for (std::size_t j = 0; j < dc.size(); ++j) Pd(i, j) = Pv(dc[i], dc[j]);
+      TrackEstimate t;
+      t.track_id = id;
+      t.frame = k;
+      t.D_theta = d_theta(v0);
+      t.covariance = Jt * Pd * Jt.transpose();
+      t.num_updates = count[id];
+      if (t.D_theta.allFinite() && t.covariance.allFinite()) (*window_tracks)[id] = t;
+    }
+  }
 
   std::vector<FeatureSlot> slots;
   for (int id : ids) {

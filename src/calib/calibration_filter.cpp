@@ -81,7 +81,13 @@ void CalibrationFilter::end_bootstrap(FrameEstimate rec) {
   {
     bootstrapping_ = false;
     std::string why;
-    if (bootstrap_filter_state(window_, options_, &state_, &why)) {
+    std::map<int, TrackEstimate> window_tracks;
+    if (bootstrap_filter_state(window_, options_, &state_, &why, &window_tracks)) {
+      const int first = frame_ - static_cast<int>(window_.frames.size()) + 1;
+      for (auto& [id, t] : window_tracks) {
+        t.frame += first;
+        tracks_[id] = t;
+      }
       rec.extrinsics = state_.extrinsics();
       rec.covariance = state_.extrinsics_covariance();
       rec.num_features = state_.num_features();

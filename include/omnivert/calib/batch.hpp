@@ -133,11 +133,16 @@ RefinementResult refine_batch(const CalibrationRun& run,
 // docs/calib.md: one linearisation per frame while depth and camera yaw are both unknown.
 // Tracks with fewer than 2 bearings in the window are left out (they enter afterwards).
 // Outlying bearings are removed as in refine_batch.
+// `window_tracks` (optional) receives every track of the window's solution as (D, theta)
+// from the robot at its last window frame (frame = index in the window), with covariance:
+// tracks that ended inside the window never enter the state, and the refinement starts from
+// these.
 // Returns false (state untouched, reason in *why) when the window cannot be solved.
 bool bootstrap_filter_state(const CalibrationRun& window,
                             const Options& options,
                             FilterState* state,
-                            std::string* why = nullptr);
+                            std::string* why = nullptr,
+                            std::map<int, TrackEstimate>* window_tracks = nullptr);
 
 // Verdict on one parameter (or combination) of the extrinsics.
 struct ParameterVerdict {
