@@ -103,6 +103,7 @@ void run_calibrate(const CalibrateArgs& a) {
   if (a.sigma_psi) opt.prior_sigma(2) = *a.sigma_psi;
   if (a.bearing_sigma_deg) opt.bearing_sigma = deg2rad(*a.bearing_sigma_deg);
   if (a.odometry_inflation) opt.odometry_inflation = *a.odometry_inflation;
+  opt.split_chi2 = a.split_chi2;
   if (!opt.IsValid(&why)) throw InputError("invalid calibration options: " + why);
 
   std::error_code ec;
@@ -268,9 +269,9 @@ void add_calibrate_command(CLI::App& app) {
   cmd->add_flag("--refine", a->refine,
                 "Refine the filter's result by batch maximum likelihood over the whole run (Ceres)");
   cmd->add_option("--split-chi2", a->split_chi2,
-                  "Refinement: split a track in two where two features explain its bearings "
-                  "better than one by this likelihood-ratio statistic (a track that slipped onto "
-                  "a neighbouring line); 0 turns splitting off")
+                  "Filter's window and refinement: split a track in two where two features "
+                  "explain its bearings better than one by this likelihood-ratio statistic (a "
+                  "track that slipped onto a neighbouring line); 0 turns splitting off")
       ->check(kNonNegative)
       ->capture_default_str();
   cmd->add_flag("!--no-noise-check", a->noise_check,

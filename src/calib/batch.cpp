@@ -758,7 +758,7 @@ bool bootstrap_filter_state(const CalibrationRun& window,
                             const Options& options,
                             FilterState* state,
                             std::string* why,
-                            std::map<int, TrackEstimate>* window_tracks) {
+                            BootstrapDetails* details) {
   auto fail = [why](const std::string& m) {
     if (why) *why = m;
     return false;
@@ -769,13 +769,20 @@ bool bootstrap_filter_state(const CalibrationRun& window,
   const double q_hi = 1.0 / options.min_feature_distance;
   const double q0 = 0.5 * (q_lo + q_hi), sigma_q = 0.25 * (q_hi - q_lo);
 
-  // First and last frame of each track in the window.
+  // First and last frame and number of bearings of each track of a window (after splits, of
+  // the window with the split parts renamed).
   std::map<int, int> first_frame, last_frame, count;
-  for (int k = 0; k < W; ++k)
-    for (const BearingObservation& o : window.frames[k].observations) {
-      if (!count[o.track_id]++) first_frame[o.track_id] = k;
-      last_frame[o.track_id] = k;
-    }
+  auto index_tracks = [&](const CalibrationRun& w) {
+    first_frame.clear();
+    last_frame.clear();
+    count.clear();
+    for (int k = 0; k < W; ++k)
+      for (const BearingObservation& o : w.frames[k].observations) {
+        if (!count[o.track_id]++) first_frame[o.track_id] = k;
+        last_frame[o.track_id] = k;
+      }
+  };
+  index_tracks(window);
   Options opt = options;
   opt.min_track_length = 2;
   ceres::Solver::Options so;
@@ -785,9 +792,27 @@ bool bootstrap_filter_state(const CalibrationRun& window,
   so.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
 
-  // The window's problem solved from extrinsics ex0: dead-reckoned poses, each track on its
-  // first ray at depth 1/q0; the priors on the extrinsics (options.prior) and on each track's
-  // inverse depth.
+  // The window's problem from a starting point: odometry and bearings, the priors on the
+  // extrinsics (options.prior) and on each track's inverse depth along its first ray.
+  auto build_window = [&](const CalibrationRun& w, const BatchPoint& start) {
+    Built b = build(w, opt, start, BatchOptions{}, /*robust=*/false);
+    if (b.features.empty()) return b;
+    b.problem->AddResidualBlock(
+        new ceres::AutoDiffCostFunction<ExtrinsicsPrior, 3, 3>(
+            new ExtrinsicsPrior{options.prior.vec(), options.prior_sigma.cwiseInverse()}),
+        nullptr,
+        b.ex.data());
+    for (auto& [id, f] : b.features)
+      b.problem->AddResidualBlock(
+          new ceres::AutoDiffCostFunction<InverseDepthPrior, 1, 3, 2, 3>(
+              new InverseDepthPrior{q0, 1.0 / (options.bootstrap_depth_prior_scale * sigma_q)}),
+          nullptr,
+          b.poses[first_frame[id]].data(),
+          f.data(),
+          b.ex.data());
+    return b;
+  };
+  // Solved from extrinsics ex0: dead-reckoned poses, each track on its first ray at depth 1/q0.
   auto solve_from = [&](const Extrinsics& ex0, Built* out, ceres::Solver::Summary* sum) {
     BatchPoint start;
     start.poses = dead_reckoning(window, options.wheel_base);
@@ -803,21 +828,8 @@ bool bootstrap_filter_state(const CalibrationRun& window,
         break;
       }
     }
-    Built b = build(window, opt, start, BatchOptions{}, /*robust=*/false);
+    Built b = build_window(window, start);
     if (b.features.empty()) return false;
-    b.problem->AddResidualBlock(
-        new ceres::AutoDiffCostFunction<ExtrinsicsPrior, 3, 3>(
-            new ExtrinsicsPrior{options.prior.vec(), options.prior_sigma.cwiseInverse()}),
-        nullptr,
-        b.ex.data());
-    for (auto& [id, f] : b.features)
-      b.problem->AddResidualBlock(
-          new ceres::AutoDiffCostFunction<InverseDepthPrior, 1, 3, 2, 3>(
-              new InverseDepthPrior{q0, 1.0 / (options.bootstrap_depth_prior_scale * sigma_q)}),
-          nullptr,
-          b.poses[first_frame[id]].data(),
-          f.data(),
-          b.ex.data());
     ceres::Solve(so, b.problem.get(), sum);
     *out = std::move(b);
     return true;
@@ -850,11 +862,50 @@ bool bootstrap_filter_state(const CalibrationRun& window,
   }
   if (!have) return fail("window solve failed: " + summary.BriefReport());
   const double gate = std::sqrt(chi2_quantile(options.gate_probability, 1));
-  for (int round = 0; round < 3; ++round) {
-    // One bearing and the inverse-depth prior determine a feature point.
-    if (reject_outliers(&b, gate, 1) == 0) break;
+  auto reject_and_solve = [&] {
+    for (int round = 0; round < 3; ++round) {
+      // One bearing and the inverse-depth prior determine a feature point.
+      if (reject_outliers(&b, gate, 1) == 0) break;
+      ceres::Solve(so, b.problem.get(), &summary);
+    }
+  };
+  reject_and_solve();
+  // Tracks that slipped onto a neighbouring line are split as in the refinement (find_splits,
+  // options.split_chi2): where the window is most of the run (a zigzag never turns 1.5 rad
+  // away from its start heading: office zigzag, 252 of 269 frames), the filter's estimate is
+  // the window's, and one slipped track biased it (docs/calib.md, "Splitting in the window").
+  // The later part of a split track gets a new id; `origin` maps it to the tracker's.
+  CalibrationRun split_window;
+  std::map<int, int> origin;
+  std::vector<std::pair<int, int>> window_splits;
+  BatchOptions split_options;
+  split_options.split_chi2 = options.split_chi2;
+  for (int round = 0; options.split_chi2 > 0.0 && round < split_options.split_rounds; ++round) {
+    const std::map<int, int> splits = find_splits(b, split_options);
+    if (splits.empty()) break;
+    const CalibrationRun& current = round == 0 ? window : split_window;
+    int next_id = 0;
+    for (const FrameInput& f : current.frames)
+      for (const BearingObservation& o : f.observations) next_id = std::max(next_id, o.track_id + 1);
+    CalibrationRun next = current;
+    BatchPoint at = point_of(b);
+    for (const auto& [id, from] : splits) {
+      const int nid = next_id++;
+      for (std::size_t k = static_cast<std::size_t>(from); k < next.frames.size(); ++k)
+        for (BearingObservation& o : next.frames[k].observations)
+          if (o.track_id == id) o.track_id = nid;
+      at.features[nid] = at.features.at(id);
+      origin[nid] = origin.count(id) ? origin.at(id) : id;
+      window_splits.emplace_back(origin[nid], from);
+    }
+    split_window = std::move(next);
+    index_tracks(split_window);
+    b = build_window(split_window, at);
+    if (b.features.empty()) return fail("no track with two bearings in the window");
     ceres::Solve(so, b.problem.get(), &summary);
+    reject_and_solve();
   }
+  auto tracker_id = [&origin](int id) { return origin.count(id) ? origin.at(id) : id; };
   if (!summary.IsSolutionUsable()) return fail("window solve failed: " + summary.BriefReport());
 
   // Covariance of all window variables: inverse of J^T J (priors included).
@@ -883,8 +934,14 @@ bool bootstrap_filter_state(const CalibrationRun& window,
   // kept track, (a = c, alpha, q) with alpha, q the direction and inverse distance of the
   // feature from the camera, in the robot frame.
   const int last = W - 1;
+  // Per tracker id, its latest part (the line the tracker follows now) enters the state.
+  std::map<int, int> latest;  // tracker id -> id in the (split) window
+  for (auto& [id, f] : b.features) {
+    auto [it, fresh] = latest.emplace(tracker_id(id), id);
+    if (!fresh && last_frame[id] > last_frame[it->second]) it->second = id;
+  }
   std::vector<int> ids;
-  for (auto& [id, f] : b.features)
+  for (const auto& [tid, id] : latest)
     if (last - last_frame[id] <= options.max_missed_frames) ids.push_back(id);
   const int nv = static_cast<int>(F.rows());
   const int ns = 4 * static_cast<int>(ids.size()) + 3;
@@ -931,14 +988,15 @@ bool bootstrap_filter_state(const CalibrationRun& window,
   const Eigen::MatrixXd Ps = T * Pv * T.transpose();
   if (!s0.allFinite() || !Ps.allFinite()) return fail("window solution is not finite");
 
-  if (window_tracks) {
+  if (details) {
+    std::map<int, TrackEstimate>* window_tracks = &details->tracks;
     // Every track of the window as the window solved it, (D, theta) from the robot at the
     // track's last window frame (model.hpp, feature_from_world), with its covariance (central
     // differences, as above). Tracks that ended inside the window do not enter the filter's
     // state; without these the refinement would start without them and leave them out
     // (hall zigzag seed 1, a 252-frame window: 130 of 316 tracks refined).
     window_tracks->clear();
-    for (auto& [id, f] : b.features) {
+    for (const auto& [tid, id] : latest) {
       const int k = last_frame[id];
       const int pc = k > 0 ? 3 * (k - 1) : -1;  // frame 0's pose is the constant origin
       auto d_theta = [&](const Eigen::VectorXd& v) {
@@ -962,19 +1020,20 @@ bool bootstrap_filter_state(const CalibrationRun& window,
       for (std::size_t i = 0; i < dc.size(); ++i)
         for (std::size_t j = 0; j < dc.size(); ++j) Pd(i, j) = Pv(dc[i], dc[j]);
       TrackEstimate t;
-      t.track_id = id;
+      t.track_id = tid;
       t.frame = k;
       t.D_theta = d_theta(v0);
       t.covariance = Jt * Pd * Jt.transpose();
       t.num_updates = count[id];
-      if (t.D_theta.allFinite() && t.covariance.allFinite()) (*window_tracks)[id] = t;
+      if (t.D_theta.allFinite() && t.covariance.allFinite()) (*window_tracks)[tid] = t;
     }
+    details->splits = window_splits;
   }
 
   std::vector<FeatureSlot> slots;
   for (int id : ids) {
     FeatureSlot slot;
-    slot.track_id = id;
+    slot.track_id = tracker_id(id);
     slot.param = FeatureParam::kAnchored;
     slot.first_frame = first_frame[id];
     slot.last_seen_frame = last_frame[id];
@@ -986,6 +1045,34 @@ bool bootstrap_filter_state(const CalibrationRun& window,
   fresh.normalise();
   *state = std::move(fresh);
   return true;
+}
+
+CalibrationRun split_tracks(const CalibrationRun& run,
+                            const std::vector<std::pair<int, int>>& splits,
+                            std::map<int, int>* origin) {
+  if (origin) origin->clear();
+  if (splits.empty()) return run;
+  int next_id = 0;
+  for (const FrameInput& f : run.frames)
+    for (const BearingObservation& o : f.observations) next_id = std::max(next_id, o.track_id + 1);
+  // Per track, its split frames in order, and the id of the part starting at each.
+  std::map<int, std::map<int, int>> parts;
+  for (const auto& [id, frame] : splits) parts[id].emplace(frame, 0);
+  for (auto& [id, starts] : parts)
+    for (auto& [frame, nid] : starts) {
+      nid = next_id++;
+      if (origin) (*origin)[nid] = id;
+    }
+  CalibrationRun out = run;
+  for (std::size_t k = 0; k < out.frames.size(); ++k)
+    for (BearingObservation& o : out.frames[k].observations) {
+      const auto it = parts.find(o.track_id);
+      if (it == parts.end()) continue;
+      auto p = it->second.upper_bound(static_cast<int>(k));  // first split after frame k
+      if (p == it->second.begin()) continue;                  // before the first split
+      o.track_id = std::prev(p)->second;
+    }
+  return out;
 }
 
 }  // namespace omnivert::calib

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iomanip>
 #include <limits>
+#include <map>
 #include <sstream>
 
 #include <Eigen/Cholesky>
@@ -74,10 +75,20 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
     };
     BatchOptions unsplit = co.batch;
     unsplit.split_chi2 = 0.0;
-    // (With splitting off, the refinement already solved this very problem.)
-    r.filter_noise = r.refined && co.batch.split_chi2 <= 0.0
-                         ? r.refinement.noise
-                         : refine_batch(run, options, filter_point, unsplit).noise;
+    // The filter's tracks: split where its window split them (FilterResult::splits), each
+    // part starting at the track's filter estimate. (With no splits anywhere, the refinement
+    // already solved this very problem.)
+    if (r.refined && co.batch.split_chi2 <= 0.0 && r.filter.splits.empty()) {
+      r.filter_noise = r.refinement.noise;
+    } else {
+      std::map<int, int> origin;
+      const CalibrationRun filter_run = split_tracks(run, r.filter.splits, &origin);
+      BatchPoint start = filter_point;
+      for (const auto& [id, tracker] : origin)
+        if (const auto it = filter_point.features.find(tracker); it != filter_point.features.end())
+          start.features[id] = it->second;
+      r.filter_noise = refine_batch(filter_run, options, start, unsplit).noise;
+    }
     lap("the filter's noise check");
     if (const double ratio = ratio_of(r.filter_noise); ratio > 0.0) {
       r.noise_checked = true;

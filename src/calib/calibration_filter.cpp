@@ -81,13 +81,14 @@ void CalibrationFilter::end_bootstrap(FrameEstimate rec) {
   {
     bootstrapping_ = false;
     std::string why;
-    std::map<int, TrackEstimate> window_tracks;
-    if (bootstrap_filter_state(window_, options_, &state_, &why, &window_tracks)) {
+    BootstrapDetails details;
+    if (bootstrap_filter_state(window_, options_, &state_, &why, &details)) {
       const int first = frame_ - static_cast<int>(window_.frames.size()) + 1;
-      for (auto& [id, t] : window_tracks) {
+      for (auto& [id, t] : details.tracks) {
         t.frame += first;
         tracks_[id] = t;
       }
+      for (const auto& [id, frame] : details.splits) splits_.emplace_back(id, frame + first);
       rec.extrinsics = state_.extrinsics();
       rec.covariance = state_.extrinsics_covariance();
       rec.num_features = state_.num_features();
@@ -193,7 +194,8 @@ FilterResult run_filter(const CalibrationRun& run, const Options& options) {
   CalibrationFilter filter(options);
   for (const FrameInput& f : run.frames) filter.process(f);
   filter.finish();
-  return {filter.extrinsics(), filter.covariance(), filter.history(), filter.tracks()};
+  return {filter.extrinsics(), filter.covariance(), filter.history(), filter.tracks(),
+          filter.splits()};
 }
 
 }  // namespace omnivert::calib

@@ -216,6 +216,13 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
                         {"condition", num(o.condition)},
                         {"message", o.message}};
   j["filter"] = extrinsics_json(r.filter.extrinsics, r.filter.covariance);
+  {
+    // Tracks split in the filter's bootstrap window (they slipped onto a neighbouring line).
+    nlohmann::json sp = nlohmann::json::array();
+    for (const auto& [track, frame] : r.filter.splits) sp.push_back({{"track_id", track}, {"frame", frame}});
+    j["filter"]["tracks_split"] = r.filter.splits.size();
+    j["filter"]["splits"] = sp;
+  }
   if (r.refined) {
     json ref = extrinsics_json(r.refinement.extrinsics, r.refinement.covariance);
     ref["converged"] = r.refinement.converged;
@@ -369,6 +376,8 @@ std::string report_html(const CalibrationResult& r, const ReportInputs& in) {
                                       f("%.2f", std::sqrt(r.noise_ratio))
                                 : std::string("not more than the model allows, sigmas kept"))
          : std::string("not made"));
+  kv("filter's window", std::to_string(r.filter.splits.size()) +
+                           " tracks split where they changed line");
   if (r.refined)
     kv("refinement", std::string(r.refinement.converged ? "converged" : "did not converge") + ", " +
                          std::to_string(r.refinement.iterations) + " iterations, " +

@@ -9,6 +9,7 @@
 #include <Eigen/Dense>
 
 #include "omnivert/calib/batch.hpp"
+#include "omnivert/calib/calibration_filter.hpp"
 #include "omnivert/calib/model.hpp"
 #include "omnivert/calib/synthetic_run.hpp"
 #include "omnivert/core/angles.hpp"
@@ -83,6 +84,81 @@ TEST(TrackSplitting, SlippedTracksAreSplitAndTheirBiasRemoved) {
     ASSERT_TRUE(slip_frame.count(track)) << "track " << track << " split at " << frame;
     EXPECT_NEAR(frame, slip_frame.at(track), 8) << "track " << track;
   }
+}
+
+// The filter's bootstrap window splits slipped tracks too. From pixels, on the office zigzag
+// the window is most of the run (the heading never gets 1.5 rad from the start's: 252 of 269
+// frames), so the window's solution is the filter's; here the window is made the whole run.
+TEST(TrackSplitting, TheFiltersWindowSplitsSlippedTracks) {
+  SyntheticRunOptions so;
+  so.bearing_sigma = deg2rad(0.05);
+  so.seed = 7;
+  const SyntheticRun clean = make_synthetic_run(so);
+  const int n = static_cast<int>(clean.run.frames.size());
+  SyntheticRun run = clean;
+  std::map<int, int> slip_frame;
+  int i = 0;
+  for (const auto& [track, j] : clean.track_feature)
+    if (i++ < 3) {
+      slip_frame[track] = n / 3 + 7 * i;
+      run = slip(run, track, slip_frame[track], 0.10);
+    }
+  Options o = options_for(so);
+  o.bootstrap_rotation = 100.0;  // never reached: the window ends with the run
+  const FilterResult split = run_filter(run.run, o);
+  o.split_chi2 = 0.0;
+  const FilterResult whole = run_filter(run.run, o);
+  const double nees_whole = test_support::nees(whole.extrinsics, whole.covariance, run.truth);
+  const double nees_split = test_support::nees(split.extrinsics, split.covariance, run.truth);
+  RecordProperty("nees_whole", std::to_string(nees_whole));
+  RecordProperty("nees_split", std::to_string(nees_split));
+  EXPECT_TRUE(whole.splits.empty());
+  EXPECT_GT(nees_whole, 16.3);  // chi-square(3) 99.9% quantile: the slips bias the estimate
+  EXPECT_LT(nees_split, 7.81);  // 95%: consistent again
+  ASSERT_EQ(split.splits.size(), 3u);
+  for (const auto& [track, frame] : split.splits) {
+    ASSERT_TRUE(slip_frame.count(track)) << "track " << track << " split at " << frame;
+    EXPECT_NEAR(frame, slip_frame.at(track), 8) << "track " << track;
+  }
+  // Each slipped track's latest part is what the filter ends with.
+  for (const auto& [track, frame] : split.splits) EXPECT_GE(split.tracks.at(track).frame, frame);
+}
+
+// split_tracks cuts each track at its split frames, the parts under new ids: the same parts
+// as the refinement's own split run.
+TEST(TrackSplitting, SplitTracksRebuildsTheRefinementsParts) {
+  CalibrationRun run;
+  run.frames.resize(10);
+  for (int k = 0; k < 10; ++k) {
+    run.frames[k].observations.push_back({3, 0.1 * k});
+    if (k >= 2) run.frames[k].observations.push_back({8, -0.1 * k});
+  }
+  std::map<int, int> origin;
+  const CalibrationRun out = split_tracks(run, {{3, 6}, {3, 4}, {8, 9}}, &origin);
+  // Track 3: frames 0-3 keep id 3, 4-5 and 6-9 get new ids; track 8: 2-8 keep 8, 9 new.
+  std::vector<int> id3, id8;
+  for (int k = 0; k < 10; ++k) {
+    id3.push_back(out.frames[k].observations[0].track_id);
+    EXPECT_DOUBLE_EQ(out.frames[k].observations[0].beta, 0.1 * k);
+    if (k >= 2) id8.push_back(out.frames[k].observations[1].track_id);
+  }
+  EXPECT_EQ(id3[0], 3);
+  EXPECT_EQ(id3[3], 3);
+  EXPECT_EQ(id3[4], id3[5]);
+  EXPECT_EQ(id3[6], id3[9]);
+  EXPECT_NE(id3[4], id3[6]);
+  EXPECT_GT(id3[4], 8);
+  EXPECT_GT(id3[6], 8);
+  EXPECT_EQ(id8[0], 8);
+  EXPECT_EQ(id8[6], 8);
+  EXPECT_GT(id8[7], 8);
+  EXPECT_NE(id8[7], id3[4]);
+  EXPECT_NE(id8[7], id3[6]);
+  EXPECT_EQ(origin.size(), 3u);
+  EXPECT_EQ(origin.at(id3[4]), 3);
+  EXPECT_EQ(origin.at(id3[6]), 3);
+  EXPECT_EQ(origin.at(id8[7]), 8);
+  EXPECT_EQ(split_tracks(run, {}).frames[5].observations[1].track_id, 8);
 }
 
 // Clean runs (no slip): splitting finds nothing to split, and the estimate is unchanged.

@@ -148,7 +148,7 @@ TEST(CalibrationFilter, OutlierBearingIsGated) {
   const Eigen::Matrix3d C = f.covariance();
   for (int i = 0; i < 3; ++i) EXPECT_LT(std::abs(e(i)), 3.5 * std::sqrt(C(i, i))) << i;
   // The refinement drops the three as well.
-  const FilterResult fr{f.extrinsics(), f.covariance(), f.history(), f.tracks()};
+  const FilterResult fr{f.extrinsics(), f.covariance(), f.history(), f.tracks(), f.splits()};
   const RefinementResult rr = refine_batch(run.run, o, batch_point_from_filter(run.run, o, fr));
   EXPECT_GE(rr.num_rejected, 3);
   const Eigen::Vector3d er = error(rr.extrinsics, run.truth);

@@ -133,16 +133,30 @@ RefinementResult refine_batch(const CalibrationRun& run,
 // docs/calib.md: one linearisation per frame while depth and camera yaw are both unknown.
 // Tracks with fewer than 2 bearings in the window are left out (they enter afterwards).
 // Outlying bearings are removed as in refine_batch.
-// `window_tracks` (optional) receives every track of the window's solution as (D, theta)
-// from the robot at its last window frame (frame = index in the window), with covariance:
-// tracks that ended inside the window never enter the state, and the refinement starts from
-// these.
+// Tracks that slipped onto a neighbouring line are split as in refine_batch
+// (options.split_chi2); the later part of such a track enters the state under the tracker's id.
 // Returns false (state untouched, reason in *why) when the window cannot be solved.
+struct BootstrapDetails {
+  // Every track of the window's solution as (D, theta) from the robot at its last window
+  // frame (frame = index in the window), with covariance: tracks that ended inside the window
+  // never enter the state, and the refinement starts from these. A split track: its latest
+  // part.
+  std::map<int, TrackEstimate> tracks;
+  std::vector<std::pair<int, int>> splits;  // (tracker's track id, window frame of the new part)
+};
 bool bootstrap_filter_state(const CalibrationRun& window,
                             const Options& options,
                             FilterState* state,
                             std::string* why = nullptr,
-                            std::map<int, TrackEstimate>* window_tracks = nullptr);
+                            BootstrapDetails* details = nullptr);
+
+// The run with tracks split at the given (tracker's track id, first frame of the new part)
+// pairs (RefinementResult::splits, FilterResult::splits): each part between consecutive split
+// frames of a track gets a new id, from one above the largest id of the run. `origin`
+// (optional) receives new id -> tracker's id.
+CalibrationRun split_tracks(const CalibrationRun& run,
+                            const std::vector<std::pair<int, int>>& splits,
+                            std::map<int, int>* origin = nullptr);
 
 // Verdict on one parameter (or combination) of the extrinsics.
 struct ParameterVerdict {

@@ -11,6 +11,7 @@
 //   Extrinsics ex = filter.extrinsics();  Eigen::Matrix3d C = filter.covariance();
 
 #include <map>
+#include <utility>
 #include <vector>
 
 #include "omnivert/calib/feature_initializer.hpp"
@@ -59,6 +60,9 @@ class CalibrationFilter {
   const FilterState& state() const { return state_; }
   const std::vector<FrameEstimate>& history() const { return history_; }
   const std::map<int, TrackEstimate>& tracks() const { return tracks_; }
+  // Tracks split in the bootstrap window (a track that slipped onto a neighbouring line):
+  // (tracker's track id, first frame of the new part); see split_tracks (batch.hpp).
+  const std::vector<std::pair<int, int>>& splits() const { return splits_; }
   int frames_processed() const { return frame_; }
   const Options& options() const { return options_; }
 
@@ -74,6 +78,7 @@ class CalibrationFilter {
   int frame_ = 0;
   std::vector<FrameEstimate> history_;
   std::map<int, TrackEstimate> tracks_;
+  std::vector<std::pair<int, int>> splits_;
   bool bootstrapping_ = false;
   CalibrationRun window_;
   double window_heading_ = 0.0;
@@ -86,6 +91,7 @@ struct FilterResult {
   Eigen::Matrix3d covariance;
   std::vector<FrameEstimate> history;
   std::map<int, TrackEstimate> tracks;
+  std::vector<std::pair<int, int>> splits;  // CalibrationFilter::splits
 };
 FilterResult run_filter(const CalibrationRun& run, const Options& options);
 

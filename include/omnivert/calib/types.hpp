@@ -101,6 +101,9 @@ struct Options {
   // Starts of the window's solve (1-5): the prior, then phi moved by -0.5, +0.5, -1 and +1 rad
   // (psi the other way), in that order; the lowest cost is kept (docs/calib.md).
   int bootstrap_starts = 5;
+  // Tracks that slipped onto a neighbouring line are split in the window's solve, with the
+  // refinement's test (BatchOptions::split_chi2, which has the same default); 0: off.
+  double split_chi2 = 20.0;
   // Updates.
   bool second_order_noise = true;   // add 1/2 tr(Hxx P Hxx P) to each bearing's variance
   int update_iterations = 3;        // 1: plain EKF; >1: iterated EKF (Gauss-Newton)
