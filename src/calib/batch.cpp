@@ -442,6 +442,39 @@ BatchPoint point_of(const Built& b) {
   return p;
 }
 
+// One round of track splitting: `found` (find_splits, ids of `current`) is added to `splits`
+// (tracker's ids, frames of the runs), the run is split again from `original` (split_tracks),
+// and `at`, keyed by the ids of `current`, is re-keyed to the new run's ids, each new part
+// starting where the part it came from was. Returns the new run; `origin` receives new id ->
+// tracker's id. (The refinement and the filter's window.)
+CalibrationRun split_round(const CalibrationRun& original,
+                           const CalibrationRun& current,
+                           const std::map<int, int>& found,
+                           std::vector<std::pair<int, int>>* splits,
+                           std::map<int, int>* origin,
+                           BatchPoint* at) {
+  for (const auto& [id, frame] : found) {
+    const auto it = origin->find(id);
+    splits->emplace_back(it != origin->end() ? it->second : id, frame);
+  }
+  std::map<int, int> next_origin;
+  CalibrationRun next = split_tracks(original, *splits, &next_origin);
+  // split_tracks only renames: observation i of frame k is the same bearing in both runs.
+  std::map<int, Eigen::Vector2d> features;
+  for (std::size_t k = 0; k < next.frames.size() && k < current.frames.size(); ++k) {
+    const auto& a = next.frames[k].observations;
+    const auto& c = current.frames[k].observations;
+    for (std::size_t i = 0; i < a.size() && i < c.size(); ++i) {
+      if (features.count(a[i].track_id)) continue;
+      const auto f = at->features.find(c[i].track_id);
+      if (f != at->features.end()) features[a[i].track_id] = f->second;
+    }
+  }
+  at->features = std::move(features);
+  *origin = std::move(next_origin);
+  return next;
+}
+
 }  // namespace
 
 bool noise_check_rejects_model(const BatchNoiseCheck& check, double level) {
@@ -516,26 +549,11 @@ RefinementResult refine_batch(const CalibrationRun& run,
   CalibrationRun split_run;
   std::map<int, int> origin;  // id given by a split -> the tracker's id
   for (int round = 0; batch.split_chi2 > 0.0 && round < batch.split_rounds; ++round) {
-    const std::map<int, int> splits = find_splits(b, batch);
-    if (splits.empty()) break;
-    const CalibrationRun& current = round == 0 ? run : split_run;
-    int next_id = 0;
-    for (const FrameInput& f : current.frames)
-      for (const BearingObservation& o : f.observations) next_id = std::max(next_id, o.track_id + 1);
-    CalibrationRun next = current;
+    const std::map<int, int> found = find_splits(b, batch);
+    if (found.empty()) break;
     BatchPoint at = point_of(b);
-    for (const auto& [id, first_frame] : splits) {
-      const int nid = next_id++;
-      for (std::size_t k = static_cast<std::size_t>(first_frame); k < next.frames.size(); ++k)
-        for (BearingObservation& o : next.frames[k].observations)
-          if (o.track_id == id) o.track_id = nid;
-      at.features[nid] = at.features.at(id);
-      const int tracker_id = origin.count(id) ? origin.at(id) : id;
-      origin[nid] = tracker_id;
-      res.splits.emplace_back(tracker_id, first_frame);
-    }
-    res.num_splits += static_cast<int>(splits.size());
-    split_run = std::move(next);
+    split_run = split_round(run, round == 0 ? run : split_run, found, &res.splits, &origin, &at);
+    res.num_splits += static_cast<int>(found.size());
     b = build(split_run, options, at, batch, batch.robust);
     ceres::Solve(so, b.problem.get(), &summary);
     reject_and_solve();
@@ -881,24 +899,11 @@ bool bootstrap_filter_state(const CalibrationRun& window,
   BatchOptions split_options;
   split_options.split_chi2 = options.split_chi2;
   for (int round = 0; options.split_chi2 > 0.0 && round < split_options.split_rounds; ++round) {
-    const std::map<int, int> splits = find_splits(b, split_options);
-    if (splits.empty()) break;
-    const CalibrationRun& current = round == 0 ? window : split_window;
-    int next_id = 0;
-    for (const FrameInput& f : current.frames)
-      for (const BearingObservation& o : f.observations) next_id = std::max(next_id, o.track_id + 1);
-    CalibrationRun next = current;
+    const std::map<int, int> found = find_splits(b, split_options);
+    if (found.empty()) break;
     BatchPoint at = point_of(b);
-    for (const auto& [id, from] : splits) {
-      const int nid = next_id++;
-      for (std::size_t k = static_cast<std::size_t>(from); k < next.frames.size(); ++k)
-        for (BearingObservation& o : next.frames[k].observations)
-          if (o.track_id == id) o.track_id = nid;
-      at.features[nid] = at.features.at(id);
-      origin[nid] = origin.count(id) ? origin.at(id) : id;
-      window_splits.emplace_back(origin[nid], from);
-    }
-    split_window = std::move(next);
+    split_window = split_round(window, round == 0 ? window : split_window, found, &window_splits,
+                               &origin, &at);
     index_tracks(split_window);
     b = build_window(split_window, at);
     if (b.features.empty()) return fail("no track with two bearings in the window");
