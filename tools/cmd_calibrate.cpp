@@ -50,6 +50,7 @@ struct CalibrateArgs {
   std::optional<double> odometry_inflation;
   double max_wheel_gap = 0.5;
   double split_chi2 = calib::BatchOptions{}.split_chi2;
+  double lateral_sigma = calib::BatchOptions{}.lateral_sigma;
   FeaturePipelineOptions pipeline;
   TrackerFlags tracker;
 };
@@ -77,6 +78,7 @@ void remove_if_exists(const std::filesystem::path& p) {
 calib::BatchOptions batch_options(const CalibrateArgs& a) {
   calib::BatchOptions b;
   b.split_chi2 = a.split_chi2;
+  b.lateral_sigma = a.lateral_sigma;
   return b;
 }
 
@@ -104,6 +106,7 @@ void run_calibrate(const CalibrateArgs& a) {
   if (a.bearing_sigma_deg) opt.bearing_sigma = deg2rad(*a.bearing_sigma_deg);
   if (a.odometry_inflation) opt.odometry_inflation = *a.odometry_inflation;
   opt.split_chi2 = a.split_chi2;
+  opt.lateral_sigma = a.lateral_sigma;
   if (!opt.IsValid(&why)) throw InputError("invalid calibration options: " + why);
 
   std::error_code ec;
@@ -310,6 +313,13 @@ void add_calibrate_command(CLI::App& app) {
                   "Factor on the Chong-Kleeman K of wheel0/sensor.yaml, eq. (31) (default 5, the "
                   "paper's)")
       ->check(kPositive)
+      ->group(gm);
+  cmd->add_option("--lateral-sigma", a->lateral_sigma,
+                  "Sideways slip per image step [m] allowed by the batch problems (the filter's "
+                  "window and the refinement); eq. (14) has none. docs/calib.md, \"The noise "
+                  "check\"")
+      ->check(kPositive)
+      ->capture_default_str()
       ->group(gm);
   cmd->add_option("--max-wheel-gap", a->max_wheel_gap,
                   "Wheel samples further apart than this [s] are a gap: the bearings of the "

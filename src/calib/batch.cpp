@@ -813,8 +813,10 @@ bool bootstrap_filter_state(const CalibrationRun& window,
 
   // The window's problem from a starting point: odometry and bearings, the priors on the
   // extrinsics (options.prior) and on each track's inverse depth along its first ray.
+  BatchOptions window_batch;
+  window_batch.lateral_sigma = options.lateral_sigma;
   auto build_window = [&](const CalibrationRun& w, const BatchPoint& start) {
-    Built b = build(w, opt, start, BatchOptions{}, /*robust=*/false);
+    Built b = build(w, opt, start, window_batch, /*robust=*/false);
     if (b.features.empty()) return b;
     b.problem->AddResidualBlock(
         new ceres::AutoDiffCostFunction<ExtrinsicsPrior, 3, 3>(

@@ -56,6 +56,7 @@ bool Options::IsValid(std::string* why) const {
     return fail(why, "need 2 <= bootstrap_min_frames <= bootstrap_max_frames");
   if (bootstrap_starts < 1 || bootstrap_starts > 5)
     return fail(why, "bootstrap_starts must be between 1 and 5");
+  if (!finite_positive(lateral_sigma)) return fail(why, "lateral_sigma must be > 0");
   if (!(split_chi2 >= 0.0 && std::isfinite(split_chi2)))
     return fail(why, "split_chi2 must be >= 0 and finite");
   if (!finite_positive(bootstrap_depth_prior_scale))

@@ -104,6 +104,9 @@ struct Options {
   // Tracks that slipped onto a neighbouring line are split in the window's solve, with the
   // refinement's test (BatchOptions::split_chi2, which has the same default); 0: off.
   double split_chi2 = 20.0;
+  // Sideways slip per step [m] in the window's odometry factors (BatchOptions::lateral_sigma,
+  // which has the same default).
+  double lateral_sigma = 1e-4;
   // Updates.
   bool second_order_noise = true;   // add 1/2 tr(Hxx P Hxx P) to each bearing's variance
   int update_iterations = 3;        // 1: plain EKF; >1: iterated EKF (Gauss-Newton)
