@@ -7,11 +7,13 @@
 //   calib_monte_carlo [--runs 50] [--sigma-deg 0.3] [--init anchored|inverse|naive]
 //                     [--inflation 5] [--iterations 3] [--trajectory paper|zigzag]
 //                     [--bootstrap RAD] [--refine] [--seed 1] [--correlation A]
+//                     [--lateral M]
 // --init anchored (default): anchored inverse depth + camera-pose extrinsics, with the batch
 //   window up to the first turn (--bootstrap, rad of rotation; 0: no window);
 // --init inverse: the paper's state eq. (28) with undelayed inverse-distance features;
 // --init naive: NOTES Sec. 5's naive initialisation.
 // --correlation A: AR(1) coefficient of each track's bearing errors from frame to frame.
+// --lateral M: sideways slip per step allowed by the batch problems (window, refinement).
 // Diagnostics (environment): PRIOR_AT_TRUTH=s (prior centred on truth, sigma s), PRIOR_SIGMA=s,
 // DMIN/DMAX (feature distance prior), CONVERT (convert_ratio), NO_SECOND_ORDER, VERBOSE.
 #include <Eigen/Cholesky>
@@ -96,6 +98,7 @@ int main(int argc, char** argv) {
   bool refine = false;
   double bootstrap = Options{}.bootstrap_rotation;
   double sigma_deg = 0.3, inflation = 5.0, correlation = 0.0;
+  double lateral = Options{}.lateral_sigma;
   std::string init = "anchored", trajectory = "paper";
   std::uint64_t seed = 1;
   for (int i = 1; i < argc; ++i) {
@@ -124,6 +127,8 @@ int main(int argc, char** argv) {
       refine = true;
     else if (!std::strcmp(argv[i], "--bootstrap"))
       bootstrap = std::atof(next());
+    else if (!std::strcmp(argv[i], "--lateral"))
+      lateral = std::atof(next());
     else if (!std::strcmp(argv[i], "--seed"))
       seed = std::strtoull(next(), nullptr, 10);
     else {
@@ -141,6 +146,7 @@ int main(int argc, char** argv) {
   fo.odometry_inflation = inflation;
   fo.bearing_sigma = so.bearing_sigma;
   fo.update_iterations = iterations;
+  fo.lateral_sigma = lateral;
   fo.feature_init = init == "naive"     ? FeatureInit::kNaive
                     : init == "inverse" ? FeatureInit::kInverseDistance
                                         : FeatureInit::kAnchoredInverseDepth;
@@ -171,7 +177,7 @@ int main(int argc, char** argv) {
     CalibrationResult cr;
     if (refine) {
       CalibrateOptions co{.refine = true};
-      if (const char* c = std::getenv("LATERAL")) co.batch.lateral_sigma = std::atof(c);  // diagnostics
+      co.batch.lateral_sigma = lateral;
       cr = calibrate(run.run, fo, co);
     }
     const FilterResult fr = refine ? cr.filter : run_filter(run.run, fo);
