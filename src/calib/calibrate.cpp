@@ -148,6 +148,15 @@ std::vector<std::string> result_warnings(const CalibrationResult& r) {
                   r.refined ? "" : " and run with --refine");
     out.emplace_back(buf);
   }
+  if (!r.filter.window_failure.empty()) {
+    std::snprintf(buf, sizeof(buf),
+                  "the filter's start-up window (%d frames, solved as a batch) could not be "
+                  "solved (%s); the filter ran over it from the prior, one frame at a time, and "
+                  "may be off by more than its sigma%s",
+                  r.filter.window_frames, r.filter.window_failure.c_str(),
+                  r.refined ? "; the refinement's answer is the one to trust" : ": run with --refine");
+    out.emplace_back(buf);
+  }
   if (r.noise_checked && r.noise.clusters >= 2) {
     // noise_check_rejects_model at its default level: under the model the check's scale is
     // about chi-square(G) / G over G tracks.

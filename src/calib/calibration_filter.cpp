@@ -80,6 +80,7 @@ void CalibrationFilter::finish() {
 void CalibrationFilter::end_bootstrap(FrameEstimate rec) {
   {
     bootstrapping_ = false;
+    window_frames_ = static_cast<int>(window_.frames.size());
     std::string why;
     BootstrapDetails details;
     if (bootstrap_filter_state(window_, options_, &state_, &why, &details)) {
@@ -99,7 +100,9 @@ void CalibrationFilter::end_bootstrap(FrameEstimate rec) {
       window_.frames.clear();
       return;
     }
-    // The window could not be solved: run the plain filter over it.
+    // The window could not be solved: run the plain filter over it (and say so: the plain
+    // filter from the rough prior can end millimetres off, result_warnings).
+    window_failure_ = why.empty() ? "unknown reason" : why;
     const int first = frame_ - static_cast<int>(window_.frames.size()) + 1;
     history_.resize(first);
     frame_ = first;
@@ -195,7 +198,7 @@ FilterResult run_filter(const CalibrationRun& run, const Options& options) {
   for (const FrameInput& f : run.frames) filter.process(f);
   filter.finish();
   return {filter.extrinsics(), filter.covariance(), filter.history(), filter.tracks(),
-          filter.splits()};
+          filter.splits(), filter.window_frames(), filter.window_failure()};
 }
 
 }  // namespace omnivert::calib

@@ -221,6 +221,9 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
     nlohmann::json sp = nlohmann::json::array();
     for (const auto& [track, frame] : r.filter.splits) sp.push_back({{"track_id", track}, {"frame", frame}});
     j["filter"]["tracks_split"] = r.filter.splits.size();
+    j["filter"]["window_frames"] = r.filter.window_frames;
+    j["filter"]["window_solved"] = r.filter.window_frames > 0 && r.filter.window_failure.empty();
+    if (!r.filter.window_failure.empty()) j["filter"]["window_failure"] = r.filter.window_failure;
     j["filter"]["splits"] = sp;
   }
   if (r.refined) {

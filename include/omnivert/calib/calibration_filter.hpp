@@ -11,6 +11,7 @@
 //   Extrinsics ex = filter.extrinsics();  Eigen::Matrix3d C = filter.covariance();
 
 #include <map>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -63,6 +64,10 @@ class CalibrationFilter {
   // Tracks split in the bootstrap window (a track that slipped onto a neighbouring line):
   // (tracker's track id, first frame of the new part); see split_tracks (batch.hpp).
   const std::vector<std::pair<int, int>>& splits() const { return splits_; }
+  // The bootstrap window: how many frames it held (0: none), and, when it could not be
+  // solved, why (the filter then ran over it from the prior, undelayed).
+  int window_frames() const { return window_frames_; }
+  const std::string& window_failure() const { return window_failure_; }
   int frames_processed() const { return frame_; }
   const Options& options() const { return options_; }
 
@@ -79,6 +84,8 @@ class CalibrationFilter {
   std::vector<FrameEstimate> history_;
   std::map<int, TrackEstimate> tracks_;
   std::vector<std::pair<int, int>> splits_;
+  int window_frames_ = 0;
+  std::string window_failure_;
   bool bootstrapping_ = false;
   CalibrationRun window_;
   double window_heading_ = 0.0;
@@ -92,6 +99,8 @@ struct FilterResult {
   std::vector<FrameEstimate> history;
   std::map<int, TrackEstimate> tracks;
   std::vector<std::pair<int, int>> splits;  // CalibrationFilter::splits
+  int window_frames = 0;                     // CalibrationFilter::window_frames
+  std::string window_failure;                // CalibrationFilter::window_failure
 };
 FilterResult run_filter(const CalibrationRun& run, const Options& options);
 
