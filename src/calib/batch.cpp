@@ -861,9 +861,8 @@ bool bootstrap_filter_state(const CalibrationRun& window,
   // phi moved by +-0.5 and +-1 rad (psi moved the other way, keeping the camera yaw, which the
   // bearings fix first); the start with the lowest cost is kept. Costs are compared before
   // outliers are removed, on the same residuals.
-  // The starts are independent problems and run in threads (hall zigzag, 2 cores: the
-  // filter 17.8 -> 10.6 s); the choice does not depend on their order of completion (lowest
-  // cost, ties to the earlier start).
+  // The starts are independent problems and run in threads; the choice does not depend on
+  // their order of completion (lowest cost, ties to the earlier start).
   Built b;
   bool have = false;
   double best_cost = std::numeric_limits<double>::infinity();
