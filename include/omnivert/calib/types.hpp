@@ -106,7 +106,7 @@ struct Options {
   double split_chi2 = 20.0;
   // Sideways slip per step [m] in the window's odometry factors (BatchOptions::lateral_sigma,
   // which has the same default).
-  double lateral_sigma = 1e-4;
+  double lateral_sigma = 1e-5;
   // Updates.
   bool second_order_noise = true;   // add 1/2 tr(Hxx P Hxx P) to each bearing's variance
   int update_iterations = 3;        // 1: plain EKF; >1: iterated EKF (Gauss-Newton)
