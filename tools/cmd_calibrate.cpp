@@ -316,8 +316,8 @@ void add_calibrate_command(CLI::App& app) {
       ->group(gm);
   cmd->add_option("--lateral-sigma", a->lateral_sigma,
                   "Sideways slip per image step [m] allowed by the batch problems (the filter's "
-                  "window and the refinement); eq. (14) has none. docs/calib.md, \"The noise "
-                  "check\"")
+                  "window and the refinement); eq. (14) has none. Raise it for a robot that "
+                  "slips sideways (docs/calib.md, \"lateral sigma\")")
       ->check(kPositive)
       ->capture_default_str()
       ->group(gm);
