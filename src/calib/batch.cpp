@@ -725,8 +725,9 @@ ObservabilityReport analyse_observability(const CalibrationRun& run,
     m << (bad.size() == 1 ? " is" : " are") << " not determined by this trajectory";
     if (rep.yaw.determined)
       m << " (the camera yaw phi + psi is, to " << rad2deg(rep.yaw.crlb)
-        << " deg): the camera position is not seen from a rotating robot. Add a turn in "
-           "place near features (1-3 m away), or alternate straights and turns (Sec. 8.1).";
+        << " deg): the camera's position on the robot shows only while the robot turns, and "
+           "this run did not turn enough. Add a turn in place near features (1-3 m away), or "
+           "alternate straights and turns (Sec. 8.1).";
     else
       m << ", not even the camera yaw phi + psi: drive a straight line with vertical lines "
            "around (a few meters away), then turn in place near them (Sec. 8.1).";
