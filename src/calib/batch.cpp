@@ -910,7 +910,8 @@ bool bootstrap_filter_state(const CalibrationRun& window,
   // Tracks that slipped onto a neighbouring line are split as in the refinement (find_splits,
   // options.split_chi2): where the window is most of the run (a zigzag never turns 1.5 rad
   // away from its start heading: office zigzag, 252 of 269 frames), the filter's estimate is
-  // the window's, and one slipped track biased it (docs/calib.md, "Splitting in the window").
+  // the window's, and one slipped track biased it (docs/calib.md, "Tracks that slipped onto a
+  // neighbouring line").
   // The later part of a split track gets a new id; `origin` maps it to the tracker's.
   CalibrationRun split_window;
   std::map<int, int> origin;
