@@ -379,8 +379,15 @@ std::string report_html(const CalibrationResult& r, const ReportInputs& in) {
                                       f("%.2f", std::sqrt(r.noise_ratio))
                                 : std::string("not more than the model allows, sigmas kept"))
          : std::string("not made"));
-  kv("filter's window", std::to_string(r.filter.splits.size()) +
-                           " tracks split where they changed line");
+  kv("filter's window",
+     r.filter.window_frames == 0
+         ? std::string("none")
+         : std::to_string(r.filter.window_frames) + " frames solved as a batch" +
+               (r.filter.window_failure.empty()
+                    ? ", " + std::to_string(r.filter.splits.size()) +
+                          " tracks split where they changed line"
+                    : std::string(": could not be solved (") + r.filter.window_failure +
+                          "), the filter ran over it from the prior"));
   if (r.refined)
     kv("refinement", std::string(r.refinement.converged ? "converged" : "did not converge") + ", " +
                          std::to_string(r.refinement.iterations) + " iterations, " +
