@@ -172,7 +172,7 @@ int main(int argc, char** argv) {
     so.seed = seed + r;
     const SyntheticRun run = make_synthetic_run(so);
     // With --refine, the tool's pipeline (calib::calibrate): the filter, the refinement, and
-    // the noise checks of the filter (its tracks unsplit) and of the refinement; the model's
+    // the noise checks of the filter (its tracks as its window split them) and of the refinement; the model's
     // covariances are kept aside. The filter is run once either way.
     CalibrationResult cr;
     if (refine) {

@@ -61,9 +61,9 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
   if (co.noise_check && r.observability.all_determined()) {
     // How large the errors really are, measured by the data (docs/calib.md, "The noise
     // check"): at a batch solution, the errors of each track summed before squaring. The
-    // filter is checked on its own tracks (unsplit: it treats a track that slipped onto a
-    // neighbouring line as one feature, and the check should see that), the refinement on
-    // the problem it solved (tracks split). A covariance is replaced by the checked one only
+    // filter is checked on its own tracks, split only where its window split them (after the
+    // window it treats a track that slipped onto a neighbouring line as one feature, and the
+    // check should see that), the refinement on the problem it solved (tracks split). A covariance is replaced by the checked one only
     // when the check shows more noise than the model allows (noise_check_rejects_model): with
     // 10-15 tracks one run's scale is uncertain, and applied always it made the refinement's
     // NEES worse where the model is right (synthetic 0.3 degree, 50 runs: 3.50 -> 5.18).

@@ -24,7 +24,8 @@ struct CalibrateOptions {
   // The data's check of the bearing noise (BatchNoiseCheck, at a batch solution): where it
   // rejects the model, the reported covariance becomes the checked one. The refinement's:
   // model + (scale - 1) x its bearing part. The filter's: scaled by the overall variance
-  // ratio of a check on its own (unsplit) tracks, a batch solved for the check alone.
+  // ratio of a check on its own tracks (split only where its window split them), a batch
+  // solved for the check alone.
   // false: no check, the model's covariances.
   bool noise_check = true;
   double noise_check_level = 0.01;  // of noise_check_rejects_model
@@ -49,7 +50,7 @@ struct CalibrationResult {
   // it rejected the model and the reported covariance is the checked one (the refinement's:
   // model + (scale - 1) x bearing part; the filter's: scaled by noise_ratio, the overall
   // variance ratio tr(model^-1 checked) / 3). filter_noise: the check of the filter on its own
-  // (unsplit) tracks, and the ratio its covariance was scaled by (1 when not). The model's
+  // tracks (split only where its window split them), and the ratio its covariance was scaled by (1 when not). The model's
   // covariances before any check are kept.
   bool noise_checked = false;
   bool noise_applied = false;
