@@ -50,8 +50,8 @@ struct CalibrationResult {
   // it rejected the model and the reported covariance is the checked one (the refinement's:
   // model + (scale - 1) x bearing part; the filter's: scaled by noise_ratio, the overall
   // variance ratio tr(model^-1 checked) / 3). filter_noise: the check of the filter on its own
-  // tracks (split only where its window split them), and the ratio its covariance was scaled by (1 when not). The model's
-  // covariances before any check are kept.
+  // tracks (split only where its window split them), and the ratio its covariance was scaled
+  // by (1 when not). The model's covariances before any check are kept.
   bool noise_checked = false;
   bool noise_applied = false;
   BatchNoiseCheck noise;
