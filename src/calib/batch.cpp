@@ -76,6 +76,25 @@ struct Built {
   std::vector<ceres::ResidualBlockId> odometry_blocks;
 };
 
+// Keeps the bearings for which keep(block, (track id, frame)) is true; the others leave the
+// problem's bookkeeping (the caller removes their residual blocks, or their parameter block).
+// Returns how many left.
+template <typename Keep>
+int filter_bearings(Built* b, Keep keep) {
+  std::vector<ceres::ResidualBlockId> kept;
+  std::vector<std::pair<int, int>> kept_keys;
+  for (std::size_t i = 0; i < b->bearing_blocks.size(); ++i) {
+    if (!keep(b->bearing_blocks[i], b->bearing_keys[i])) continue;
+    kept.push_back(b->bearing_blocks[i]);
+    kept_keys.push_back(b->bearing_keys[i]);
+  }
+  const int n = static_cast<int>(b->bearing_blocks.size() - kept.size());
+  b->num_bearings -= n;
+  b->bearing_blocks = std::move(kept);
+  b->bearing_keys = std::move(kept_keys);
+  return n;
+}
+
 // Removes the features left with fewer than `min_bearings` bearings (with their remaining
 // bearings and any prior on them): their information is singular. Measured: hall zigzag,
 // seed 1, every bearing of one track was an outlier in the filter's bootstrap window, whose
@@ -85,21 +104,13 @@ struct Built {
 int drop_unobserved_features(Built* b, int min_bearings) {
   std::map<int, int> count;
   for (const auto& [id, frame] : b->bearing_keys) ++count[id];
-  std::vector<int> drop;
+  std::set<int> drop;
   for (const auto& [id, f] : b->features)
-    if (count[id] < min_bearings) drop.push_back(id);
+    if (count[id] < min_bearings) drop.insert(id);
   if (drop.empty()) return 0;
-  const std::set<int> dropped(drop.begin(), drop.end());
-  std::vector<ceres::ResidualBlockId> kept;
-  std::vector<std::pair<int, int>> kept_keys;
-  for (std::size_t i = 0; i < b->bearing_blocks.size(); ++i) {
-    if (dropped.count(b->bearing_keys[i].first)) continue;
-    kept.push_back(b->bearing_blocks[i]);
-    kept_keys.push_back(b->bearing_keys[i]);
-  }
-  b->num_bearings -= static_cast<int>(b->bearing_blocks.size() - kept.size());
-  b->bearing_blocks = std::move(kept);
-  b->bearing_keys = std::move(kept_keys);
+  filter_bearings(b, [&](ceres::ResidualBlockId, const std::pair<int, int>& key) {
+    return !drop.count(key.first);
+  });
   for (int id : drop) {
     b->problem->RemoveParameterBlock(b->features.at(id).data());  // and its residual blocks
     b->features.erase(id);
@@ -111,24 +122,13 @@ int drop_unobserved_features(Built* b, int min_bearings) {
 // gate, in sigmas) at the current solution, then the features left with fewer than
 // `min_bearings` bearings (drop_unobserved_features). Returns how many bearings.
 int reject_outliers(Built* b, double threshold, int min_bearings) {
-  int n = 0;
-  std::vector<ceres::ResidualBlockId> kept;
-  std::vector<std::pair<int, int>> kept_keys;
-  for (std::size_t i = 0; i < b->bearing_blocks.size(); ++i) {
-    const ceres::ResidualBlockId id = b->bearing_blocks[i];
+  const int n = filter_bearings(b, [&](ceres::ResidualBlockId id, const std::pair<int, int>&) {
     double r = 0.0, cost = 0.0;
     b->problem->EvaluateResidualBlock(id, /*apply_loss_function=*/false, &cost, &r, nullptr);
-    if (!(std::abs(r) <= threshold)) {
-      b->problem->RemoveResidualBlock(id);
-      ++n;
-    } else {
-      kept.push_back(id);
-      kept_keys.push_back(b->bearing_keys[i]);
-    }
-  }
-  b->bearing_blocks = std::move(kept);
-  b->bearing_keys = std::move(kept_keys);
-  b->num_bearings -= n;
+    if (std::abs(r) <= threshold) return true;  // (false for NaN)
+    b->problem->RemoveResidualBlock(id);
+    return false;
+  });
   if (n > 0) drop_unobserved_features(b, min_bearings);
   return n;
 }
@@ -772,6 +772,27 @@ struct InverseDepthPrior {
   }
 };
 
+// Central differences of f (a smooth map of the window's variables) at v0, over the variables
+// `cols`: d f / d v(cols). Rows in `angle_rows` are angles and their differences are wrapped.
+template <typename F>
+Eigen::MatrixXd central_jacobian(const F& f,
+                                 const Eigen::VectorXd& v0,
+                                 const std::vector<int>& cols,
+                                 const std::vector<int>& angle_rows) {
+  constexpr double h = 1e-6;
+  Eigen::MatrixXd J;
+  for (std::size_t j = 0; j < cols.size(); ++j) {
+    Eigen::VectorXd vp = v0, vm = v0;
+    vp(cols[j]) += h;
+    vm(cols[j]) -= h;
+    Eigen::VectorXd d = f(vp) - f(vm);
+    for (int r : angle_rows) d(r) = wrap_angle(d(r));
+    if (j == 0) J.resize(d.size(), static_cast<Eigen::Index>(cols.size()));
+    J.col(static_cast<Eigen::Index>(j)) = d / (2 * h);
+  }
+  return J;
+}
+
 }  // namespace
 
 bool bootstrap_filter_state(const CalibrationRun& window,
@@ -999,23 +1020,15 @@ bool bootstrap_filter_state(const CalibrationRun& window,
     v0.segment<2>(feature_col[id]) = Eigen::Map<Eigen::Vector2d>(f.data());
   v0.segment<3>(ex_col) = Eigen::Map<Eigen::Vector3d>(b.ex.data());
   const Eigen::VectorXd s0 = state_of(v0);
-  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(ns, nv);  // central differences (smooth maps)
   std::vector<int> cols = {pose_col, pose_col + 1, pose_col + 2, ex_col, ex_col + 1, ex_col + 2};
   for (int id : ids) {
     cols.push_back(feature_col[id]);
     cols.push_back(feature_col[id] + 1);
   }
-  for (int c : cols) {
-    const double h = 1e-6;
-    Eigen::VectorXd vp = v0, vm = v0;
-    vp(c) += h;
-    vm(c) -= h;
-    Eigen::VectorXd d = state_of(vp) - state_of(vm);
-    for (std::size_t i = 0; i < ids.size(); ++i) d(4 * i + 2) = wrap_angle(d(4 * i + 2));
-    d(ns - 1) = wrap_angle(d(ns - 1));
-    T.col(c) = d / (2 * h);
-  }
-  const Eigen::MatrixXd Ps = T * Pv * T.transpose();
+  std::vector<int> angle_rows = {ns - 1};
+  for (std::size_t i = 0; i < ids.size(); ++i) angle_rows.push_back(4 * static_cast<int>(i) + 2);
+  const Eigen::MatrixXd T = central_jacobian(state_of, v0, cols, angle_rows);
+  const Eigen::MatrixXd Ps = T * Pv(cols, cols) * T.transpose();
   if (!s0.allFinite() || !Ps.allFinite()) return fail("window solution is not finite");
 
   if (details) {
@@ -1036,24 +1049,12 @@ bool bootstrap_filter_state(const CalibrationRun& window,
       };
       std::vector<int> dc = {feature_col[id], feature_col[id] + 1};
       if (pc >= 0) dc.insert(dc.end(), {pc, pc + 1, pc + 2});
-      Eigen::MatrixXd Jt(2, static_cast<int>(dc.size()));
-      for (std::size_t j = 0; j < dc.size(); ++j) {
-        const double h = 1e-6;
-        Eigen::VectorXd vp = v0, vm = v0;
-        vp(dc[j]) += h;
-        vm(dc[j]) -= h;
-        Eigen::Vector2d d = d_theta(vp) - d_theta(vm);
-        d(1) = wrap_angle(d(1));
-        Jt.col(static_cast<int>(j)) = d / (2 * h);
-      }
-      Eigen::MatrixXd Pd(dc.size(), dc.size());
-      for (std::size_t i = 0; i < dc.size(); ++i)
-        for (std::size_t j = 0; j < dc.size(); ++j) Pd(i, j) = Pv(dc[i], dc[j]);
+      const Eigen::MatrixXd Jt = central_jacobian(d_theta, v0, dc, {1});
       TrackEstimate t;
       t.track_id = tid;
       t.frame = k;
       t.D_theta = d_theta(v0);
-      t.covariance = Jt * Pd * Jt.transpose();
+      t.covariance = Jt * Pv(dc, dc) * Jt.transpose();
       t.num_updates = count[id];
       if (t.D_theta.allFinite() && t.covariance.allFinite()) (*window_tracks)[tid] = t;
     }
