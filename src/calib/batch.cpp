@@ -478,10 +478,13 @@ CalibrationRun split_round(const CalibrationRun& original,
 
 }  // namespace
 
+double noise_check_limit(int tracks, double level) {
+  return chi2_quantile(1.0 - level, tracks) / tracks;
+}
+
 bool noise_check_rejects_model(const BatchNoiseCheck& check, double level) {
   if (!check.ok || check.clusters < 2 || !(level > 0.0 && level < 0.5)) return false;
-  const int g = check.clusters;
-  return check.scale > chi2_quantile(1.0 - level, g) / g;
+  return check.scale > noise_check_limit(check.clusters, level);
 }
 
 std::vector<Eigen::Vector3d> dead_reckoning(const CalibrationRun& run, double wheel_base) {

@@ -161,14 +161,15 @@ std::vector<std::string> result_warnings(const CalibrationResult& r) {
     // noise_check_rejects_model at its default level: under the model the check's scale is
     // about chi-square(G) / G over G tracks.
     const int g = r.noise.clusters;
-    const double limit = chi2_quantile(0.99, g) / g;
-    if (r.noise.scale > limit) {
+    const double limit = noise_check_limit(g);
+    if (noise_check_rejects_model(r.noise)) {
       std::snprintf(buf, sizeof(buf), "To weight the bearings as the data say, run again with "
                     "--bearing-sigma %.3f", rad2deg(r.bearing_sigma * std::sqrt(r.noise.scale)));
       std::string remedy = buf;
       if (!r.refined)
         remedy += "; or add --refine, which splits tracks that slipped onto a neighbouring "
-                  "line (the filter treats each as one feature, which the check sees)";
+                  "line anywhere in the run (the filter splits them only in its start-up window "
+                  "and then treats each as one feature, which the check sees)";
       std::snprintf(buf, sizeof(buf),
                     "the bearings' errors, summed along each track, are larger than the bearing "
                     "sigma of %.3f deg allows (variance x%.2f over %d tracks; under the model "

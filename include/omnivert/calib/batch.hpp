@@ -90,6 +90,8 @@ struct BatchNoiseCheck {
 // pessimistic (corridor from pixels: scale 0.16, and the covariance shrunk by it gave NEES
 // 4.9). false when the check failed or has fewer than 2 tracks.
 bool noise_check_rejects_model(const BatchNoiseCheck& check, double level = 0.01);
+// The scale above which it does: the 1 - level quantile of chi-square(tracks) / tracks.
+double noise_check_limit(int tracks, double level = 0.01);
 
 struct RefinementResult {
   bool converged = false;
