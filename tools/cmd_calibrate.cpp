@@ -219,13 +219,8 @@ void run_calibrate(const CalibrateArgs& a) {
   std::printf("camera in the robot frame: x %.2f mm, y %.2f mm, yaw %.3f deg\n", p(0) * 1e3,
               p(1) * 1e3, rad2deg(e.yaw()));
   if (result.noise_checked)
-    std::printf("bearing sigma %.3f deg; noise check over %d tracks: the errors along the tracks "
-                "act as %.3f deg of independent noise (%s%.2f)\n",
-                rad2deg(result.bearing_sigma), result.noise.clusters,
-                rad2deg(result.bearing_sigma * std::sqrt(result.noise.scale)),
-                result.noise_applied ? "the model is rejected: sigmas above scaled by "
-                                     : "not more than the model allows: sigmas kept, variance x",
-                result.noise_applied ? std::sqrt(result.noise_ratio) : result.noise.scale);
+    std::printf("bearing sigma %.3f deg; %s\n", rad2deg(result.bearing_sigma),
+                calib::noise_check_line(result).c_str());
   else
     std::printf("bearing sigma %.3f deg (no noise check%s)\n", rad2deg(result.bearing_sigma),
                 a.noise_check ? ": the run does not determine the extrinsics" : "");

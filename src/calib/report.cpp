@@ -170,6 +170,20 @@ std::string f(const char* format, double v) {
 
 }  // namespace
 
+std::string noise_check_line(const CalibrationResult& r) {
+  if (!r.noise_checked) return {};
+  char buf[256];
+  std::snprintf(buf, sizeof(buf),
+                "noise check over %d tracks: the errors along the tracks act as %.3f deg of "
+                "independent noise (variance x%.2f; %s)",
+                r.noise.clusters, rad2deg(r.bearing_sigma * std::sqrt(r.noise.scale)),
+                r.noise.scale,
+                r.noise_applied ? f("the model is rejected: sigmas scaled by %.2f",
+                                    std::sqrt(r.noise_ratio)).c_str()
+                                : "not more than the model allows: sigmas kept");
+  return buf;
+}
+
 std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
   json j;
   j["tool"] = "omnivert calibrate";
@@ -370,15 +384,7 @@ std::string report_html(const CalibrationResult& r, const ReportInputs& in) {
      f("%.4f m", in.options.wheel_base) + " / " + f("%.3g m", in.options.odometry_K) + " (x" +
          f("%g", in.options.odometry_inflation) + ")");
   kv("bearing sigma", f("%.4f deg", rad2deg(r.bearing_sigma)));
-  kv("noise check",
-     r.noise_checked
-         ? std::to_string(r.noise.clusters) + " tracks: the errors along the tracks act as " +
-               f("%.4f deg", rad2deg(r.bearing_sigma * std::sqrt(r.noise.scale))) +
-               " of independent noise (variance x" + f("%.2f", r.noise.scale) + "); " +
-               (r.noise_applied ? "the model is rejected, sigmas scaled by " +
-                                      f("%.2f", std::sqrt(r.noise_ratio))
-                                : std::string("not more than the model allows, sigmas kept"))
-         : std::string("not made"));
+  kv("noise check", r.noise_checked ? noise_check_line(r) : std::string("not made"));
   kv("filter's window",
      r.filter.window_frames == 0
          ? std::string("none")

@@ -56,6 +56,11 @@ struct ReportInputs {
   bool wrote_extrinsics = false;
 };
 
+// One line on the noise check (docs/calib.md, "The noise check"), for the terminal and the
+// report: over how many tracks, the independent noise the errors act as, and what was done;
+// empty when no check was made.
+std::string noise_check_line(const CalibrationResult& result);
+
 // summary.json's text (pretty-printed JSON).
 std::string summary_json(const CalibrationResult& result, const ReportInputs& inputs);
 // report.html's text: refers to convergence.png and tracks.png next to it.
