@@ -170,6 +170,13 @@ std::string f(const char* format, double v) {
 
 }  // namespace
 
+// Track splits as [{"track_id", "frame"}]: the tracker's id and the first frame of the new part.
+nlohmann::json splits_json(const std::vector<std::pair<int, int>>& splits) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const auto& [track, frame] : splits) a.push_back({{"track_id", track}, {"frame", frame}});
+  return a;
+}
+
 std::string noise_check_line(const CalibrationResult& r) {
   if (!r.noise_checked) return {};
   char buf[256];
@@ -232,13 +239,11 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
   j["filter"] = extrinsics_json(r.filter.extrinsics, r.filter.covariance);
   {
     // Tracks split in the filter's bootstrap window (they slipped onto a neighbouring line).
-    nlohmann::json sp = nlohmann::json::array();
-    for (const auto& [track, frame] : r.filter.splits) sp.push_back({{"track_id", track}, {"frame", frame}});
     j["filter"]["tracks_split"] = r.filter.splits.size();
     j["filter"]["window_frames"] = r.filter.window_frames;
     j["filter"]["window_solved"] = r.filter.window_frames > 0 && r.filter.window_failure.empty();
     if (!r.filter.window_failure.empty()) j["filter"]["window_failure"] = r.filter.window_failure;
-    j["filter"]["splits"] = sp;
+    j["filter"]["splits"] = splits_json(r.filter.splits);
   }
   if (r.refined) {
     json ref = extrinsics_json(r.refinement.extrinsics, r.refinement.covariance);
@@ -250,9 +255,7 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
     ref["bearings_rejected"] = r.refinement.num_rejected;
     ref["tracks_split"] = r.refinement.num_splits;
     ref["features"] = r.refinement.num_features;
-    nlohmann::json sp = nlohmann::json::array();
-    for (const auto& [track, frame] : r.refinement.splits) sp.push_back({{"track_id", track}, {"frame", frame}});
-    ref["splits"] = sp;
+    ref["splits"] = splits_json(r.refinement.splits);
     ref["bearing_residual_sigma_deg"] = num(rad2deg(r.refinement.bearing_residual_sigma));
     ref["initial_cost"] = num(r.refinement.initial_cost);
     ref["final_cost"] = num(r.refinement.final_cost);
