@@ -51,6 +51,7 @@ struct CalibrateArgs {
   double max_wheel_gap = 0.5;
   double split_chi2 = calib::BatchOptions{}.split_chi2;
   double lateral_sigma = calib::BatchOptions{}.lateral_sigma;
+  double crossing_guard_deg = rad2deg(calib::Options{}.crossing_guard);
   FeaturePipelineOptions pipeline;
   TrackerFlags tracker;
 };
@@ -107,6 +108,7 @@ void run_calibrate(const CalibrateArgs& a) {
   if (a.odometry_inflation) opt.odometry_inflation = *a.odometry_inflation;
   opt.split_chi2 = a.split_chi2;
   opt.lateral_sigma = a.lateral_sigma;
+  opt.crossing_guard = deg2rad(a.crossing_guard_deg);
   if (!opt.IsValid(&why)) throw InputError("invalid calibration options: " + why);
 
   std::error_code ec;
@@ -271,6 +273,12 @@ void add_calibrate_command(CLI::App& app) {
                   "explain its bearings better than one by this likelihood-ratio statistic (a "
                   "track that slipped onto a neighbouring line); 0 turns splitting off")
       ->check(kNonNegative)
+      ->capture_default_str();
+  cmd->add_option("--crossing-guard", a->crossing_guard_deg,
+                  "Leave out a track's bearings while another line is predicted within this "
+                  "angle [degrees] of it (the extractor merges lines that close, and the "
+                  "bearing is pulled; docs/calib.md, \"Lines that cross\"); 0 turns it off")
+      ->check(CLI::Range(0.0, 20.0))
       ->capture_default_str();
   cmd->add_flag("!--no-noise-check", a->noise_check,
                 "Report the model's covariances as they are, without the data's check of the "

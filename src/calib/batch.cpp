@@ -2,6 +2,7 @@
 
 #include <ceres/ceres.h>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
@@ -29,9 +30,13 @@ namespace omnivert::calib {
 namespace {
 
 // Odometry factor between poses i and j = i + 1: eq. (14)-(15) inverted. The pose change
-// gives d_theta and, along the mid-step heading, d_rho; lateral motion must be zero.
+// gives d_theta and, along the mid-step heading, d_rho; the motion across it must be the
+// wheels' (FrameInput::lateral, 0 for one step of eq. 14).
+// The three residuals are whitened by W (W^T W = the inverse covariance of the wheels' step,
+// FrameInput::covariance_per_K, or diagonal for one step).
 struct OdometryResidual {
-  double d_right, d_left, e, inv_sigma_r, inv_sigma_l, inv_sigma_lat;
+  double d_right, d_left, lateral_measured, e;
+  Eigen::Matrix3d W;
   template <typename T>
   bool operator()(const T* pi, const T* pj, T* r) const {
     const T dth = pj[2] - pi[2];
@@ -42,9 +47,8 @@ struct OdometryResidual {
     const T lateral = -s * dx + c * dy;
     const T dR = d_rho + 0.5 * e * dth;  // eq. (15) solved for the wheels
     const T dL = d_rho - 0.5 * e * dth;
-    r[0] = (dR - d_right) * inv_sigma_r;
-    r[1] = (dL - d_left) * inv_sigma_l;
-    r[2] = lateral * inv_sigma_lat;
+    const T v[3] = {dR - d_right, dL - d_left, lateral - lateral_measured};
+    for (int i = 0; i < 3; ++i) r[i] = W(i, 0) * v[0] + W(i, 1) * v[1] + W(i, 2) * v[2];
     return true;
   }
 };
@@ -74,6 +78,7 @@ struct Built {
   std::vector<ceres::ResidualBlockId> bearing_blocks;
   std::vector<std::pair<int, int>> bearing_keys;  // (track id, frame) of each bearing block
   std::vector<ceres::ResidualBlockId> odometry_blocks;
+  std::vector<std::pair<int, int>> guarded;  // (track id, frame) left out by reject_crossings
 };
 
 // Keeps the bearings for which keep(block, (track id, frame)) is true; the others leave the
@@ -127,6 +132,67 @@ int reject_outliers(Built* b, double threshold, int min_bearings) {
     b->problem->EvaluateResidualBlock(id, /*apply_loss_function=*/false, &cost, &r, nullptr);
     if (std::abs(r) <= threshold) return true;  // (false for NaN)
     b->problem->RemoveResidualBlock(id);
+    return false;
+  });
+  if (n > 0) drop_unobserved_features(b, min_bearings);
+  return n;
+}
+
+// The crossing guard (Options::crossing_guard): removes the bearings of a feature at the
+// frames where another feature, over its track's span (first to last bearing) widened by
+// `margin` frames on each side, is predicted within `guard` of it as seen from the camera,
+// at the current solution. (The widening: a track often starts or ends where its line met
+// another, its detections given to the other track meanwhile; the tracker bridges gaps of
+// max_missed_frames, the margin used.) There the extractor
+// sees one line where there are two: the detection is pulled towards the other line, or
+// belongs to it (office paper, seed 9: track 3 pulled by up to 0.19 degree by lines passing
+// within 1 degree, and then split by the slip test although it never left its line;
+// docs/calib.md, "Lines that cross"). The bearings are not independent Gaussian errors about
+// the line there, which is what eq. (30) assumes. Then the features left with fewer than
+// `min_bearings` bearings go (drop_unobserved_features). Returns how many bearings; their
+// keys are added to b->guarded.
+int reject_crossings(Built* b,
+                     double guard,
+                     int margin,
+                     int min_bearings,
+                     const std::map<int, int>& origin) {
+  if (!(guard > 0.0) || b->features.empty()) return 0;
+  std::map<int, std::pair<int, int>> span;  // track id -> (first, last) frame
+  for (const auto& [id, k] : b->bearing_keys) {
+    auto [it, fresh] = span.emplace(id, std::make_pair(k, k));
+    it->second.first = std::min(it->second.first, k);
+    it->second.second = std::max(it->second.second, k);
+  }
+  // Per frame, the direction of each live feature from the camera centre (eq. 16-17).
+  const int frames = static_cast<int>(b->poses.size());
+  std::vector<std::vector<std::pair<double, int>>> seen(static_cast<std::size_t>(frames));
+  for (const auto& [id, f] : b->features) {
+    const auto it = span.find(id);
+    if (it == span.end()) continue;
+    const int from = std::max(it->second.first - margin, 0);
+    const int to = std::min(it->second.second + margin, frames - 1);
+    for (int k = from; k <= to; ++k) {
+      const auto& p = b->poses[static_cast<std::size_t>(k)];
+      const double xc = p[0] + b->ex[1] * std::cos(p[2] + b->ex[0]);
+      const double yc = p[1] + b->ex[1] * std::sin(p[2] + b->ex[0]);
+      seen[static_cast<std::size_t>(k)].emplace_back(std::atan2(f[1] - yc, f[0] - xc), id);
+    }
+  }
+  // Two parts of one split track are one line, not a crossing.
+  auto tracker = [&origin](int id) {
+    const auto it = origin.find(id);
+    return it != origin.end() ? it->second : id;
+  };
+  const auto same_line = [&tracker](int a, int c) { return tracker(a) == tracker(c); };
+  std::set<std::pair<int, int>> crossing;  // (track id, frame)
+  for (int k = 0; k < frames; ++k)
+    for (int id : crowded_directions(std::move(seen[static_cast<std::size_t>(k)]), guard, same_line))
+      crossing.emplace(id, k);
+  if (crossing.empty()) return 0;
+  const int n = filter_bearings(b, [&](ceres::ResidualBlockId id, const std::pair<int, int>& key) {
+    if (!crossing.count(key)) return true;
+    b->problem->RemoveResidualBlock(id);
+    b->guarded.push_back(key);
     return false;
   });
   if (n > 0) drop_unobserved_features(b, min_bearings);
@@ -407,15 +473,24 @@ Built build(const CalibrationRun& run,
   const double K = options.odometry_K * batch.odometry_inflation;
   for (std::size_t k = 1; k < run.frames.size(); ++k) {
     const FrameInput& f = run.frames[k];
-    const Mat2 Q =
-        chong_kleeman_covariance(f.d_right, f.d_left, K, options.odometry_variance_floor);
+    // Covariance of (d_right, d_left, lateral): eq. (31) over the frame's wheel samples
+    // (compose_wheel_steps), or over the frame as one step; with the side slip allowed
+    // (lateral_sigma) and the floor.
+    Eigen::Matrix3d S = Eigen::Matrix3d::Zero();
+    if (!f.covariance_per_K.isZero()) {
+      S = K * f.covariance_per_K;
+      S(0, 0) += options.odometry_variance_floor;
+      S(1, 1) += options.odometry_variance_floor;
+    } else {
+      S.topLeftCorner<2, 2>() =
+          chong_kleeman_covariance(f.d_right, f.d_left, K, options.odometry_variance_floor);
+    }
+    S(2, 2) += batch.lateral_sigma * batch.lateral_sigma;
+    // W = L^-1 with S = L L^T: W^T W = S^-1.
+    const Eigen::LLT<Eigen::Matrix3d> llt(S);
+    const Eigen::Matrix3d W = llt.matrixL().solve(Eigen::Matrix3d::Identity());
     auto* cost = new ceres::AutoDiffCostFunction<OdometryResidual, 3, 3, 3>(
-        new OdometryResidual{f.d_right,
-                             f.d_left,
-                             options.wheel_base,
-                             1.0 / std::sqrt(Q(0, 0)),
-                             1.0 / std::sqrt(Q(1, 1)),
-                             1.0 / batch.lateral_sigma});
+        new OdometryResidual{f.d_right, f.d_left, f.lateral, options.wheel_base, W});
     b.odometry_blocks.push_back(
         b.problem->AddResidualBlock(cost, nullptr, b.poses[k - 1].data(), b.poses[k].data()));
   }
@@ -492,7 +567,10 @@ std::vector<Eigen::Vector3d> dead_reckoning(const CalibrationRun& run, double wh
   poses.reserve(run.frames.size());
   Eigen::Vector3d p = Eigen::Vector3d::Zero();
   for (std::size_t k = 0; k < run.frames.size(); ++k) {
-    if (k > 0) p = integrate_pose(p, run.frames[k].d_right, run.frames[k].d_left, wheel_base);
+    if (k > 0) {
+      const FrameInput& f = run.frames[k];
+      p = integrate_pose_lateral(p, f.d_right, f.d_left, f.lateral, wheel_base);
+    }
     poses.push_back(p);
   }
   return poses;
@@ -537,7 +615,11 @@ RefinementResult refine_batch(const CalibrationRun& run,
   ceres::Solve(so, b.problem.get(), &summary);
   // Outlying bearings (false matches) out, at the filter's gate, then solve again.
   const double gate = std::sqrt(chi2_quantile(options.gate_probability, 1));
+  std::map<int, int> origin;  // id given by a split -> the tracker's id
   auto reject_and_solve = [&] {
+    // Bearings where lines cross out first (the outliers are judged without them).
+    if (reject_crossings(&b, options.crossing_guard, options.max_missed_frames, 2, origin) > 0)
+      ceres::Solve(so, b.problem.get(), &summary);
     res.num_rejected = 0;
     for (int round = 0; round < 3; ++round) {
       // Two bearings at least determine a feature point.
@@ -551,7 +633,6 @@ RefinementResult refine_batch(const CalibrationRun& run,
   // Tracks that slipped onto a neighbouring line are split in two and the problem is built
   // and solved again from the current solution (all bearings back in, outliers re-judged).
   CalibrationRun split_run;
-  std::map<int, int> origin;  // id given by a split -> the tracker's id
   for (int round = 0; batch.split_chi2 > 0.0 && round < batch.split_rounds; ++round) {
     const std::map<int, int> found = find_splits(b, batch);
     if (found.empty()) break;
@@ -563,6 +644,7 @@ RefinementResult refine_batch(const CalibrationRun& run,
     reject_and_solve();
   }
   if (res.num_splits > 0) res.split_run = std::move(split_run);
+  res.guarded = b.guarded;
   res.num_bearings = b.num_bearings;
   res.num_features = static_cast<int>(b.features.size());
   {
@@ -923,7 +1005,12 @@ bool bootstrap_filter_state(const CalibrationRun& window,
   }
   if (!have) return fail("window solve failed: " + summary.BriefReport());
   const double gate = std::sqrt(chi2_quantile(options.gate_probability, 1));
+  std::map<int, int> origin;  // id given by a split -> the tracker's id
   auto reject_and_solve = [&] {
+    if (reject_crossings(&b, options.crossing_guard, options.max_missed_frames, 1, origin) > 0) {
+      if (b.features.empty()) return;
+      ceres::Solve(so, b.problem.get(), &summary);
+    }
     for (int round = 0; round < 3; ++round) {
       // One bearing and the inverse-depth prior determine a feature point.
       if (reject_outliers(&b, gate, 1) == 0) break;
@@ -931,6 +1018,7 @@ bool bootstrap_filter_state(const CalibrationRun& window,
     }
   };
   reject_and_solve();
+  if (b.features.empty()) return fail("no track left in the window where lines do not cross");
   // Tracks that slipped onto a neighbouring line are split as in the refinement (find_splits,
   // options.split_chi2): where the window is most of the run (a zigzag never turns 1.5 rad
   // away from its start heading: office zigzag, 252 of 269 frames), the filter's estimate is
@@ -938,7 +1026,6 @@ bool bootstrap_filter_state(const CalibrationRun& window,
   // neighbouring line").
   // The later part of a split track gets a new id; `origin` maps it to the tracker's.
   CalibrationRun split_window;
-  std::map<int, int> origin;
   std::vector<std::pair<int, int>> window_splits;
   BatchOptions split_options;
   split_options.split_chi2 = options.split_chi2;
@@ -953,6 +1040,7 @@ bool bootstrap_filter_state(const CalibrationRun& window,
     if (b.features.empty()) return fail("no track with two bearings in the window");
     ceres::Solve(so, b.problem.get(), &summary);
     reject_and_solve();
+    if (b.features.empty()) return fail("no track left in the window where lines do not cross");
   }
   auto tracker_id = [&origin](int id) { return origin.count(id) ? origin.at(id) : id; };
   if (!summary.IsSolutionUsable()) return fail("window solve failed: " + summary.BriefReport());
@@ -1062,6 +1150,8 @@ bool bootstrap_filter_state(const CalibrationRun& window,
       if (t.D_theta.allFinite() && t.covariance.allFinite()) (*window_tracks)[tid] = t;
     }
     details->splits = window_splits;
+    details->guarded.clear();
+    for (const auto& [id, k] : b.guarded) details->guarded.emplace_back(tracker_id(id), k);
   }
 
   std::vector<FeatureSlot> slots;

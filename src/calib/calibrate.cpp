@@ -8,6 +8,7 @@
 #include <iomanip>
 #include <limits>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include <Eigen/Cholesky>
@@ -20,6 +21,23 @@
 namespace omnivert::calib {
 
 namespace {
+// The run without the given (track id, frame) bearings.
+CalibrationRun without_bearings(const CalibrationRun& run,
+                                const std::vector<std::pair<int, int>>& keys) {
+  if (keys.empty()) return run;
+  std::map<int, std::set<int>> by_frame;  // frame -> track ids
+  for (const auto& [id, k] : keys) by_frame[k].insert(id);
+  CalibrationRun out = run;
+  for (const auto& [k, ids] : by_frame) {
+    if (k < 0 || k >= static_cast<int>(out.frames.size())) continue;
+    auto& obs = out.frames[static_cast<std::size_t>(k)].observations;
+    obs.erase(std::remove_if(obs.begin(), obs.end(),
+                             [&ids](const BearingObservation& o) { return ids.count(o.track_id) > 0; }),
+              obs.end());
+  }
+  return out;
+}
+
 CalibrationResult calibrate_once(const CalibrationRun& run,
                                  const Options& options,
                                  const CalibrateOptions& co) {
@@ -36,16 +54,21 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
   lap("filter");
   const BatchPoint filter_point = batch_point_from_filter(run, options, r.filter);
   BatchPoint at = filter_point;
-  const CalibrationRun* analysed = &run;
+  // Sec. 8.1 on the bearings the estimate used: those left out where lines cross
+  // (Options::crossing_guard) do not follow eq. (30)'s model and carry no information the
+  // estimators use.
+  CalibrationRun analysed = without_bearings(run, r.filter.guarded);
   if (co.refine) {
     r.refinement = refine_batch(run, options, at, co.batch);
     r.refined = true;
     at = r.refinement.solution;
-    if (r.refinement.num_splits > 0) analysed = &r.refinement.split_run;  // the same problem
+    // The same problem (split where the refinement split the tracks).
+    analysed = without_bearings(r.refinement.num_splits > 0 ? r.refinement.split_run : run,
+                                r.refinement.guarded);
     lap("refinement");
   }
   // Sec. 8.1 at the best estimate of the trajectory, the features and the extrinsics.
-  r.observability = analyse_observability(*analysed, options, at, co.batch, co.observability);
+  r.observability = analyse_observability(analysed, options, at, co.batch, co.observability);
   lap("observability");
   if (r.refined && !r.refinement.covariance_ok && r.observability.all_determined() &&
       r.observability.crlb_covariance.allFinite()) {
@@ -264,14 +287,14 @@ void write_extrinsics_yaml(const std::string& path, const CalibrationResult& r) 
 
 void write_states_csv(const std::string& path, const std::vector<FrameEstimate>& history) {
   std::ostringstream s;
-  s << "frame,phi,rho,psi,sigma_phi,sigma_rho,sigma_psi,features,updates,rejected,new\n";
+  s << "frame,phi,rho,psi,sigma_phi,sigma_rho,sigma_psi,features,updates,rejected,new,guarded\n";
   s << std::setprecision(10);
   for (const FrameEstimate& h : history) {
     s << h.frame << "," << num(h.extrinsics.phi) << "," << num(h.extrinsics.rho) << ","
       << num(h.extrinsics.psi);
     for (int i = 0; i < 3; ++i) s << "," << num(std::sqrt(std::max(h.covariance(i, i), 0.0)));
     s << "," << h.num_features << "," << h.num_updates << "," << h.num_rejected << "," << h.num_new
-      << "\n";
+      << "," << h.num_guarded << "\n";
   }
   commit_file(path, s.str());
 }

@@ -7,6 +7,7 @@
 
 #include "omnivert/calib/batch.hpp"
 #include "omnivert/calib/model.hpp"
+#include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
 
 namespace omnivert::calib {
@@ -34,7 +35,7 @@ CalibrationFilter::CalibrationFilter(const Options& options)
 
 void CalibrationFilter::process(const FrameInput& frame) {
   const std::string where = "frame " + std::to_string(frame_);
-  if (!std::isfinite(frame.d_right) || !std::isfinite(frame.d_left))
+  if (!std::isfinite(frame.d_right) || !std::isfinite(frame.d_left) || !std::isfinite(frame.lateral))
     throw InputError(where + ": wheel travel is not a finite number");
   std::set<int> seen;
   for (const BearingObservation& o : frame.observations) {
@@ -90,6 +91,11 @@ void CalibrationFilter::end_bootstrap(FrameEstimate rec) {
         tracks_[id] = t;
       }
       for (const auto& [id, frame] : details.splits) splits_.emplace_back(id, frame + first);
+      for (const auto& [id, frame] : details.guarded) {
+        guarded_.emplace_back(id, frame + first);
+        const std::size_t k = static_cast<std::size_t>(frame + first);  // history_ ends before rec
+        ++(k < history_.size() ? history_[k].num_guarded : rec.num_guarded);
+      }
       rec.extrinsics = state_.extrinsics();
       rec.covariance = state_.extrinsics_covariance();
       rec.num_features = state_.num_features();
@@ -116,9 +122,24 @@ void CalibrationFilter::step(const FrameInput& frame) {
   FrameEstimate rec;
   rec.frame = frame_;
   // Prediction, eq. (29). (The first frame carries no travel; propagating zero is harmless.)
-  if (state_.num_features() > 0) propagator_.propagate(frame.d_right, frame.d_left, &state_);
+  if (state_.num_features() > 0) propagator_.propagate(frame, &state_);
 
   // Updates of the tracks already in the state, eq. (30), all bearings of the frame at once.
+  // The crossing guard (Options::crossing_guard): a feature whose predicted bearing (eq. 27)
+  // is within the guard of another feature's in the state (the other one's track seen
+  // within the last max_missed_frames frames) is not updated in this frame: the extractor
+  // merges the two lines there and the bearing is pulled towards the other one.
+  std::vector<char> crossing(static_cast<std::size_t>(state_.num_features()), 0);
+  if (options_.crossing_guard > 0.0 && state_.num_features() > 1) {
+    const Extrinsics ex = state_.extrinsics();
+    std::vector<std::pair<double, int>> pred;
+    for (int s = 0; s < state_.num_features(); ++s) {
+      const Eigen::Vector2d d = state_.feature_distance_form(s);
+      if (d.allFinite() && d(0) > 0.0) pred.emplace_back(predict_bearing(d(0), d(1), ex), s);
+    }
+    for (int s : crowded_directions(std::move(pred), options_.crossing_guard))
+      crossing[static_cast<std::size_t>(s)] = 1;
+  }
   std::vector<const BearingObservation*> fresh;
   std::vector<BearingMeasurement> z;
   for (const BearingObservation& o : frame.observations) {
@@ -128,6 +149,11 @@ void CalibrationFilter::step(const FrameInput& frame) {
       continue;
     }
     state_.mutable_slots()[slot].last_seen_frame = frame_;
+    if (crossing[static_cast<std::size_t>(slot)]) {
+      ++rec.num_guarded;
+      guarded_.emplace_back(o.track_id, frame_);
+      continue;
+    }
     z.push_back({slot, o.beta});
   }
   const std::vector<BearingUpdateResult> results = updater_.update(z, &state_);
@@ -198,7 +224,7 @@ FilterResult run_filter(const CalibrationRun& run, const Options& options) {
   for (const FrameInput& f : run.frames) filter.process(f);
   filter.finish();
   return {filter.extrinsics(), filter.covariance(), filter.history(), filter.tracks(),
-          filter.splits(), filter.window_frames(), filter.window_failure()};
+          filter.splits(), filter.window_frames(), filter.window_failure(), filter.guarded()};
 }
 
 }  // namespace omnivert::calib

@@ -1,5 +1,6 @@
 #include "omnivert/calib/model.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "omnivert/core/angles.hpp"
@@ -20,6 +21,56 @@ Eigen::Vector3d integrate_pose(const Eigen::Vector3d& pose,
   const Vec2 s = wheel_step(d_right, d_left, wheel_base);
   const double mid = pose(2) + 0.5 * s(1);
   return {pose(0) + s(0) * std::cos(mid), pose(1) + s(0) * std::sin(mid), pose(2) + s(1)};
+}
+
+Eigen::Vector3d integrate_pose_lateral(const Eigen::Vector3d& pose,
+                                       double d_right,
+                                       double d_left,
+                                       double lateral,
+                                       double wheel_base) {
+  Eigen::Vector3d p = integrate_pose(pose, d_right, d_left, wheel_base);
+  const double mid = pose(2) + 0.5 * (d_right - d_left) / wheel_base;
+  p(0) -= lateral * std::sin(mid);
+  p(1) += lateral * std::cos(mid);
+  return p;
+}
+
+namespace {
+// compose_wheel_steps over sample steps (right, left).
+Eigen::Vector3d compose_steps(const std::vector<Eigen::Vector2d>& steps, double wheel_base) {
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();  // in the robot frame of the first image
+  for (const Eigen::Vector2d& d : steps) p = integrate_pose(p, d(0), d(1), wheel_base);
+  const double mid = 0.5 * p(2), c = std::cos(mid), s = std::sin(mid);
+  const double along = c * p(0) + s * p(1), lateral = -s * p(0) + c * p(1);
+  return {along + 0.5 * wheel_base * p(2), along - 0.5 * wheel_base * p(2), lateral};
+}
+}  // namespace
+
+Eigen::Vector3d compose_wheel_steps(const std::vector<Eigen::Vector2d>& travel,
+                                    double wheel_base,
+                                    Eigen::Matrix3d* covariance_per_K) {
+  std::vector<Eigen::Vector2d> steps;  // (right, left) per sample step
+  for (std::size_t i = 1; i < travel.size(); ++i)
+    steps.emplace_back(travel[i](1) - travel[i - 1](1), travel[i](0) - travel[i - 1](0));
+  const Eigen::Vector3d out = compose_steps(steps, wheel_base);
+  if (covariance_per_K) {
+    // First order: sum over steps and wheels of J J^T |d| (central differences; the map is
+    // smooth and the steps millimetres, so h = 1e-7 m leaves errors near 1e-14).
+    Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
+    constexpr double h = 1e-7;
+    for (std::size_t i = 0; i < steps.size(); ++i)
+      for (int w = 0; w < 2; ++w) {
+        const double d = steps[i](w);
+        if (d == 0.0) continue;
+        std::vector<Eigen::Vector2d> a = steps, b = steps;
+        a[i](w) += h;
+        b[i](w) -= h;
+        const Eigen::Vector3d J = (compose_steps(a, wheel_base) - compose_steps(b, wheel_base)) / (2 * h);
+        C += std::abs(d) * J * J.transpose();
+      }
+    *covariance_per_K = C;
+  }
+  return out;
 }
 
 Vec2 propagate_feature(
@@ -280,6 +331,25 @@ Extrinsics extrinsics_from_camera_pose(const Vec3& cam, Mat3* J_ex_cam) {
         1;
   }
   return {phi, r, wrap_angle(cam(2) - phi)};
+}
+
+std::set<int> crowded_directions(std::vector<std::pair<double, int>> v,
+                                 double guard,
+                                 const std::function<bool(int, int)>& same_line) {
+  std::set<int> out;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t step = 1; step < n; ++step) {  // counter-clockwise until past the guard
+      const std::size_t j = (i + step) % n;
+      double d = v[j].first - v[i].first;
+      if (j < i) d += kTwoPi;  // the circle closed
+      if (!(d < guard)) break;
+      if (same_line && same_line(v[i].second, v[j].second)) continue;
+      out.insert(v[i].second);
+      out.insert(v[j].second);
+    }
+  return out;
 }
 
 }  // namespace omnivert::calib

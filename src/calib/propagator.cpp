@@ -1,8 +1,39 @@
 #include "omnivert/calib/propagator.hpp"
 
+#include <cmath>
+
 #include "omnivert/calib/model.hpp"
 
 namespace omnivert::calib {
+
+std::array<Eigen::Vector2d, 2> frame_steps(double d_right,
+                                           double d_left,
+                                           double lateral,
+                                           double wheel_base) {
+  const Eigen::Vector2d one(d_right, d_left), zero = Eigen::Vector2d::Zero();
+  const double e = wheel_base;
+  const double along = 0.5 * (d_right + d_left), turn = (d_right - d_left) / e;
+  // The displacement in the robot frame at the start: `along` the mid-step heading, `lateral`
+  // across it.
+  const double mid = 0.5 * turn, c = std::cos(mid), s = std::sin(mid);
+  Eigen::Vector2d t(c * along - s * lateral, s * along + c * lateral);
+  if (lateral == 0.0 || std::abs(lateral) > 0.5 * std::abs(along)) return {one, zero};
+  const double r = along < 0.0 ? -t.norm() : t.norm();  // backwards: r < 0
+  if (along < 0.0) t = -t;
+  // Second step: distance r with mid-step heading alpha + (turn - alpha) / 2 = psi, the
+  // direction of t; first: a turn in place by alpha = 2 psi - turn.
+  const double psi = std::atan2(t(1), t(0));
+  const double alpha = 2.0 * psi - turn;
+  const double rest = turn - alpha;
+  return {Eigen::Vector2d(0.5 * e * alpha, -0.5 * e * alpha),
+          Eigen::Vector2d(r + 0.5 * e * rest, r - 0.5 * e * rest)};
+}
+
+void Propagator::propagate(const FrameInput& frame, FilterState* state) const {
+  const auto steps = frame_steps(frame.d_right, frame.d_left, frame.lateral, options_.wheel_base);
+  propagate(steps[0](0), steps[0](1), state);
+  if (!steps[1].isZero()) propagate(steps[1](0), steps[1](1), state);
+}
 
 void Propagator::propagate(double d_right, double d_left, FilterState* state) const {
   const int n = state->dim();

@@ -244,6 +244,8 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
     j["filter"]["window_solved"] = r.filter.window_frames > 0 && r.filter.window_failure.empty();
     if (!r.filter.window_failure.empty()) j["filter"]["window_failure"] = r.filter.window_failure;
     j["filter"]["splits"] = splits_json(r.filter.splits);
+    // Bearings left out where lines cross (Options::crossing_guard), window and EKF.
+    j["filter"]["bearings_guarded"] = r.filter.guarded.size();
   }
   if (r.refined) {
     json ref = extrinsics_json(r.refinement.extrinsics, r.refinement.covariance);
@@ -253,6 +255,7 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
     ref["iterations"] = r.refinement.iterations;
     ref["bearings_used"] = r.refinement.num_bearings;
     ref["bearings_rejected"] = r.refinement.num_rejected;
+    ref["bearings_guarded"] = r.refinement.guarded.size();
     ref["tracks_split"] = r.refinement.num_splits;
     ref["features"] = r.refinement.num_features;
     ref["splits"] = splits_json(r.refinement.splits);
@@ -394,14 +397,18 @@ std::string report_html(const CalibrationResult& r, const ReportInputs& in) {
          : std::to_string(r.filter.window_frames) + " frames solved as a batch" +
                (r.filter.window_failure.empty()
                     ? ", " + std::to_string(r.filter.splits.size()) +
-                          " tracks split where they changed line"
+                          " tracks split where they changed line; " +
+                          std::to_string(r.filter.guarded.size()) +
+                          " bearings left out where lines cross (window and filter)"
                     : std::string(": could not be solved (") + r.filter.window_failure +
                           "), the filter ran over it from the prior"));
   if (r.refined)
     kv("refinement", std::string(r.refinement.converged ? "converged" : "did not converge") + ", " +
                          std::to_string(r.refinement.iterations) + " iterations, " +
                          std::to_string(r.refinement.num_bearings) + " bearings (" +
-                         std::to_string(r.refinement.num_rejected) + " rejected as outliers), " +
+                         std::to_string(r.refinement.num_rejected) + " rejected as outliers, " +
+                         std::to_string(r.refinement.guarded.size()) +
+                         " left out where lines cross), " +
                          std::to_string(r.refinement.num_splits) + " tracks split where they " +
                          "changed line");
   kv("time: tracking / calibration", f("%.1f s", in.seconds_tracking) + " / " + f("%.1f s", in.seconds_calibration));

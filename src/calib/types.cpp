@@ -66,6 +66,8 @@ bool Options::IsValid(std::string* why) const {
     return fail(why, "gate_probability must be in (0, 1]");
   if (max_missed_frames < 0) return fail(why, "max_missed_frames must be >= 0");
   if (min_track_length < 2) return fail(why, "min_track_length must be >= 2");
+  if (!(crossing_guard >= 0.0 && crossing_guard < 0.5))
+    return fail(why, "crossing_guard must be >= 0 and below 0.5 rad");
   return true;
 }
 

@@ -5,9 +5,11 @@
 
 #include <Eigen/Geometry>
 #include <functional>
+#include <set>
 #include <random>
 
 #include "omnivert/calib/model.hpp"
+#include "omnivert/calib/propagator.hpp"
 #include "omnivert/core/angles.hpp"
 
 namespace omnivert::calib {
@@ -274,6 +276,68 @@ TEST(Odometry, WheelStepAndChongKleeman) {
   p = integrate_pose(Eigen::Vector3d::Zero(), 0.25, -0.25, 0.5);  // pure turn of 1 rad
   EXPECT_NEAR(p.head<2>().norm(), 0.0, 1e-15);
   EXPECT_NEAR(p(2), 1.0, 1e-15);
+}
+
+// The crossing guard's test: directions within the guard of another, the circle closed at
+// +-pi, a chain counted pair by pair, two parts of one line not a crossing.
+TEST(CrowdedDirections, FindsTheDirectionsWithANeighbourWithinTheGuard) {
+  const double g = deg2rad(1.0);
+  const std::vector<std::pair<double, int>> v = {
+      {deg2rad(10.0), 1}, {deg2rad(10.9), 2},    // a pair
+      {deg2rad(50.0), 3},                        // alone
+      {deg2rad(179.7), 4}, {deg2rad(-179.8), 5},  // across +-180
+      {deg2rad(90.0), 6}, {deg2rad(90.6), 7}, {deg2rad(91.2), 8},  // a chain: 6-7, 7-8
+      {deg2rad(-30.0), 9}, {deg2rad(-29.5), 10}};                  // one split line
+  const std::set<int> out = crowded_directions(v, g, [](int a, int b) {
+    return std::min(a, b) == 9 && std::max(a, b) == 10;
+  });
+  EXPECT_EQ(out, (std::set<int>{1, 2, 4, 5, 6, 7, 8}));
+  EXPECT_EQ(crowded_directions(v, g).count(9), 1u);
+  EXPECT_TRUE(crowded_directions(v, 0.0).empty());
+  EXPECT_TRUE(crowded_directions({{0.0, 1}}, g).empty());
+}
+
+// A frame's motion from its wheel samples (compose_wheel_steps): one step of eq. (14) plus a
+// sideways displacement gives the pose the samples give, and so do the filter's two steps
+// (frame_steps), a turn in place and a step of eq. (14).
+TEST(FrameMotion, ComposedWheelStepsAndTheFiltersTwoStepsGiveThePose) {
+  const double e = 0.4;
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  double max_lateral = 0.0;
+  for (int trial = 0; trial < 200; ++trial) {
+    // A straight that turns within the frame, or random speeds, over 17 samples.
+    std::vector<Eigen::Vector2d> travel = {Eigen::Vector2d(u(rng), u(rng))};
+    const bool straight_then_turn = trial % 2 == 0;
+    const double v = 0.003 * u(rng), w = 0.006 * u(rng);
+    for (int i = 0; i < 17; ++i) {
+      Eigen::Vector2d d = straight_then_turn ? (i < 9 ? Eigen::Vector2d(v, v) : Eigen::Vector2d(w, -w))
+                                             : Eigen::Vector2d(0.003 * u(rng), 0.003 * u(rng));
+      travel.push_back(travel.back() + d);  // (left, right)
+    }
+    Eigen::Vector3d direct = Eigen::Vector3d(0.3, -0.2, 0.7);
+    const Eigen::Vector3d start = direct;
+    for (std::size_t i = 1; i < travel.size(); ++i)
+      direct = integrate_pose(direct, travel[i](1) - travel[i - 1](1),
+                              travel[i](0) - travel[i - 1](0), e);
+    const Eigen::Vector3d m = compose_wheel_steps(travel, e);
+    const Eigen::Vector3d composed = integrate_pose_lateral(start, m(0), m(1), m(2), e);
+    EXPECT_LT((composed - direct).norm(), 1e-12) << "trial " << trial;
+    // The total turn is the wheels' (eq. 15).
+    const Eigen::Vector2d total = travel.back() - travel.front();
+    EXPECT_NEAR((m(0) - m(1)) / e, (total(1) - total(0)) / e, 1e-12);
+    const auto steps = frame_steps(m(0), m(1), m(2), e);
+    Eigen::Vector3d two = integrate_pose(start, steps[0](0), steps[0](1), e);
+    two = integrate_pose(two, steps[1](0), steps[1](1), e);
+    if (std::abs(m(2)) <= 0.5 * std::abs(0.5 * (m(0) + m(1))))
+      EXPECT_LT((two - direct).norm(), 1e-12) << "trial " << trial;
+    max_lateral = std::max(max_lateral, std::abs(m(2)));
+  }
+  EXPECT_GT(max_lateral, 1e-4);  // the test has sideways steps to compose
+  // No sideways displacement: one step, as given.
+  const auto one = frame_steps(0.02, 0.01, 0.0, e);
+  EXPECT_EQ(one[0], Eigen::Vector2d(0.02, 0.01));
+  EXPECT_TRUE(one[1].isZero());
 }
 
 }  // namespace

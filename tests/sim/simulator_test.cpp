@@ -15,9 +15,12 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "omnivert/calib/batch.hpp"
+#include "omnivert/calib/dataset_run.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
 #include "omnivert/dataset/dataset.hpp"
+#include "omnivert/match/tracks_io.hpp"
 #include "omnivert/sim/simulator.hpp"
 
 namespace omnivert::sim {
@@ -124,6 +127,41 @@ TEST_F(SimulatorTest, WheelTravelIntegratesToTheGroundTruthPoses) {
     ASSERT_GE(l.r_inner, cfg.camera.r_min - 1e-3);
     ASSERT_LE(l.r_outer, cfg.camera.r_max + 1e-3);
   }
+
+  // What the calibration sees (calib::calibration_run_from_tracks, the ground truth's lines as
+  // tracks): one step per frame, composed from the wheel samples between the images, with its
+  // sideways displacement (FrameInput::lateral). Dead-reckoned, it gives the ground-truth
+  // poses; eq. (14) once per frame does not (frame 61 ends the straight and starts the turn).
+  std::vector<TrackRow> rows;
+  for (const auto& l : gt.lines) {
+    TrackRow r;
+    r.frame = l.frame;
+    r.timestamp_ns = d.images()[static_cast<std::size_t>(l.frame)].timestamp_ns;
+    r.track_id = l.line_id;
+    r.bearing = r.image_angle = l.bearing;
+    rows.push_back(r);
+  }
+  const calib::DatasetRun run = calib::calibration_run_from_tracks(d, rows);
+  const std::vector<Eigen::Vector3d> dr = calib::dead_reckoning(run.run, e);
+  calib::CalibrationRun one_step = run.run;
+  for (calib::FrameInput& f : one_step.frames) f.lateral = 0.0;
+  const std::vector<Eigen::Vector3d> dr1 = calib::dead_reckoning(one_step, e);
+  double max_run = 0, max_one = 0, max_lateral = 0;
+  const auto& g0 = gt.poses[0];
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    // The ground truth in the robot frame of the first image.
+    const double dx = gt.poses[i].x - g0.x, dy = gt.poses[i].y - g0.y;
+    const Eigen::Vector2d g(std::cos(g0.theta) * dx + std::sin(g0.theta) * dy,
+                            -std::sin(g0.theta) * dx + std::cos(g0.theta) * dy);
+    max_run = std::max(max_run, (dr[i].head<2>() - g).norm());
+    max_one = std::max(max_one, (dr1[i].head<2>() - g).norm());
+    max_lateral = std::max(max_lateral, std::abs(run.run.frames[i].lateral));
+  }
+  std::printf("dead reckoning of the calibration's frames: max %.2e m (eq. 14 once per frame: "
+              "%.2e m; largest sideways step %.2e m)\n", max_run, max_one, max_lateral);
+  EXPECT_LT(max_run, 1e-5);
+  EXPECT_GT(max_one, 4e-4);
+  EXPECT_NEAR(max_lateral, 4.75e-4, 1e-5);
 }
 
 TEST(Presets, EveryTrajectoryPresetFitsEveryWorldPreset) {

@@ -107,6 +107,9 @@ struct RefinementResult {
   int num_features = 0;  // tracks in the problem (after splitting)
   int num_splits = 0;    // tracks split in two (BatchOptions::split_chi2)
   std::vector<std::pair<int, int>> splits;  // (tracker's track id, first frame of the new part)
+  // Bearings left out where lines cross (Options::crossing_guard): (track id of the solved
+  // run, i.e. of split_run when tracks were split, frame).
+  std::vector<std::pair<int, int>> guarded;
   CalibrationRun split_run;  // with splits: the run `solution` refers to (split parts renamed)
   // Scale of the bearing residuals at the solution, outliers removed [rad]: 1.4826 x median
   // |residual| x sqrt(bearings / (bearings - 2 features - 3)); the bearing noise the data
@@ -146,6 +149,8 @@ struct BootstrapDetails {
   // part.
   std::map<int, TrackEstimate> tracks;
   std::vector<std::pair<int, int>> splits;  // (tracker's track id, window frame of the new part)
+  std::vector<std::pair<int, int>> guarded;  // (tracker's track id, window frame) left out
+                                             // where lines cross (Options::crossing_guard)
 };
 bool bootstrap_filter_state(const CalibrationRun& window,
                             const Options& options,

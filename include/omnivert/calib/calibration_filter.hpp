@@ -32,6 +32,7 @@ struct FrameEstimate {
   int num_updates = 0;   // bearings used
   int num_rejected = 0;  // bearings refused by the chi-square gate
   int num_new = 0;       // tracks that entered
+  int num_guarded = 0;   // bearings left out where lines cross (Options::crossing_guard)
 };
 
 // The last estimate of a track while it was in the state: (D, theta) relative to the robot
@@ -68,6 +69,9 @@ class CalibrationFilter {
   // solved, why (the filter then ran over it from the prior, undelayed).
   int window_frames() const { return window_frames_; }
   const std::string& window_failure() const { return window_failure_; }
+  // Bearings left out where lines cross (Options::crossing_guard), in the window and after:
+  // (tracker's track id, frame).
+  const std::vector<std::pair<int, int>>& guarded() const { return guarded_; }
   int frames_processed() const { return frame_; }
   const Options& options() const { return options_; }
 
@@ -84,6 +88,7 @@ class CalibrationFilter {
   std::vector<FrameEstimate> history_;
   std::map<int, TrackEstimate> tracks_;
   std::vector<std::pair<int, int>> splits_;
+  std::vector<std::pair<int, int>> guarded_;
   int window_frames_ = 0;
   std::string window_failure_;
   bool bootstrapping_ = false;
@@ -101,6 +106,7 @@ struct FilterResult {
   std::vector<std::pair<int, int>> splits;  // CalibrationFilter::splits
   int window_frames = 0;                     // CalibrationFilter::window_frames
   std::string window_failure;                // CalibrationFilter::window_failure
+  std::vector<std::pair<int, int>> guarded;  // CalibrationFilter::guarded
 };
 FilterResult run_filter(const CalibrationRun& run, const Options& options);
 

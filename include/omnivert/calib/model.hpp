@@ -8,6 +8,10 @@
 // (-D cos theta, D sin theta).
 
 #include <Eigen/Core>
+#include <functional>
+#include <set>
+#include <utility>
+#include <vector>
 
 #include "omnivert/calib/types.hpp"
 
@@ -20,6 +24,27 @@ using Mat23 = Eigen::Matrix<double, 2, 3>;
 
 // Eq. (15): d_rho = (d_R + d_L) / 2, d_theta = (d_R - d_L) / e. Returns (d_rho, d_theta).
 Vec2 wheel_step(double d_right, double d_left, double wheel_base, Mat2* J_step_wheels = nullptr);
+
+// Eq. (14) over many wheel samples between two images: `travel` holds the cumulative
+// (left, right) wheel travel at the first image, at each wheel sample between, and at the
+// second image; each sample-to-sample step is integrated by eq. (14) and the composed motion
+// is returned as one step of eq. (14) plus a sideways displacement: (d_right, d_left,
+// lateral) with d_theta = (d_right - d_left) / e the total turn and the displacement
+// (d_right + d_left) / 2 along, `lateral` across, the mid-step heading (FrameInput). Exact
+// where the wheels change speed within the frame (a straight that ends in a turn), which
+// one step of eq. (14) over the frame is not.
+// With `covariance_per_K`, the covariance of the result per unit K when each sample step of
+// each wheel has the noise of eq. (31), variance K |d| (first order).
+Eigen::Vector3d compose_wheel_steps(const std::vector<Eigen::Vector2d>& travel,
+                                    double wheel_base,
+                                    Eigen::Matrix3d* covariance_per_K = nullptr);
+
+// Eq. (14) with the sideways displacement of compose_wheel_steps (FrameInput::lateral).
+Eigen::Vector3d integrate_pose_lateral(const Eigen::Vector3d& pose,
+                                       double d_right,
+                                       double d_left,
+                                       double lateral,
+                                       double wheel_base);
 
 // Eq. (14): pose (x, y, theta) after one odometry step (midpoint heading).
 Eigen::Vector3d integrate_pose(const Eigen::Vector3d& pose,
@@ -140,5 +165,12 @@ Vec2 point_to_distance_form(const Vec2& p, Mat2* J_out_p = nullptr);
 // Camera pose (c_x, c_y, eta) <-> extrinsics (phi, rho, psi).
 Vec3 camera_pose_from_extrinsics(const Extrinsics& ex, Mat3* J_cam_ex = nullptr);
 Extrinsics extrinsics_from_camera_pose(const Vec3& cam, Mat3* J_ex_cam = nullptr);
+
+// The crossing guard's test (Options::crossing_guard): of directions (angle [rad], key), the
+// keys with another direction within `guard` of theirs on the circle; a pair for which
+// same_line(key_a, key_b) is true does not count (two parts of one split track).
+std::set<int> crowded_directions(std::vector<std::pair<double, int>> directions,
+                                 double guard,
+                                 const std::function<bool(int, int)>& same_line = {});
 
 }  // namespace omnivert::calib

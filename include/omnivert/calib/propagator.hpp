@@ -4,6 +4,10 @@
 //   X' = f(X, u),  P' = F_x P F_x^T + F_u Q F_u^T,  Q = diag(K' |d_R|, K' |d_L|),
 // with K' = K * inflation (the paper inflates K five-fold).
 
+#include <array>
+
+#include <Eigen/Core>
+
 #include "omnivert/calib/filter_state.hpp"
 #include "omnivert/calib/types.hpp"
 
@@ -14,9 +18,23 @@ class Propagator {
   explicit Propagator(const Options& options) : options_(options) {}
   // One odometry step of wheel travels (d_right, d_left) [m].
   void propagate(double d_right, double d_left, FilterState* state) const;
+  // One frame's motion (FrameInput: wheel travels and sideways displacement). With a
+  // sideways displacement the motion is made of two steps of eq. (29), a turn in place and
+  // a step of eq. (14), that compose to it exactly (frame_steps).
+  void propagate(const FrameInput& frame, FilterState* state) const;
 
  private:
   Options options_;
 };
+
+// The two steps of eq. (14), (d_right, d_left) each, that compose to one step with the
+// sideways displacement `lateral` (FrameInput::lateral): a turn in place by alpha, then a
+// step whose mid-step heading points along the displacement. When lateral is 0, or the
+// displacement too short to give it a direction, the first is the step itself and the
+// second zero.
+std::array<Eigen::Vector2d, 2> frame_steps(double d_right,
+                                           double d_left,
+                                           double lateral,
+                                           double wheel_base);
 
 }  // namespace omnivert::calib

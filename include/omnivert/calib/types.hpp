@@ -39,6 +39,17 @@ struct BearingObservation {
 struct FrameInput {
   double d_right = 0.0;  // right wheel travel since the previous frame [m]
   double d_left = 0.0;   // left wheel travel since the previous frame [m]
+  // Sideways displacement over the step [m], perpendicular to the mid-step heading, that
+  // eq. (14) applied once per image cannot give: the wheel samples between two images, each
+  // integrated by eq. (14), compose to a motion that can have it (a straight that turns
+  // within the frame: simulator, paper trajectory, frame 61, 0.47 mm). 0 from a single step.
+  double lateral = 0.0;
+  // Covariance of (d_right, d_left, lateral) per unit Chong-Kleeman K (eq. 31 applied to each
+  // wheel sample, compose_wheel_steps): the sideways displacement composed from noisy samples
+  // is noisy too (a heading error early in the frame moves the robot sideways later; about
+  // 0.02 mm per frame on the simulator's straights). Zero: one step, diag(|d_right|, |d_left|)
+  // and no sideways noise.
+  Eigen::Matrix3d covariance_per_K = Eigen::Matrix3d::Zero();
   std::vector<BearingObservation> observations;
 };
 
@@ -113,6 +124,11 @@ struct Options {
   double gate_probability = 0.999;  // chi-square gate of each bearing (1 dof); 1: no gate
   int max_missed_frames = 20;       // a track not seen for this many frames has ended
   int min_track_length = 3;         // batch/observability: shorter tracks are ignored
+  // Crossing guard [rad]: a bearing is not used while another feature's predicted bearing
+  // is within this angle of its own (filter: features in the state; batches: tracks over
+  // their span). The extractor merges two lines that close into one detection, whose
+  // bearing is pulled towards the other line (docs/calib.md, "Lines that cross"); 0: off.
+  double crossing_guard = 1.0 * 3.14159265358979323846 / 180.0;
 
   // True when usable; otherwise false with the reason in *why (may be null).
   bool IsValid(std::string* why) const;
