@@ -242,7 +242,7 @@ TEST(CrossingGuard, MergedDetectionsAreLeftOutAndDoNotMoveTheEstimate) {
   for (int s = 1; s <= runs; ++s) {
     so.seed = 300 + s;
     const SyntheticRun clean = make_synthetic_run(so);
-    const SyntheticRun run = merge_crossings(clean, deg2rad(0.4), deg2rad(1.0), 0.1);
+    const SyntheticRun run = merge_crossings(clean, deg2rad(0.4), Options{}.crossing_guard, 0.2);
     Options o = options_for(so);
     const RefinementResult on = refine_batch(run.run, o, truth_point(run));
     const RefinementResult on_clean = refine_batch(clean.run, o, truth_point(clean));
@@ -257,7 +257,7 @@ TEST(CrossingGuard, MergedDetectionsAreLeftOutAndDoNotMoveTheEstimate) {
     guarded += static_cast<int>(on.guarded.size());
     bearings += off.num_bearings;
     // Known geometry, known answer: a bearing is left out where another feature's true
-    // bearing is within the guard (to 0.2 degree: the guard judges at the estimate, whose
+    // bearing is within the guard (0.75 degree; to 0.2 degree: the guard judges at the estimate, whose
     // features are a few millimetres off; measured up to 0.15), that feature's track seen
     // within max_missed_frames.
     std::map<int, std::pair<int, int>> span;
@@ -286,9 +286,10 @@ TEST(CrossingGuard, MergedDetectionsAreLeftOutAndDoNotMoveTheEstimate) {
     EXPECT_EQ(wrong, 0) << "seed " << so.seed;
   }
   // Guarded, the merged run's estimate is the clean run's to a small fraction of its sigma
-  // (measured 0.02); unguarded, it moves (measured 0.59).
-  EXPECT_LT(moved_on, 0.1);
-  EXPECT_GT(moved_off, 0.3);
+  // (measured 0.023); unguarded, it moves (measured 0.213).
+  EXPECT_LT(moved_on, 0.05);
+  EXPECT_GT(moved_off, 0.15);
+  EXPECT_GT(moved_off, 4.0 * moved_on);
   RecordProperty("moved_on", std::to_string(moved_on));
   RecordProperty("moved_off", std::to_string(moved_off));
   std::printf("guarded %d of %d bearings; shift from the clean run: guard %.3f, none %.3f\n",
@@ -312,7 +313,7 @@ TEST(CrossingGuard, TheFilterLeavesOutMergedDetections) {
   for (int s = 1; s <= runs; ++s) {
     so.seed = 300 + s;
     const SyntheticRun clean = make_synthetic_run(so);
-    const SyntheticRun run = merge_crossings(clean, deg2rad(0.4), deg2rad(1.0), 0.1);
+    const SyntheticRun run = merge_crossings(clean, deg2rad(0.4), Options{}.crossing_guard, 0.2);
     Options o = options_for(so);
     const FilterResult on = run_filter(run.run, o), on_clean = run_filter(clean.run, o);
     o.crossing_guard = 0.0;
@@ -328,9 +329,11 @@ TEST(CrossingGuard, TheFilterLeavesOutMergedDetections) {
     EXPECT_EQ(in_history, static_cast<int>(on.guarded.size()));
   }
   EXPECT_GT(after_window, 0);  // the EKF's guard acted, not only the window's
-  // Measured: 0.09 with the guard, 1.04 without.
-  EXPECT_LT(moved_on, 0.2);
-  EXPECT_GT(moved_off, 0.3);
+  // Measured: 0.21 with the guard, 0.93 without. (The filter cannot leave out the bearings
+  // of a track that starts merged: the other line's feature is not in its state yet.)
+  EXPECT_LT(moved_on, 0.3);
+  EXPECT_GT(moved_off, 0.6);
+  EXPECT_GT(moved_off, 3.0 * moved_on);
   RecordProperty("moved_on", std::to_string(moved_on));
   RecordProperty("moved_off", std::to_string(moved_off));
   std::printf("filter: shift from the clean run: guard %.3f, none %.3f; %d left out after the "

@@ -19,8 +19,9 @@ class Propagator {
   // One odometry step of wheel travels (d_right, d_left) [m].
   void propagate(double d_right, double d_left, FilterState* state) const;
   // One frame's motion (FrameInput: wheel travels and sideways displacement). With a
-  // sideways displacement the motion is made of two steps of eq. (29), a turn in place and
-  // a step of eq. (14), that compose to it exactly (frame_steps).
+  // sideways displacement beyond three sigmas of its noise the motion is made of two steps
+  // of eq. (29), a turn in place and a step of eq. (14), that compose to it exactly
+  // (frame_steps); otherwise one step.
   void propagate(const FrameInput& frame, FilterState* state) const;
 
  private:

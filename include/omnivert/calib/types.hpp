@@ -128,7 +128,10 @@ struct Options {
   // is within this angle of its own (filter: features in the state; batches: tracks over
   // their span). The extractor merges two lines that close into one detection, whose
   // bearing is pulled towards the other line (docs/calib.md, "Lines that cross"); 0: off.
-  double crossing_guard = 1.0 * 3.14159265358979323846 / 180.0;
+  // 0.75 degree: from pixels, bearings within 0.5-0.75 degree of another line are off by
+  // 0.04-0.08 degree RMS, against 0.01-0.03 beyond 1 degree; 1 degree left out up to two
+  // thirds of the hall's bearings (docs/calib.md).
+  double crossing_guard = 0.75 * 3.14159265358979323846 / 180.0;
 
   // True when usable; otherwise false with the reason in *why (may be null).
   bool IsValid(std::string* why) const;
