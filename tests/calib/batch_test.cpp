@@ -55,7 +55,11 @@ TEST(TrackSplitting, SlippedTracksAreSplitAndTheirBiasRemoved) {
   int i = 0;
   for (const auto& [track, j] : clean.track_feature)
     if (i++ < 3) run = slip(run, track, n / 3 + 7 * i, 0.10);
-  const Options o = options_for(so);
+  // The splitting alone: the crossing guard leaves out other bearings of this run and moves
+  // its NEES by chance (the clean run's: 5.3 without the guard, 6.8 with it). Over seeds
+  // 7-46 it changes nothing on average (docs/calib.md, "Lines that cross").
+  Options o = options_for(so);
+  o.crossing_guard = 0.0;
   BatchOptions off;
   off.split_chi2 = 0.0;
   const RefinementResult whole = refine_batch(run.run, o, truth_point(run), off);
@@ -107,6 +111,7 @@ TEST(TrackSplitting, TheFiltersWindowSplitsSlippedTracks) {
       run = slip(run, track, slip_frame[track], 0.10);
     }
   Options o = options_for(so);
+  o.crossing_guard = 0.0;        // the splitting alone (as above)
   o.bootstrap_rotation = 100.0;  // never reached: the window ends with the run
   const FilterResult split = run_filter(run.run, o);
   o.split_chi2 = 0.0;
