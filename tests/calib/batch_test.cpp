@@ -227,27 +227,35 @@ SyntheticRun merge_crossings(SyntheticRun run, double merged, double pulled, dou
   return run;
 }
 
+// The crossing tests' runs: 30 features at the extractor's noise, seed 300 + s, clean and
+// with merged detections (within 0.4 degree) and pulled ones (a fifth of the separation,
+// within the guard).
+SyntheticRunOptions crossing_options(int s) {
+  SyntheticRunOptions so;
+  so.bearing_sigma = deg2rad(0.05);
+  so.num_features = 30;
+  so.seed = 300 + s;
+  return so;
+}
+SyntheticRun with_crossings(const SyntheticRun& clean) {
+  return merge_crossings(clean, deg2rad(0.4), Options{}.crossing_guard, 0.2);
+}
+
 // The crossing guard (Options::crossing_guard) leaves out exactly the bearings where another
 // feature is within the guard, and with it merged detections no longer move the estimate:
 // the run with merged detections gives the clean run's estimate; without the guard it does
 // not.
 TEST(CrossingGuard, MergedDetectionsAreLeftOutAndDoNotMoveTheEstimate) {
-  SyntheticRunOptions so;
-  so.bearing_sigma = deg2rad(0.05);
-  so.num_features = 30;
   const int runs = 10;
   double moved_on = 0.0, moved_off = 0.0;  // mean squared Mahalanobis shift from the clean run
   int guarded = 0, bearings = 0;
   auto shift = [](const RefinementResult& a, const RefinementResult& clean) {
-    const Eigen::Vector3d d(wrap_angle(a.extrinsics.phi - clean.extrinsics.phi),
-                            a.extrinsics.rho - clean.extrinsics.rho,
-                            wrap_angle(a.extrinsics.psi - clean.extrinsics.psi));
-    return d.dot(clean.covariance.ldlt().solve(d));
+    return test_support::nees(a.extrinsics, clean.covariance, clean.extrinsics);
   };
   for (int s = 1; s <= runs; ++s) {
-    so.seed = 300 + s;
+    const SyntheticRunOptions so = crossing_options(s);
     const SyntheticRun clean = make_synthetic_run(so);
-    const SyntheticRun run = merge_crossings(clean, deg2rad(0.4), Options{}.crossing_guard, 0.2);
+    const SyntheticRun run = with_crossings(clean);
     Options o = options_for(so);
     const RefinementResult on = refine_batch(run.run, o, truth_point(run));
     const RefinementResult on_clean = refine_batch(clean.run, o, truth_point(clean));
@@ -303,22 +311,16 @@ TEST(CrossingGuard, MergedDetectionsAreLeftOutAndDoNotMoveTheEstimate) {
 
 // The filter's guard, in its window and in the EKF after it: the same comparison.
 TEST(CrossingGuard, TheFilterLeavesOutMergedDetections) {
-  SyntheticRunOptions so;
-  so.bearing_sigma = deg2rad(0.05);
-  so.num_features = 30;
   const int runs = 10;
   double moved_on = 0.0, moved_off = 0.0;
   int after_window = 0;
   auto shift = [](const FilterResult& a, const FilterResult& clean) {
-    const Eigen::Vector3d d(wrap_angle(a.extrinsics.phi - clean.extrinsics.phi),
-                            a.extrinsics.rho - clean.extrinsics.rho,
-                            wrap_angle(a.extrinsics.psi - clean.extrinsics.psi));
-    return d.dot(clean.covariance.ldlt().solve(d));
+    return test_support::nees(a.extrinsics, clean.covariance, clean.extrinsics);
   };
   for (int s = 1; s <= runs; ++s) {
-    so.seed = 300 + s;
+    const SyntheticRunOptions so = crossing_options(s);
     const SyntheticRun clean = make_synthetic_run(so);
-    const SyntheticRun run = merge_crossings(clean, deg2rad(0.4), Options{}.crossing_guard, 0.2);
+    const SyntheticRun run = with_crossings(clean);
     Options o = options_for(so);
     const FilterResult on = run_filter(run.run, o), on_clean = run_filter(clean.run, o);
     o.crossing_guard = 0.0;
