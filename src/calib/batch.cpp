@@ -789,6 +789,22 @@ ObservabilityReport analyse_observability(const CalibrationRun& run,
   rep.yaw = verdict({1, 0, 1}, obs.max_sigma_angle);
   rep.x = verdict({-ex.rho * std::sin(ex.phi), std::cos(ex.phi), 0}, obs.max_sigma_rho);
   rep.y = verdict({ex.rho * std::cos(ex.phi), std::sin(ex.phi), 0}, obs.max_sigma_rho);
+  // Did the robot turn (Sec. 8.1)? Its heading's span against the heading noise of eq. (31)
+  // accumulated over the run: below min_rotation_sigmas, the information about phi, rho and
+  // psi individually comes from the estimated trajectory's noise, not from a turn.
+  {
+    double lo = 0.0, hi = 0.0, var = 0.0;
+    for (std::size_t k = 0; k < at.poses.size(); ++k) {
+      lo = std::min(lo, at.poses[k](2) - at.poses[0](2));
+      hi = std::max(hi, at.poses[k](2) - at.poses[0](2));
+    }
+    const double K = options.odometry_K * batch.odometry_inflation;
+    for (const FrameInput& f : run.frames) var += K * (std::abs(f.d_right) + std::abs(f.d_left));
+    rep.heading_range = hi - lo;
+    rep.heading_noise = std::sqrt(var) / options.wheel_base;
+    if (rep.heading_range < obs.min_rotation_sigmas * rep.heading_noise)
+      for (ParameterVerdict* p : {&rep.phi, &rep.rho, &rep.psi, &rep.x, &rep.y}) p->determined = false;
+  }
   if (rep.rank == 3) {
     rep.crlb_covariance = S.ldlt().solve(Eigen::Matrix3d::Identity());
   } else {
@@ -811,8 +827,13 @@ ObservabilityReport analyse_observability(const CalibrationRun& run,
     if (rep.yaw.determined)
       m << " (the camera yaw phi + psi is, to " << rad2deg(rep.yaw.crlb)
         << " deg): the camera's position on the robot shows only while the robot turns, and "
-           "this run did not turn enough. Add a turn in place near features (1-3 m away), or "
-           "alternate straights and turns (Sec. 8.1).";
+           "this run did not turn enough";
+    if (rep.yaw.determined && rep.heading_range < obs.min_rotation_sigmas * rep.heading_noise)
+      m << " (its heading spans " << rad2deg(rep.heading_range)
+        << " deg, within the wheels' noise of " << rad2deg(rep.heading_noise) << " deg)";
+    if (rep.yaw.determined)
+      m << ". Add a turn in place near features (1-3 m away), or alternate straights and turns "
+           "(Sec. 8.1).";
     else
       m << ", not even the camera yaw phi + psi: drive a straight line with vertical lines "
            "around (a few meters away), then turn in place near them (Sec. 8.1).";

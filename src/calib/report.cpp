@@ -235,6 +235,8 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
                         {"y", verdict_json(o.y)},
                         {"rank", o.rank},
                         {"condition", num(o.condition)},
+                        {"heading_range_deg", num(rad2deg(o.heading_range))},
+                        {"heading_noise_deg", num(rad2deg(o.heading_noise))},
                         {"message", o.message}};
   j["filter"] = extrinsics_json(r.filter.extrinsics, r.filter.covariance);
   {

@@ -153,5 +153,36 @@ TEST(Calibrate, StraightRunIsReportedNotObservable) {
   EXPECT_GT(std::sqrt(r.covariance(1, 1)), 0.09);
 }
 
+// However small the bearing noise, a straight run does not determine phi, rho and psi: the
+// bounds at its estimated trajectory come from the heading's noise, and at 0.005 degree they
+// fall under the thresholds; the run's heading span, within its odometry noise, says so.
+TEST(Calibrate, StraightRunIsNotDeterminedAtAnyBearingNoise) {
+  SyntheticRunOptions so;
+  so.trajectory = Trajectory::kStraight;
+  so.bearing_sigma = deg2rad(0.005);
+  const SyntheticRun run = make_synthetic_run(so);
+  const CalibrationResult r = calibrate(run.run, options_for(so));
+  const ObservabilityReport& o = r.observability;
+  EXPECT_FALSE(r.observable());
+  EXPECT_FALSE(o.rho.determined || o.phi.determined || o.psi.determined);
+  EXPECT_TRUE(o.yaw.determined);
+  EXPECT_LT(o.heading_range, ObservabilityOptions{}.min_rotation_sigmas * o.heading_noise);
+  EXPECT_NE(o.message.find("within the wheels' noise"), std::string::npos) << o.message;
+  // The bounds alone would have called rho determined.
+  ObservabilityOptions bounds_only;
+  bounds_only.min_rotation_sigmas = 0.0;
+  const BatchPoint at = batch_point_from_filter(run.run, options_for(so), r.filter);
+  const ObservabilityReport b = analyse_observability(run.run, options_for(so), at, {}, bounds_only);
+  RecordProperty("rho_crlb_mm", std::to_string(1e3 * b.rho.crlb));
+  EXPECT_TRUE(b.rho.determined) << "rho's bound " << b.rho.crlb;
+  // A run that turns is not affected (paper trajectory: 180 degrees).
+  SyntheticRunOptions turning = so;
+  turning.trajectory = Trajectory::kPaper;
+  const SyntheticRun pr = make_synthetic_run(turning);
+  const CalibrationResult p = calibrate(pr.run, options_for(turning));
+  EXPECT_TRUE(p.observable());
+  EXPECT_GT(p.observability.heading_range, 100.0 * p.observability.heading_noise);
+}
+
 }  // namespace
 }  // namespace omnivert::calib

@@ -177,6 +177,11 @@ struct ObservabilityOptions {
                                              // reported as not determined
   double max_sigma_rho = 0.02;               // [m]
   double relative_eigenvalue_floor = 1e-9;   // eigenvalues below floor * max count as zero
+  // phi, rho and psi individually need the robot to turn (Sec. 8.1). A run whose heading
+  // spans less than this many sigmas of its own odometry noise did not turn: the bounds at
+  // its estimated trajectory come from heading noise (a straight run at 0.025 degree of
+  // bearing noise: rho's bound 15.6 mm, under the 2 cm above), and they are not determined.
+  double min_rotation_sigmas = 5.0;
                                              // (numerical null directions reach 2e-12)
 };
 
@@ -189,6 +194,8 @@ struct ObservabilityReport {
   Eigen::Matrix3d information = Eigen::Matrix3d::Zero();  // marginal Fisher information
   Eigen::Vector3d eigenvalues = Eigen::Vector3d::Zero();  // of the information scaled by
                                                           // the thresholds (dimensionless)
+  double heading_range = 0.0;  // [rad] max - min of the robot's heading along the run
+  double heading_noise = 0.0;  // [rad] sigma of the heading odometry alone accumulates (eq. 31)
   int rank = 0;            // numerical rank of the marginal information
   double condition = 0.0;  // its condition number (scaled), infinity when singular
   Eigen::Matrix3d crlb_covariance = Eigen::Matrix3d::Zero();  // inverse information
