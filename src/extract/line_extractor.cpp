@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include "omnivert/core/angles.hpp"
@@ -20,6 +21,7 @@ bool LineExtractorOptions::IsValid(std::string* why) const {
   if (!(lateral_tolerance_px > 0)) return fail("lateral_tolerance_px must be positive");
   if (!(max_gap_px >= 0)) return fail("max_gap_px must not be negative");
   if (!(min_separation_deg >= 0)) return fail("min_separation_deg must not be negative");
+  if (!(isolation_px >= 0 && isolation_px <= 50)) return fail("isolation_px must be in [0, 50]");
   if (peak_window < 0 || peak_window > 10) return fail("peak_window must be in [0, 10] sectors");
   if (nms_radius < 1 || nms_radius > 10) return fail("nms_radius must be in [1, 10] sectors");
   if (!(length_fraction > 0 && length_fraction <= 1)) return fail("length_fraction must be in (0, 1]");
@@ -55,9 +57,67 @@ void LineExtractor::build_lut(const MirrorCircle& circle) {
   lut_r_max_ = r1;
 }
 
-namespace {
-
-}  // namespace
+double LineExtractor::fit_angle(int k,
+                                int pol,
+                                double a,
+                                double cx,
+                                double cy,
+                                const std::vector<double>* avoid,
+                                double avoid_px,
+                                double* fit_rms,
+                                std::vector<float>* radii) const {
+  const int N = options_.sectors;
+  const double tol = options_.lateral_tolerance_px;
+  // Pixels kept from the full fit, as a fraction of its weight, below which the isolated fit
+  // is not trusted (the line is close to another over most of its length).
+  constexpr double kMinIsolatedWeight = 0.2;
+  double full_weight = 0;
+  bool ok = false;
+  for (int iter = 0; iter < 4; ++iter) {
+    const double ca = std::cos(a), sa = std::sin(a);
+    double sxx = 0, sxy = 0, syy = 0, sl2 = 0, sw = 0, sw_all = 0;
+    if (radii) radii->clear();
+    for (int j = -3; j <= 3; ++j) {
+      const int b = 2 * ((k + j + N) % N) + pol;
+      for (int q = bucket_start_[b]; q < bucket_start_[b + 1]; ++q) {
+        const EdgePoint& p = edges_[bucket_items_[q]];
+        const double rx = p.x - cx, ry = p.y - cy;
+        const double fwd = rx * ca + ry * sa;
+        const double lat = -rx * sa + ry * ca;
+        if (fwd <= 0 || std::abs(lat) > tol) continue;
+        const double w = p.weight;
+        sw_all += w;
+        // Left out by the radius alone (the other line's distance from this one there), not
+        // by the pixel's own distance from the other line: that would drop the pixels on the
+        // near side first and push the fit away from the neighbour.
+        if (avoid) {
+          bool close = false;
+          for (double b_angle : *avoid)
+            close = close || fwd * std::abs(std::sin(b_angle - a)) < avoid_px;
+          if (close) continue;
+        }
+        sxx += w * rx * rx, sxy += w * rx * ry, syy += w * ry * ry;
+        sl2 += w * lat * lat, sw += w;
+        if (radii) radii->push_back(static_cast<float>(fwd));
+      }
+    }
+    if (iter == 0) full_weight = sw_all;
+    if (sw <= 0 || (avoid && sw < kMinIsolatedWeight * full_weight)) {
+      ok = false;
+      break;
+    }
+    ok = true;
+    if (fit_rms) *fit_rms = std::sqrt(sl2 / sw);
+    // Principal direction of the scatter about the centre (least-squares line through it).
+    double a_new = 0.5 * std::atan2(2 * sxy, sxx - syy);
+    if (std::cos(a_new - a) < 0) a_new += kPi;
+    const double change = std::abs(angle_diff(a_new, a));
+    a = a_new;
+    if (change < 1e-7) break;
+  }
+  if (avoid && !ok) return std::numeric_limits<double>::quiet_NaN();
+  return a;
+}
 
 void LineExtractor::extract(const cv::Mat& gray,
                             const MirrorCircle& circle,
@@ -169,7 +229,6 @@ void LineExtractor::extract(const cv::Mat& gray,
   if (options_.threshold != LineThreshold::kFractionOfAnnulus) floor_fraction = options_.min_fraction;
   const float peak_min = static_cast<float>(0.4 * floor_fraction * L);
   const double cx = circle.center.x(), cy = circle.center.y();
-  const double tol = options_.lateral_tolerance_px;
   const double max_gap = std::max(1.0, options_.max_gap_px);
   std::vector<LineCandidate>& found = found_;
   std::vector<float>& radii = radii_;
@@ -194,36 +253,9 @@ void LineExtractor::extract(const cv::Mat& gray,
       if (!is_max) continue;
 
       // Step 5: gather support around the peak and refine the angle (fit through the centre).
-      double a = (k + 0.5) / N * kTwoPi;
       double fit_rms = 0;
-      radii.clear();
-      for (int iter = 0; iter < 4; ++iter) {
-        const double ca = std::cos(a), sa = std::sin(a);
-        double sxx = 0, sxy = 0, syy = 0, sl2 = 0, sw = 0;
-        radii.clear();
-        for (int j = -3; j <= 3; ++j) {
-          const int b = 2 * ((k + j + N) % N) + pol;
-          for (int q = bucket_start_[b]; q < bucket_start_[b + 1]; ++q) {
-            const EdgePoint& p = edges_[bucket_items_[q]];
-            const double rx = p.x - cx, ry = p.y - cy;
-            const double fwd = rx * ca + ry * sa;
-            const double lat = -rx * sa + ry * ca;
-            if (fwd <= 0 || std::abs(lat) > tol) continue;
-            const double w = p.weight;
-            sxx += w * rx * rx, sxy += w * rx * ry, syy += w * ry * ry;
-            sl2 += w * lat * lat, sw += w;
-            radii.push_back(static_cast<float>(fwd));
-          }
-        }
-        if (sw <= 0) break;
-        fit_rms = std::sqrt(sl2 / sw);
-        // Principal direction of the scatter about the centre (least-squares line through it).
-        double a_new = 0.5 * std::atan2(2 * sxy, sxx - syy);
-        if (std::cos(a_new - a) < 0) a_new += kPi;
-        const double change = std::abs(angle_diff(a_new, a));
-        a = a_new;
-        if (change < 1e-7) break;
-      }
+      const double a =
+          fit_angle(k, pol, (k + 0.5) / N * kTwoPi, cx, cy, nullptr, 0.0, &fit_rms, &radii);
       if (radii.size() < 2) continue;
       std::sort(radii.begin(), radii.end());
       double covered = 1.0;
@@ -232,6 +264,7 @@ void LineExtractor::extract(const cv::Mat& gray,
         covered += gap <= max_gap ? gap : 1.0;
       }
       LineCandidate lc;
+      lc.peak = k;
       lc.line.image_angle = wrap_angle(a);
       lc.line.bearing = lc.line.image_angle;
       lc.line.edge_pixels = static_cast<int>(std::lround(covered));
@@ -242,6 +275,32 @@ void LineExtractor::extract(const cv::Mat& gray,
       lc.polarity = pol;
       lc.length = covered;
       found.push_back(lc);
+    }
+  }
+
+  // Step 5 again for the lines that have a neighbour: each angle is refitted from its support
+  // pixels that are at least isolation_px from every other candidate line, so that no pixel
+  // whose Sobel window or sub-pixel parabola reaches into the other edge's gradient biases the
+  // angle (docs/extraction.md, "Edges close to another"). The length stays the full support's.
+  const double sep = deg2rad(options_.min_separation_deg);
+  if (options_.isolation_px > 0 && found.size() > 1) {
+    const double D = options_.isolation_px;
+    // Two lines further apart than this (radians) are D pixels apart everywhere in the annulus.
+    const double reach = std::asin(std::min(1.0, D / std::max(1.0, circle.r_min)));
+    std::vector<double>& near = near_;
+    for (LineCandidate& f : found) {
+      near.clear();
+      for (const LineCandidate& g : found) {
+        const double d = std::abs(angle_diff(g.line.image_angle, f.line.image_angle));
+        // A peak of the same polarity closer than min_separation is the same edge (merged
+        // below), not a neighbour.
+        if (&g == &f || d >= reach || (g.polarity == f.polarity && d < sep)) continue;
+        near.push_back(g.line.image_angle);
+      }
+      if (near.empty()) continue;
+      double rms = 0;
+      const double a = fit_angle(f.peak, f.polarity, f.line.image_angle, cx, cy, &near, D, &rms);
+      if (std::isfinite(a)) f.line.image_angle = f.line.bearing = wrap_angle(a);
     }
   }
 
@@ -259,7 +318,6 @@ void LineExtractor::extract(const cv::Mat& gray,
   std::sort(found.begin(), found.end(), [](const LineCandidate& x, const LineCandidate& y) {
     return x.length > y.length;
   });
-  const double sep = deg2rad(options_.min_separation_deg);
   for (const LineCandidate& f : found) {
     if (f.length < thr) break;
     if (options_.threshold == LineThreshold::kTopK && static_cast<int>(out.size()) >= options_.top_k)

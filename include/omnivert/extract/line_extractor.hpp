@@ -53,6 +53,13 @@ struct LineExtractorOptions {
   double max_gap_px = 4.0;
   // Two lines of the same polarity closer than this are one line (degrees).
   double min_separation_deg = 0.75;
+  // A line with another candidate line nearby has its angle refitted from the support pixels
+  // at least this far (pixels) from every other candidate: nearer, the 3x3 Sobel window and
+  // the 3-pixel sub-pixel parabola reach into the other edge's gradient, which pushes the two
+  // edges of a thin bar apart (drawn bars 1 degree wide: each edge 0.015 degree outwards;
+  // docs/extraction.md, "Edges close to another"). Kept only when at least a fifth of the
+  // support's weight is that far; 0: off.
+  double isolation_px = 3.0;
   // Step 4's peak score sums the votes of 2 * peak_window + 1 sectors, and a peak must beat
   // the scores of the nms_radius sectors on each side. The defaults (0 and 1: the votes of one
   // sector, peaks at least 2 sectors = 1 degree apart) resolve two edges 1 degree apart, which
@@ -101,6 +108,20 @@ class LineExtractor {
     float sector;         // continuous sector coordinate of the pixel, in [0, sectors)
   };
   void build_lut(const MirrorCircle& circle);
+  // Step 5's fit: the angle of the radial line through the centre (cx, cy) fitted to the
+  // support pixels of polarity `pol` near sector k, starting at angle a. With `avoid`, the
+  // pixels within avoid_px of any of those lines (angles) are left out, and NaN is returned
+  // when less than a fifth of the support's weight is left. `radii` receives the distances
+  // from the centre of the pixels used.
+  double fit_angle(int k,
+                   int pol,
+                   double a,
+                   double cx,
+                   double cy,
+                   const std::vector<double>* avoid,
+                   double avoid_px,
+                   double* fit_rms,
+                   std::vector<float>* radii = nullptr) const;
 
   LineExtractorOptions options_;
   // Lookup table over the annulus, valid for (lut_r_min_, lut_r_max_).
@@ -113,6 +134,7 @@ class LineExtractor {
     float m;
   };
   struct LineCandidate {
+    int peak;  // sector of the vote peak
     VerticalLine line;
     int polarity;
     double length;
@@ -123,6 +145,7 @@ class LineExtractor {
   std::vector<EdgePoint> edges_;
   std::vector<LineCandidate> found_;
   std::vector<float> radii_, score_;
+  std::vector<double> near_;
   std::vector<int32_t> bucket_fill_;
   std::vector<float> hist_[2];
   std::vector<int32_t> bucket_start_;
