@@ -52,6 +52,10 @@ inline void add_pipeline_options(CLI::App* cmd, FeaturePipelineOptions& o) {
       ->group(g);
   cmd->add_flag("!--fixed-center", o.track_center, "Keep the first frame's centre instead of detecting it on every frame")
       ->group(g);
+  cmd->add_flag("--refine-center", o.refine_given_center,
+                "Fit the mirror centre to the rim (and track it, unless --fixed-center) even when "
+                "cam0/sensor.yaml gives it; by default a given centre is used as it is")
+      ->group(g);
 
   const std::string d = "Descriptor (Sec. 3)";
   static const std::map<std::string, DescriptorSmoothing> kSmoothing{

@@ -91,8 +91,10 @@ bool FeaturePipeline::process(const cv::Mat& image, FrameFeatures& out, std::str
       }
       return false;
     }
+    if (geometry_.center && !options_.refine_given_center) c->center = *geometry_.center;
     circle_ = c;
-  } else if (options_.track_center && circle_->rim_radius > 0) {
+  } else if (options_.track_center && circle_->rim_radius > 0 &&
+             !(geometry_.center && !options_.refine_given_center)) {
     std::string reason;
     if (auto c = center_.detect(gray_, *circle_, &reason)) {
       circle_ = c;
