@@ -54,6 +54,8 @@ void run_extract(const ExtractArgs& a) {
       jl["edge_pixels"] = l.edge_pixels;
       jl["r_inner"] = l.r_inner;
       jl["r_outer"] = l.r_outer;
+      jl["polarity"] = l.polarity;
+      jl["crowded"] = l.crowded;
       const auto row = f.descriptors.row(static_cast<Eigen::Index>(i));
       jl["descriptor"] = std::vector<float>(row.data(), row.data() + row.size());
       j["lines"].push_back(std::move(jl));
@@ -63,12 +65,13 @@ void run_extract(const ExtractArgs& a) {
     std::printf("%s: %dx%d, centre (%.2f, %.2f) px, annulus %.1f..%.1f px, %zu vertical lines\n",
                 a.image.c_str(), image.cols, image.rows, f.circle.center.x(), f.circle.center.y(),
                 f.circle.r_min, f.circle.r_max, f.lines.size());
-    std::printf("%4s %12s %16s %11s %9s %9s %8s\n", "line", "bearing[deg]", "image_angle[deg]",
-                "edge_pixels", "r_inner", "r_outer", "fit[px]");
+    std::printf("%4s %12s %16s %11s %9s %9s %8s %8s\n", "line", "bearing[deg]",
+                "image_angle[deg]", "edge_pixels", "r_inner", "r_outer", "fit[px]", "crowded");
     for (std::size_t i = 0; i < f.lines.size(); ++i) {
       const auto& l = f.lines[i];
-      std::printf("%4zu %12.3f %16.3f %11d %9.1f %9.1f %8.2f\n", i, rad2deg(l.bearing),
-                  rad2deg(l.image_angle), l.edge_pixels, l.r_inner, l.r_outer, l.fit_rms_px);
+      std::printf("%4zu %12.3f %16.3f %11d %9.1f %9.1f %8.2f %8s\n", i, rad2deg(l.bearing),
+                  rad2deg(l.image_angle), l.edge_pixels, l.r_inner, l.r_outer, l.fit_rms_px,
+                  l.crowded ? "yes" : "");
     }
   }
   if (!a.overlay.empty()) {

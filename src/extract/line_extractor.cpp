@@ -119,6 +119,57 @@ double LineExtractor::fit_angle(int k,
   return a;
 }
 
+void LineExtractor::hidden_neighbours(int k,
+                                      int pol,
+                                      double a,
+                                      double length,
+                                      double cx,
+                                      double cy,
+                                      std::vector<double>* near) const {
+  const int N = options_.sectors;
+  const double tol = options_.lateral_tolerance_px;
+  // Pixels between the support's band (tol) and this far from the line, on each side.
+  constexpr double kBand = 4.0;
+  // A side's pixels make a line when they cover this fraction of the line's length and lie
+  // this close (RMS, px) to the radial line fitted through them.
+  constexpr double kMinCover = 0.3, kMaxRms = 0.6;
+  const double ca = std::cos(a), sa = std::sin(a);
+  double sxx[2] = {0, 0}, sxy[2] = {0, 0}, syy[2] = {0, 0}, sw[2] = {0, 0};
+  int count[2] = {0, 0};
+  // Sectors either side of the peak: the band's width at the inner radius of the simulator's
+  // and the real images' annuli (60 px: 3.8 degrees) and the support's 3 sectors.
+  constexpr int span = 8;
+  for (int j = -span; j <= span; ++j) {
+    const int b = 2 * ((k + j + N) % N) + pol;
+    for (int q = bucket_start_[b]; q < bucket_start_[b + 1]; ++q) {
+      const EdgePoint& p = edges_[bucket_items_[q]];
+      const double rx = p.x - cx, ry = p.y - cy;
+      const double fwd = rx * ca + ry * sa;
+      const double lat = -rx * sa + ry * ca;
+      if (fwd <= 0 || std::abs(lat) <= tol || std::abs(lat) > kBand) continue;
+      const int side = lat > 0;
+      const double w = p.weight;
+      sxx[side] += w * rx * rx, sxy[side] += w * rx * ry, syy[side] += w * ry * ry;
+      sw[side] += w;
+      ++count[side];
+    }
+  }
+  for (int side = 0; side < 2; ++side) {
+    if (count[side] < std::max(10.0, kMinCover * length)) continue;
+    double b = 0.5 * std::atan2(2 * sxy[side], sxx[side] - syy[side]);
+    if (std::cos(b - a) < 0) b += kPi;
+    // Weighted RMS distance of the side's pixels from the radial line at b: the smaller
+    // eigenvalue of the scatter over the weight.
+    const double tr = sxx[side] + syy[side];
+    const double det = sxx[side] * syy[side] - sxy[side] * sxy[side];
+    const double small = 0.5 * tr - std::sqrt(std::max(0.0, 0.25 * tr * tr - det));
+    if (!(small / sw[side] <= kMaxRms * kMaxRms)) continue;
+    bool known = false;
+    for (double n : *near) known = known || std::abs(angle_diff(n, b)) < deg2rad(0.2);
+    if (!known) near->push_back(b);
+  }
+}
+
 void LineExtractor::extract(const cv::Mat& gray,
                             const MirrorCircle& circle,
                             std::vector<VerticalLine>& out) {
@@ -279,11 +330,15 @@ void LineExtractor::extract(const cv::Mat& gray,
   }
 
   // Step 5 again for the lines that have a neighbour: each angle is refitted from its support
-  // pixels that are at least isolation_px from every other candidate line, so that no pixel
-  // whose Sobel window or sub-pixel parabola reaches into the other edge's gradient biases the
-  // angle (docs/extraction.md, "Edges close to another"). The length stays the full support's.
+  // pixels at radii where every other candidate line is at least isolation_px away, so that
+  // no pixel whose Sobel window or sub-pixel parabola reaches into the other edge's gradient
+  // biases the angle (docs/extraction.md, "Edges close to another"). The neighbours are the
+  // other candidate peaks and, on each side, a line of same-polarity edge pixels just outside
+  // the support that made no peak of its own (a door leaf 0.6 degree from its frame: one
+  // peak, whose fit those pixels pull). A line whose neighbour is that close over most of its
+  // length is marked `crowded` and keeps its full fit. The length stays the full support's.
   const double sep = deg2rad(options_.min_separation_deg);
-  if (options_.isolation_px > 0 && found.size() > 1) {
+  if (options_.isolation_px > 0) {
     const double D = options_.isolation_px;
     // Two lines further apart than this (radians) are D pixels apart everywhere in the annulus.
     const double reach = std::asin(std::min(1.0, D / std::max(1.0, circle.r_min)));
@@ -297,10 +352,14 @@ void LineExtractor::extract(const cv::Mat& gray,
         if (&g == &f || d >= reach || (g.polarity == f.polarity && d < sep)) continue;
         near.push_back(g.line.image_angle);
       }
+      hidden_neighbours(f.peak, f.polarity, f.line.image_angle, f.length, cx, cy, &near);
       if (near.empty()) continue;
       double rms = 0;
       const double a = fit_angle(f.peak, f.polarity, f.line.image_angle, cx, cy, &near, D, &rms);
-      if (std::isfinite(a)) f.line.image_angle = f.line.bearing = wrap_angle(a);
+      if (std::isfinite(a))
+        f.line.image_angle = f.line.bearing = wrap_angle(a);
+      else
+        f.line.crowded = true;
     }
   }
 

@@ -78,6 +78,7 @@ void append_track_rows(std::int64_t frame_index,
     r.distance = a.distance;
     r.line = static_cast<int>(i);
     r.matched_line = a.is_new() ? -1 : a.matched_line;
+    r.crowded = l.crowded;
     rows->push_back(r);
   }
 }
@@ -87,12 +88,12 @@ void write_tracks_csv(const fs::path& path, const std::vector<TrackRow>& rows) {
   out.reserve(rows.size() * 96 + 128);
   out +=
       "frame,timestamp_ns,track_id,bearing_rad,image_angle_rad,edge_pixels,r_inner,r_outer,"
-      "matched_frame,distance,line,matched_line\n";
+      "matched_frame,distance,line,matched_line,crowded\n";
   char buf[256];
   for (const TrackRow& r : rows) {
     const int n = std::snprintf(buf,
                                 sizeof(buf),
-                                "%lld,%lld,%lld,%.9f,%.9f,%d,%.3f,%.3f,%lld,%.6f,%d,%d\n",
+                                "%lld,%lld,%lld,%.9f,%.9f,%d,%.3f,%.3f,%lld,%.6f,%d,%d,%d\n",
                                 static_cast<long long>(r.frame),
                                 static_cast<long long>(r.timestamp_ns),
                                 static_cast<long long>(r.track_id),
@@ -104,7 +105,8 @@ void write_tracks_csv(const fs::path& path, const std::vector<TrackRow>& rows) {
                                 static_cast<long long>(r.matched_frame),
                                 r.distance,
                                 r.line,
-                                r.matched_line);
+                                r.matched_line,
+                                r.crowded ? 1 : 0);
     out.append(buf, static_cast<std::size_t>(n));
   }
   write_text_atomic(path.string(), out);
@@ -182,6 +184,11 @@ std::vector<TrackRow> read_tracks_csv(const fs::path& path) {
     if (has("line")) r.line = parse_number<int>(field("line"), file, line_no, "line");
     if (has("matched_line")) {
       r.matched_line = parse_number<int>(field("matched_line"), file, line_no, "matched_line");
+    }
+    if (has("crowded")) {
+      const int c = parse_number<int>(field("crowded"), file, line_no, "crowded");
+      if (c != 0 && c != 1) throw InputError(file, line_no, "column 'crowded' must be 0 or 1");
+      r.crowded = c == 1;
     }
     rows.push_back(r);
   }

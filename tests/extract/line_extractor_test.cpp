@@ -193,5 +193,39 @@ TEST(LineExtractor, TheEdgesOfAThinBarAreNotPushedApart) {
   EXPECT_LT(std::abs(isolated), 0.004);
 }
 
+// Edges too close to be refitted apart are marked crowded: a bar 0.8 degree wide (its edges
+// 0.6-3.1 px apart, nowhere the 3 px the refit needs over a fifth of the line) pushes its
+// edges 0.023 degree apart (measured); one 1.5 degrees wide is refitted and not marked.
+TEST(LineExtractor, EdgesTooCloseToRefitAreMarkedCrowded) {
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> U(-kPi, kPi);
+  LineExtractor ex;
+  MirrorCircle c;
+  c.center = {320.3, 240.6};
+  c.r_min = 40;
+  c.r_max = 220;
+  int crowded_thin = 0, crowded_wide = 0, lines_thin = 0, lines_wide = 0;
+  for (int rep = 0; rep < 4; ++rep) {
+    for (double width_deg : {0.8, 1.5}) {
+      const double a1 = U(rng), width = deg2rad(width_deg);
+      std::vector<VerticalLine> out;
+      ex.extract(draw_bar(a1, width, c.center, rng), c, out);
+      for (const VerticalLine& l : out) {
+        const bool on_bar = std::abs(angle_diff(l.image_angle, a1)) < deg2rad(0.2) ||
+                            std::abs(angle_diff(l.image_angle, a1 + width)) < deg2rad(0.2);
+        ASSERT_TRUE(on_bar) << "a line off the bar at " << rad2deg(l.image_angle);
+        (width_deg < 1 ? lines_thin : lines_wide) += 1;
+        (width_deg < 1 ? crowded_thin : crowded_wide) += l.crowded ? 1 : 0;
+      }
+    }
+  }
+  std::printf("bar 0.8 deg: %d of %d edges crowded; bar 1.5 deg: %d of %d\n", crowded_thin,
+              lines_thin, crowded_wide, lines_wide);
+  EXPECT_EQ(lines_thin, 8);
+  EXPECT_EQ(crowded_thin, 8);
+  EXPECT_EQ(lines_wide, 8);
+  EXPECT_EQ(crowded_wide, 0);
+}
+
 }  // namespace
 }  // namespace omnivert

@@ -39,6 +39,7 @@ TEST(TracksCsv, RoundTrip) {
     v.edge_pixels = 100 + i;
     v.r_inner = 40.5;
     v.r_outer = 180.25;
+    v.crowded = i == 1;
     frame.lines.push_back(v);
   }
   std::vector<TrackAssignment> as(3);
@@ -76,6 +77,7 @@ TEST(TracksCsv, RoundTrip) {
     EXPECT_EQ(back[i].matched_frame, rows[i].matched_frame);
     EXPECT_EQ(back[i].line, static_cast<int>(i));
     EXPECT_EQ(back[i].matched_line, rows[i].matched_line);
+    EXPECT_EQ(back[i].crowded, i == 1);
   }
   EXPECT_EQ(back[1].matched_line, -1);
   EXPECT_EQ(back[2].matched_line, 4);
@@ -112,6 +114,7 @@ TEST(TracksCsv, BadInputNamesFileAndLine) {
   expect_error("frame,timestamp_ns,track_id,bearing_rad\n0,1,2,nan\n", 2, "");
   expect_error("frame,timestamp_ns,track_id,bearing_rad\n-1,1,2,0.1\n", 2, "negative frame");
   expect_error("frame,timestamp_ns,track_id,bearing_rad\n0,1,2,4.0\n", 2, "outside");
+  expect_error("frame,timestamp_ns,track_id,bearing_rad,crowded\n0,1,2,0.1,2\n", 2, "crowded");
   expect_error("", 0, "empty");
   EXPECT_THROW(read_tracks_csv(dir / "does_not_exist.csv"), InputError);
 }

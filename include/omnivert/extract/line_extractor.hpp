@@ -58,7 +58,7 @@ struct LineExtractorOptions {
   // the 3-pixel sub-pixel parabola reach into the other edge's gradient, which pushes the two
   // edges of a thin bar apart (drawn bars 1 degree wide: each edge 0.015 degree outwards;
   // docs/extraction.md, "Edges close to another"). Kept only when at least a fifth of the
-  // support's weight is that far; 0: off.
+  // support's weight is that far; otherwise the line is marked crowded (VerticalLine). 0: off.
   double isolation_px = 3.0;
   // Step 4's peak score sums the votes of 2 * peak_window + 1 sectors, and a peak must beat
   // the scores of the nms_radius sectors on each side. The defaults (0 and 1: the votes of one
@@ -122,6 +122,16 @@ class LineExtractor {
                    double avoid_px,
                    double* fit_rms,
                    std::vector<float>* radii = nullptr) const;
+  // Same-polarity edge pixels just outside the support of the line at angle a (peak sector
+  // k), on each side, that form a radial line of their own: its angle is added to *near
+  // unless a line within 0.2 degree is there already.
+  void hidden_neighbours(int k,
+                         int pol,
+                         double a,
+                         double length,
+                         double cx,
+                         double cy,
+                         std::vector<double>* near) const;
 
   LineExtractorOptions options_;
   // Lookup table over the annulus, valid for (lut_r_min_, lut_r_max_).

@@ -20,6 +20,12 @@ struct VerticalLine {
   double fit_rms_px = 0.0;
   // Edge polarity: +1 if the image is brighter on the side of increasing image angle.
   int polarity = 0;
+  // Another edge line runs within LineExtractorOptions::isolation_px of this one over most of
+  // its length, so that their gradients overlap and the angle is pulled towards or pushed
+  // from it (rendered door frames and their leaves 0.6-0.75 degree apart: 0.04-0.13 degree).
+  // Left for the user to judge: the calibration uses them (leaving them out was measured and
+  // not better: docs/extraction.md, "Edges close to another").
+  bool crowded = false;
 };
 
 }  // namespace omnivert

@@ -37,6 +37,8 @@ struct TrackRow {
   // when a track holds two lines in one frame (the paper's rules allow such double claims).
   int line = -1;
   int matched_line = -1;
+  // VerticalLine::crowded: another edge runs within a few pixels all along this line.
+  bool crowded = false;
 };
 
 // Appends one row per line of `frame` (in line order) from the tracker's assignments.
