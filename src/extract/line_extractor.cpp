@@ -57,6 +57,33 @@ void LineExtractor::build_lut(const MirrorCircle& circle) {
   lut_r_max_ = r1;
 }
 
+namespace {
+// Direction of the principal axis of a scatter about the centre (the least-squares line
+// through it), on the side of `near_a`.
+double principal_angle(double sxx, double sxy, double syy, double near_a) {
+  double b = 0.5 * std::atan2(2 * sxy, sxx - syy);
+  if (std::cos(b - near_a) < 0) b += kPi;
+  return b;
+}
+}  // namespace
+
+template <typename F>
+void LineExtractor::visit_pixels(int k, int pol, int span, double a, double cx, double cy,
+                                 F&& f) const {
+  const int N = options_.sectors;
+  const double ca = std::cos(a), sa = std::sin(a);
+  for (int j = -span; j <= span; ++j) {
+    const int b = 2 * ((k + j + N) % N) + pol;
+    for (int q = bucket_start_[b]; q < bucket_start_[b + 1]; ++q) {
+      const EdgePoint& p = edges_[bucket_items_[q]];
+      const double rx = p.x - cx, ry = p.y - cy;
+      const double fwd = rx * ca + ry * sa;
+      if (fwd <= 0) continue;
+      f(rx, ry, fwd, -rx * sa + ry * ca, static_cast<double>(p.weight));
+    }
+  }
+}
+
 double LineExtractor::fit_angle(int k,
                                 int pol,
                                 double a,
@@ -66,7 +93,6 @@ double LineExtractor::fit_angle(int k,
                                 double avoid_px,
                                 double* fit_rms,
                                 std::vector<float>* radii) const {
-  const int N = options_.sectors;
   const double tol = options_.lateral_tolerance_px;
   // Pixels kept from the full fit, as a fraction of its weight, below which the isolated fit
   // is not trusted (the line is close to another over most of its length).
@@ -74,33 +100,23 @@ double LineExtractor::fit_angle(int k,
   double full_weight = 0;
   bool ok = false;
   for (int iter = 0; iter < 4; ++iter) {
-    const double ca = std::cos(a), sa = std::sin(a);
     double sxx = 0, sxy = 0, syy = 0, sl2 = 0, sw = 0, sw_all = 0;
     if (radii) radii->clear();
-    for (int j = -3; j <= 3; ++j) {
-      const int b = 2 * ((k + j + N) % N) + pol;
-      for (int q = bucket_start_[b]; q < bucket_start_[b + 1]; ++q) {
-        const EdgePoint& p = edges_[bucket_items_[q]];
-        const double rx = p.x - cx, ry = p.y - cy;
-        const double fwd = rx * ca + ry * sa;
-        const double lat = -rx * sa + ry * ca;
-        if (fwd <= 0 || std::abs(lat) > tol) continue;
-        const double w = p.weight;
-        sw_all += w;
-        // Left out by the radius alone (the other line's distance from this one there), not
-        // by the pixel's own distance from the other line: that would drop the pixels on the
-        // near side first and push the fit away from the neighbour.
-        if (avoid) {
-          bool close = false;
-          for (double b_angle : *avoid)
-            close = close || fwd * std::abs(std::sin(b_angle - a)) < avoid_px;
-          if (close) continue;
-        }
-        sxx += w * rx * rx, sxy += w * rx * ry, syy += w * ry * ry;
-        sl2 += w * lat * lat, sw += w;
-        if (radii) radii->push_back(static_cast<float>(fwd));
+    visit_pixels(k, pol, 3, a, cx, cy, [&](double rx, double ry, double fwd, double lat, double w) {
+      if (std::abs(lat) > tol) return;
+      sw_all += w;
+      // Left out by the radius alone (the other line's distance from this one there), not
+      // by the pixel's own distance from the other line: that would drop the pixels on the
+      // near side first and push the fit away from the neighbour.
+      if (avoid) {
+        bool close = false;
+        for (double b_angle : *avoid) close = close || fwd * std::abs(std::sin(b_angle - a)) < avoid_px;
+        if (close) return;
       }
-    }
+      sxx += w * rx * rx, sxy += w * rx * ry, syy += w * ry * ry;
+      sl2 += w * lat * lat, sw += w;
+      if (radii) radii->push_back(static_cast<float>(fwd));
+    });
     if (iter == 0) full_weight = sw_all;
     if (sw <= 0 || (avoid && sw < kMinIsolatedWeight * full_weight)) {
       ok = false;
@@ -109,8 +125,7 @@ double LineExtractor::fit_angle(int k,
     ok = true;
     if (fit_rms) *fit_rms = std::sqrt(sl2 / sw);
     // Principal direction of the scatter about the centre (least-squares line through it).
-    double a_new = 0.5 * std::atan2(2 * sxy, sxx - syy);
-    if (std::cos(a_new - a) < 0) a_new += kPi;
+    const double a_new = principal_angle(sxx, sxy, syy, a);
     const double change = std::abs(angle_diff(a_new, a));
     a = a_new;
     if (change < 1e-7) break;
@@ -126,38 +141,27 @@ void LineExtractor::hidden_neighbours(int k,
                                       double cx,
                                       double cy,
                                       std::vector<double>* near) const {
-  const int N = options_.sectors;
   const double tol = options_.lateral_tolerance_px;
   // Pixels between the support's band (tol) and this far from the line, on each side.
   constexpr double kBand = 4.0;
   // A side's pixels make a line when they cover this fraction of the line's length and lie
   // this close (RMS, px) to the radial line fitted through them.
   constexpr double kMinCover = 0.3, kMaxRms = 0.6;
-  const double ca = std::cos(a), sa = std::sin(a);
   double sxx[2] = {0, 0}, sxy[2] = {0, 0}, syy[2] = {0, 0}, sw[2] = {0, 0};
   int count[2] = {0, 0};
   // Sectors either side of the peak: the band's width at the inner radius of the simulator's
   // and the real images' annuli (60 px: 3.8 degrees) and the support's 3 sectors.
   constexpr int span = 8;
-  for (int j = -span; j <= span; ++j) {
-    const int b = 2 * ((k + j + N) % N) + pol;
-    for (int q = bucket_start_[b]; q < bucket_start_[b + 1]; ++q) {
-      const EdgePoint& p = edges_[bucket_items_[q]];
-      const double rx = p.x - cx, ry = p.y - cy;
-      const double fwd = rx * ca + ry * sa;
-      const double lat = -rx * sa + ry * ca;
-      if (fwd <= 0 || std::abs(lat) <= tol || std::abs(lat) > kBand) continue;
-      const int side = lat > 0;
-      const double w = p.weight;
-      sxx[side] += w * rx * rx, sxy[side] += w * rx * ry, syy[side] += w * ry * ry;
-      sw[side] += w;
-      ++count[side];
-    }
-  }
+  visit_pixels(k, pol, span, a, cx, cy, [&](double rx, double ry, double, double lat, double w) {
+    if (std::abs(lat) <= tol || std::abs(lat) > kBand) return;
+    const int side = lat > 0;
+    sxx[side] += w * rx * rx, sxy[side] += w * rx * ry, syy[side] += w * ry * ry;
+    sw[side] += w;
+    ++count[side];
+  });
   for (int side = 0; side < 2; ++side) {
     if (count[side] < std::max(10.0, kMinCover * length)) continue;
-    double b = 0.5 * std::atan2(2 * sxy[side], sxx[side] - syy[side]);
-    if (std::cos(b - a) < 0) b += kPi;
+    const double b = principal_angle(sxx[side], sxy[side], syy[side], a);
     // Weighted RMS distance of the side's pixels from the radial line at b: the smaller
     // eigenvalue of the scatter over the weight.
     const double tr = sxx[side] + syy[side];

@@ -122,6 +122,11 @@ class LineExtractor {
                    double avoid_px,
                    double* fit_rms,
                    std::vector<float>* radii = nullptr) const;
+  // Calls f(rx, ry, fwd, lat, weight) for each thinned edge pixel of polarity `pol` in the
+  // sectors k - span .. k + span that lies ahead of the centre along angle a: (rx, ry) from
+  // the centre (cx, cy), fwd along the radial line at a, lat across it.
+  template <typename F>
+  void visit_pixels(int k, int pol, int span, double a, double cx, double cy, F&& f) const;
   // Same-polarity edge pixels just outside the support of the line at angle a (peak sector
   // k), on each side, that form a radial line of their own: its angle is added to *near
   // unless a line within 0.2 degree is there already.
