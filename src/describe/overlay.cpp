@@ -48,7 +48,8 @@ cv::Mat draw_overlay(const cv::Mat& image,
     cv::putText(bgr, std::to_string(i),
                 cv::Point(static_cast<int>(c.center.x() + rt * ca - 6 * scale),
                           static_cast<int>(c.center.y() + rt * sa + 4 * scale)),
-                cv::FONT_HERSHEY_SIMPLEX, 0.4 * scale, {0, 255, 255}, thick, cv::LINE_AA);
+                cv::FONT_HERSHEY_SIMPLEX, 0.4 * scale,
+                l.crowded ? cv::Scalar(0, 0, 255) : cv::Scalar(0, 255, 255), thick, cv::LINE_AA);
   }
   if (highlight >= 0 && highlight < static_cast<int>(f.lines.size())) {
     const double ra = descriptor.area_radius(c);

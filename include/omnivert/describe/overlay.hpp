@@ -1,6 +1,7 @@
 #pragma once
 // Pictures of a frame's features for people to look at: the mirror centre, the annulus, every
-// extracted line (numbered as in the tool's table) and the descriptor areas of one line.
+// extracted line (numbered as in the tool's table; the number red where the line is crowded)
+// and the descriptor areas of one line.
 
 #include <opencv2/core.hpp>
 
