@@ -65,6 +65,8 @@ bool FeaturePipeline::process(const cv::Mat& image, FrameFeatures& out, std::str
              std::to_string(geometry_.height);
     return false;
   }
+  // A centre given in sensor.yaml is used as it is (FeaturePipelineOptions).
+  const bool center_as_given = geometry_.center && !options_.refine_given_center;
   if (!circle_) {
     std::string reason;
     auto c = center_.estimate(gray_, geometry_, &reason);
@@ -91,10 +93,9 @@ bool FeaturePipeline::process(const cv::Mat& image, FrameFeatures& out, std::str
       }
       return false;
     }
-    if (geometry_.center && !options_.refine_given_center) c->center = *geometry_.center;
+    if (center_as_given) c->center = *geometry_.center;
     circle_ = c;
-  } else if (options_.track_center && circle_->rim_radius > 0 &&
-             !(geometry_.center && !options_.refine_given_center)) {
+  } else if (options_.track_center && circle_->rim_radius > 0 && !center_as_given) {
     std::string reason;
     if (auto c = center_.detect(gray_, *circle_, &reason)) {
       circle_ = c;

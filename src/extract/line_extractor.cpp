@@ -102,17 +102,16 @@ double LineExtractor::fit_angle(int k,
   for (int iter = 0; iter < 4; ++iter) {
     double sxx = 0, sxy = 0, syy = 0, sl2 = 0, sw = 0, sw_all = 0;
     if (radii) radii->clear();
+    // Left out by the radius alone (inside r_clear some line of `avoid` is nearer than
+    // avoid_px to this one), not by the pixel's own distance from the other line: that would
+    // drop the pixels on the near side first and push the fit away from the neighbour.
+    double r_clear = 0;
+    if (avoid)
+      for (double b : *avoid) r_clear = std::max(r_clear, avoid_px / std::abs(std::sin(b - a)));
     visit_pixels(k, pol, 3, a, cx, cy, [&](double rx, double ry, double fwd, double lat, double w) {
       if (std::abs(lat) > tol) return;
       sw_all += w;
-      // Left out by the radius alone (the other line's distance from this one there), not
-      // by the pixel's own distance from the other line: that would drop the pixels on the
-      // near side first and push the fit away from the neighbour.
-      if (avoid) {
-        bool close = false;
-        for (double b_angle : *avoid) close = close || fwd * std::abs(std::sin(b_angle - a)) < avoid_px;
-        if (close) return;
-      }
+      if (fwd < r_clear) return;
       sxx += w * rx * rx, sxy += w * rx * ry, syy += w * ry * ry;
       sl2 += w * lat * lat, sw += w;
       if (radii) radii->push_back(static_cast<float>(fwd));
@@ -358,8 +357,7 @@ void LineExtractor::extract(const cv::Mat& gray,
       }
       hidden_neighbours(f.peak, f.polarity, f.line.image_angle, f.length, cx, cy, &near);
       if (near.empty()) continue;
-      double rms = 0;
-      const double a = fit_angle(f.peak, f.polarity, f.line.image_angle, cx, cy, &near, D, &rms);
+      const double a = fit_angle(f.peak, f.polarity, f.line.image_angle, cx, cy, &near, D, nullptr);
       if (std::isfinite(a))
         f.line.image_angle = f.line.bearing = wrap_angle(a);
       else

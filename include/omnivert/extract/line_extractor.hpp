@@ -110,8 +110,8 @@ class LineExtractor {
   void build_lut(const MirrorCircle& circle);
   // Step 5's fit: the angle of the radial line through the centre (cx, cy) fitted to the
   // support pixels of polarity `pol` near sector k, starting at angle a. With `avoid`, the
-  // pixels within avoid_px of any of those lines (angles) are left out, and NaN is returned
-  // when less than a fifth of the support's weight is left. `radii` receives the distances
+  // pixels at radii where any of those lines (angles) is nearer than avoid_px to this one
+  // are left out, and NaN is returned when less than a fifth of the support's weight is left. `radii` receives the distances
   // from the centre of the pixels used.
   double fit_angle(int k,
                    int pol,
