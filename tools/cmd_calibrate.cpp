@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <set>
 
 #include <spdlog/spdlog.h>
 
@@ -48,6 +49,7 @@ struct CalibrateArgs {
   bool noise_check = true;
   bool force = false;
   std::string prior_file;
+  std::string tracks_file;  // --tracks: an existing tracks.csv instead of tracking
   std::optional<double> phi, rho, psi, sigma_phi, sigma_rho, sigma_psi;
   std::optional<double> bearing_sigma_deg;
   std::optional<double> odometry_inflation;
@@ -77,6 +79,36 @@ void read_prior_file(const std::string& path, calib::Options* o) {
 void remove_if_exists(const std::filesystem::path& p) {
   std::error_code ec;
   std::filesystem::remove(p, ec);
+}
+
+// --tracks: the rows of an earlier tracks.csv (`omnivert track` or `calibrate`), checked
+// against the dataset: every row's frame must be one of its images, with that image's
+// timestamp (a tracks.csv of another dataset, or of a re-recorded one, is refused by file and
+// line).
+TrackDatasetResult tracks_of_dataset(const std::string& file, const dataset::Dataset& data) {
+  TrackDatasetResult t;
+  t.rows = read_tracks_csv(file);
+  const auto& images = data.images();
+  std::set<std::int64_t> ids;
+  for (std::size_t i = 0; i < t.rows.size(); ++i) {
+    const TrackRow& r = t.rows[i];
+    const int line = static_cast<int>(i) + 2;  // the header is line 1
+    if (r.frame >= static_cast<std::int64_t>(images.size()))
+      throw InputError(file, line,
+                       "frame " + std::to_string(r.frame) + " is not an image of " + data.root() +
+                           " (it has " + std::to_string(images.size()) + ")");
+    const auto& im = images[static_cast<std::size_t>(r.frame)];
+    if (r.timestamp_ns != im.timestamp_ns)
+      throw InputError(file, line,
+                       "frame " + std::to_string(r.frame) + " has timestamp " +
+                           std::to_string(r.timestamp_ns) + " but cam0/data.csv line " +
+                           std::to_string(im.line) + " has " + std::to_string(im.timestamp_ns) +
+                           ": these tracks are not of this dataset");
+    ids.insert(r.track_id);
+  }
+  t.frames = static_cast<std::int64_t>(images.size());
+  t.stats.new_tracks = static_cast<std::int64_t>(ids.size());
+  return t;
 }
 
 calib::BatchOptions batch_options(const CalibrateArgs& a) {
@@ -114,6 +146,10 @@ void run_calibrate(const CalibrateArgs& a) {
   opt.crossing_guard = deg2rad(a.crossing_guard_deg);
   if (!opt.IsValid(&why)) throw InputError("invalid calibration options: " + why);
 
+  // Read before the output folder is cleared: --tracks may name DIR/tracks.csv itself.
+  std::optional<TrackDatasetResult> given_tracks;
+  if (!a.tracks_file.empty()) given_tracks = tracks_of_dataset(a.tracks_file, data);
+
   std::error_code ec;
   fs::create_directories(a.out, ec);
   if (ec) throw InputError(a.out, 0, "cannot create the output folder: " + ec.message());
@@ -123,14 +159,19 @@ void run_calibrate(const CalibrateArgs& a) {
                         "convergence.png", "tracks.csv", "tracks.png"})
     remove_if_exists(out / f);
 
-  // 1. Tracking (Sec. 4, 9.1).
+  // 1. Tracking (Sec. 4, 9.1), or the tracks of an earlier run (--tracks).
   const auto t0 = clock::now();
-  TrackDatasetOptions to;
-  to.pipeline = a.pipeline;
-  to.tracker = a.tracker.options();
-  Progress bar("track", data.size());
-  const auto tracked = track_dataset(data, to, [&](std::size_t done, std::size_t) { bar.update(done); });
-  bar.finish();
+  TrackDatasetResult tracked;
+  if (!given_tracks) {
+    TrackDatasetOptions to;
+    to.pipeline = a.pipeline;
+    to.tracker = a.tracker.options();
+    Progress bar("track", data.size());
+    tracked = track_dataset(data, to, [&](std::size_t done, std::size_t) { bar.update(done); });
+    bar.finish();
+  } else {
+    tracked = std::move(*given_tracks);
+  }
   std::vector<std::string> warnings = tracked.warnings;
   write_tracks_csv(out / "tracks.csv", tracked.rows);
   write_tracks_png(out / "tracks.png", tracked.rows);
@@ -286,6 +327,10 @@ void add_calibrate_command(CLI::App& app) {
   cmd->add_flag("!--no-noise-check", a->noise_check,
                 "Report the model's covariances as they are, without the data's check of the "
                 "bearing noise (errors summed along each track; docs/calib.md, \"The noise check\")");
+  cmd->add_option("--tracks", a->tracks_file,
+                  "Calibrate from this tracks.csv (of `omnivert track` or an earlier calibrate "
+                  "on the same dataset) instead of extracting and tracking the images")
+      ->check(CLI::ExistingFile);
   cmd->add_flag("--force", a->force,
                 "Write extrinsics.yaml (and exit 0) even when the run does not determine every "
                 "parameter");

@@ -4,7 +4,8 @@
 #   cmake -DOV=<omnivert> -DPAPER=<paper dataset> -DSTRAIGHT=<straight dataset>
 #         -DWORK=<scratch dir> -DMODE=<mode> -P calibrate_cli.cmake
 # MODE: end_to_end | straight | straight_force | wheel_gap | wheel_short | wheel_decreasing |
-#       no_wheel | few_lines | no_lines | prior_file | few_tracks | no_noise_check
+#       no_wheel | few_lines | no_lines | prior_file | few_tracks | no_noise_check |
+#       tracks_file
 cmake_minimum_required(VERSION 3.20)
 
 function(fail msg)
@@ -303,6 +304,62 @@ elseif(MODE STREQUAL "prior_file")
   run_calibrate(${PAPER} ${out_dir} --prior ${WORK}/prior-bad.yaml)
   if(NOT rc EQUAL 2 OR NOT err MATCHES "prior-bad.yaml:2: field 'rho' must be a number, got 'far'")
     fail("expected exit 2 naming prior-bad.yaml line 2, got ${rc}: ${err}")
+  endif()
+
+elseif(MODE STREQUAL "tracks_file")
+  # --tracks: the tracks of an earlier run give the same result without the images; the
+  # folder's own tracks.csv can be named (it is read before the folder is cleared); tracks of
+  # another dataset are refused by file and line.
+  run_calibrate(${PAPER} ${out_dir})
+  if(NOT rc EQUAL 0)
+    fail("calibrate exited ${rc}: ${err}")
+  endif()
+  file(READ ${out_dir}/summary.json json1)
+  file(READ ${out_dir}/tracks.csv tracks1)
+  file(COPY ${out_dir}/tracks.csv DESTINATION ${WORK}/tracks-copy)
+  run_calibrate(${PAPER} ${out_dir}-again --tracks ${WORK}/tracks-copy/tracks.csv)
+  if(NOT rc EQUAL 0)
+    fail("calibrate --tracks exited ${rc}: ${err}")
+  endif()
+  check_no_nan(${out_dir}-again)
+  file(READ ${out_dir}-again/summary.json json2)
+  file(READ ${out_dir}-again/tracks.csv tracks2)
+  # tracks.csv holds the bearings to 1e-9 rad or so: the same estimate to six decimals.
+  foreach(k phi rho psi)
+    string(JSON a GET "${json1}" result ${k})
+    string(JSON b GET "${json2}" result ${k})
+    string(REGEX MATCH "^-?[0-9]+[.][0-9][0-9][0-9][0-9][0-9][0-9]" a6 "${a}")
+    string(REGEX MATCH "^-?[0-9]+[.][0-9][0-9][0-9][0-9][0-9][0-9]" b6 "${b}")
+    if(NOT a6 STREQUAL b6 OR a6 STREQUAL "")
+      fail("--tracks gave ${k} = ${b}, tracking gave ${a}")
+    endif()
+  endforeach()
+  if(NOT tracks1 STREQUAL tracks2)
+    fail("--tracks: tracks.csv is not the one read")
+  endif()
+  run_calibrate(${PAPER} ${out_dir} --tracks ${out_dir}/tracks.csv)
+  if(NOT rc EQUAL 0 OR NOT EXISTS ${out_dir}/tracks.csv)
+    fail("--tracks DIR/tracks.csv --out DIR exited ${rc}: ${err}")
+  endif()
+  file(READ ${out_dir}/summary.json json3)
+  foreach(k phi rho psi)
+    string(JSON b GET "${json2}" result ${k})
+    string(JSON c GET "${json3}" result ${k})
+    if(NOT b STREQUAL c)
+      fail("the same tracks.csv gave ${k} = ${b} and ${c}")
+    endif()
+  endforeach()
+  run_calibrate(${STRAIGHT} ${WORK}/tracks-other-out --tracks ${out_dir}/tracks.csv --force)
+  if(NOT rc EQUAL 2 OR NOT err MATCHES "tracks.csv:[0-9]+: frame 45 is not an image of .*cal-straight \\(it has 45\\)")
+    fail("tracks of a longer run: expected exit 2 naming tracks.csv and frame 45, got ${rc}: ${err}")
+  endif()
+  file(WRITE ${WORK}/tracks-other.csv "frame,timestamp_ns,track_id,bearing_rad\n0,123,0,0.5\n")
+  run_calibrate(${PAPER} ${WORK}/tracks-other-out --tracks ${WORK}/tracks-other.csv --force)
+  if(NOT rc EQUAL 2 OR NOT err MATCHES "tracks-other.csv:2: frame 0 has timestamp 123 but cam0/data.csv line 2 has [0-9]+: these tracks are not of this dataset")
+    fail("tracks of another dataset: expected exit 2 naming tracks-other.csv line 2, got ${rc}: ${err}")
+  endif()
+  if(EXISTS ${WORK}/tracks-other-out/summary.json)
+    fail("refused tracks left a summary.json")
   endif()
 
 else()
