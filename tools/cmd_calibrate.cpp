@@ -54,6 +54,7 @@ struct CalibrateArgs {
   std::optional<double> bearing_sigma_deg;
   std::optional<double> odometry_inflation;
   double max_wheel_gap = 0.5;
+  double crowded_sigma = calib::DatasetRunOptions{}.crowded_sigma_scale;
   double split_chi2 = calib::BatchOptions{}.split_chi2;
   double lateral_sigma = calib::BatchOptions{}.lateral_sigma;
   double crossing_guard_deg = rad2deg(calib::Options{}.crossing_guard);
@@ -180,6 +181,7 @@ void run_calibrate(const CalibrateArgs& a) {
   // 2. The calibration's input, then the filter, observability and refinement (Sec. 8).
   calib::DatasetRunOptions ro;
   ro.max_wheel_gap_s = a.max_wheel_gap;
+  ro.crowded_sigma_scale = a.crowded_sigma;
   const calib::DatasetRun run = calib::calibration_run_from_tracks(data, tracked.rows, ro);
   warnings.insert(warnings.end(), run.warnings.begin(), run.warnings.end());
   {
@@ -369,6 +371,12 @@ void add_calibrate_command(CLI::App& app) {
                   "Sideways slip per image step [m] allowed by the batch problems (the filter's "
                   "window and the refinement); eq. (14) has none. Raise it for a robot that "
                   "slips sideways (docs/calib.md, \"lateral sigma\")")
+      ->check(kPositive)
+      ->capture_default_str()
+      ->group(gm);
+  cmd->add_option("--crowded-sigma", a->crowded_sigma,
+                  "The bearing sigma of a crowded line (tracks.csv's crowded column: another edge "
+                  "within a few pixels all along it) is --bearing-sigma times this")
       ->check(kPositive)
       ->capture_default_str()
       ->group(gm);

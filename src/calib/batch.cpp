@@ -499,7 +499,7 @@ Built build(const CalibrationRun& run,
       auto it = b.features.find(o.track_id);
       if (it == b.features.end()) continue;
       auto* cost = new ceres::AutoDiffCostFunction<BearingResidual, 1, 3, 2, 3>(
-          new BearingResidual{o.beta, 1.0 / options.bearing_sigma});
+          new BearingResidual{o.beta, 1.0 / (options.bearing_sigma * o.sigma_scale)});
       ceres::LossFunction* loss = robust ? new ceres::HuberLoss(batch.huber_sigmas) : nullptr;
       b.bearing_blocks.push_back(b.problem->AddResidualBlock(
           cost, loss, b.poses[k].data(), it->second.data(), b.ex.data()));

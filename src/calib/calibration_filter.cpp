@@ -42,6 +42,9 @@ void CalibrationFilter::process(const FrameInput& frame) {
     if (!std::isfinite(o.beta))
       throw InputError(where + ": bearing of track " + std::to_string(o.track_id) +
                        " is not a finite number");
+    if (!(std::isfinite(o.sigma_scale) && o.sigma_scale > 0.0))
+      throw InputError(where + ": bearing of track " + std::to_string(o.track_id) +
+                       " has a sigma scale that is not a positive number");
     if (!seen.insert(o.track_id).second)
       throw InputError(where + ": track " + std::to_string(o.track_id) +
                        " appears twice in one frame");
@@ -154,7 +157,7 @@ void CalibrationFilter::step(const FrameInput& frame) {
       guarded_.emplace_back(o.track_id, frame_);
       continue;
     }
-    z.push_back({slot, o.beta});
+    z.push_back({slot, o.beta, o.sigma_scale});
   }
   const std::vector<BearingUpdateResult> results = updater_.update(z, &state_);
   for (std::size_t k = 0; k < z.size(); ++k) {
@@ -167,7 +170,7 @@ void CalibrationFilter::step(const FrameInput& frame) {
   }
   // Tracks that start enter the state (their first bearing is used by the initialisation).
   for (const BearingObservation* o : fresh) {
-    initializer_.initialize(o->track_id, o->beta, frame_, &state_);
+    initializer_.initialize(o->track_id, o->beta, frame_, &state_, o->sigma_scale);
     ++rec.num_new;
   }
   // Inverse-depth blocks whose depth is now well known change to (D, theta) of eq. (28)

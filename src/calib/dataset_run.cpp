@@ -131,11 +131,13 @@ DatasetRun calibration_run_from_tracks(const dataset::Dataset& data,
       continue;
     }
     out.run.frames[static_cast<std::size_t>(r.frame)].observations.push_back(
-        {static_cast<int>(r.track_id), r.bearing});
+        {static_cast<int>(r.track_id), r.bearing, r.crowded ? opt.crowded_sigma_scale : 1.0});
     ++used_tracks[r.track_id];
     ++out.observations;
+    out.crowded_bearings += r.crowded ? 1 : 0;
   }
   out.tracks = static_cast<int>(used_tracks.size());
+  out.crowded_sigma_scale = opt.crowded_sigma_scale;
   if (out.double_claims > 0) {
     out.warnings.push_back(std::to_string(out.double_claims) +
                            " times a track held two lines of one frame (the paper's rules allow "

@@ -1,15 +1,21 @@
 #include "omnivert/calib/feature_initializer.hpp"
 
+#include <cmath>
+
 #include "omnivert/calib/model.hpp"
 #include "omnivert/core/angles.hpp"
 
 namespace omnivert::calib {
 
-int FeatureInitializer::initialize(int track_id, double beta, int frame, FilterState* state) const {
+int FeatureInitializer::initialize(int track_id,
+                                   double beta,
+                                   int frame,
+                                   FilterState* state,
+                                   double sigma_scale) const {
   const Extrinsics ex = state->extrinsics();
   const int n = state->dim();
   const int e = state->extrinsics_index();
-  const double var_beta = options_.bearing_sigma * options_.bearing_sigma;
+  const double var_beta = std::pow(options_.bearing_sigma * sigma_scale, 2);
 
   FeatureSlot slot;
   slot.track_id = track_id;

@@ -207,6 +207,8 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
   if (in.run) {
     inputs["tracks_used"] = in.run->tracks;
     inputs["bearings_used"] = in.run->observations;
+    inputs["crowded_bearings"] = in.run->crowded_bearings;
+    inputs["crowded_sigma_scale"] = num(in.run->crowded_sigma_scale);
     inputs["path_length_m"] = num(in.run->path_length);
     inputs["rotation_deg"] = num(rad2deg(in.run->rotation));
     inputs["frames_dropped_for_wheel_gaps"] = in.run->frames_dropped_for_gaps;
@@ -385,6 +387,8 @@ std::string report_html(const CalibrationResult& r, const ReportInputs& in) {
     kv("tracks / bearings used", std::to_string(in.run->tracks) + " / " + std::to_string(in.run->observations));
     kv("path driven / total rotation",
        f("%.2f m", in.run->path_length) + " / " + f("%.0f deg", rad2deg(in.run->rotation)));
+    kv("bearings of crowded lines (sigma x)", std::to_string(in.run->crowded_bearings) + " (x" +
+                                                    f("%g", in.run->crowded_sigma_scale) + ")");
     kv("frames with too few lines", std::to_string(in.run->starved_frames));
     kv("frames dropped for wheel gaps", std::to_string(in.run->frames_dropped_for_gaps));
   }

@@ -240,6 +240,42 @@ TEST(CalibrationFilter, TracksEnterAndLeave) {
   for (int i = 0; i < 3; ++i) EXPECT_LT(std::abs(e(i)), 4.0 * std::sqrt(C(i, i))) << i;
 }
 
+// BearingObservation::sigma_scale weighs a bearing as one of sigma bearing_sigma x scale: the
+// filter, the refinement and the Cramer-Rao bound on a run whose bearings all have scale 2
+// equal those of the same run at twice the bearing sigma; a few scaled bearings change the
+// estimate and loosen the bound.
+TEST(CalibrationFilter, BearingSigmaScaleWeighsLikeALargerSigma) {
+  SyntheticRunOptions so;
+  so.bearing_sigma = deg2rad(0.05);
+  so.seed = 5;
+  const SyntheticRun run = make_synthetic_run(so);
+  Options o = options_for(so);
+  o.bearing_sigma = deg2rad(0.05);
+  CalibrationRun scaled = run.run, some = run.run;
+  for (FrameInput& f : scaled.frames)
+    for (BearingObservation& b : f.observations) b.sigma_scale = 2.0;
+  for (std::size_t k = 0; k < some.frames.size(); k += 3)
+    for (BearingObservation& b : some.frames[k].observations) b.sigma_scale = 4.0;
+  Options wide = o;
+  wide.bearing_sigma = 2.0 * o.bearing_sigma;
+  const FilterResult a = run_filter(scaled, o), b = run_filter(run.run, wide);
+  EXPECT_LT((a.extrinsics.vec() - b.extrinsics.vec()).norm(), 1e-9);
+  EXPECT_LT((a.covariance - b.covariance).norm(), 1e-9 * b.covariance.norm());
+  const RefinementResult ra = refine_batch(scaled, o, batch_point_from_filter(scaled, o, a));
+  const RefinementResult rb = refine_batch(run.run, wide, batch_point_from_filter(run.run, wide, b));
+  ASSERT_TRUE(ra.covariance_ok && rb.covariance_ok);
+  EXPECT_LT((ra.extrinsics.vec() - rb.extrinsics.vec()).norm(), 1e-7);
+  EXPECT_LT((ra.covariance - rb.covariance).norm(), 1e-6 * rb.covariance.norm());
+  // Scaled bearings every third frame: a different estimate, a larger bound than unscaled.
+  const FilterResult c = run_filter(some, o), d = run_filter(run.run, o);
+  EXPECT_GT((c.extrinsics.vec() - d.extrinsics.vec()).norm(), 1e-7);
+  const BatchPoint at = batch_point_from_filter(run.run, o, d);
+  const ObservabilityReport os = analyse_observability(some, o, at, BatchOptions{});
+  const ObservabilityReport od = analyse_observability(run.run, o, at, BatchOptions{});
+  EXPECT_GT(os.phi.crlb, 1.01 * od.phi.crlb);
+  EXPECT_GT(os.rho.crlb, 1.01 * od.rho.crlb);
+}
+
 TEST(CalibrationFilter, BadInputIsAnInputError) {
   Options o;
   o.bearing_sigma = -1.0;
@@ -258,6 +294,9 @@ TEST(CalibrationFilter, BadInputIsAnInputError) {
   FrameInput nanbeta;
   nanbeta.observations = {{1, std::nan("")}};
   EXPECT_THROW(f.process(nanbeta), InputError);
+  FrameInput zero_scale;
+  zero_scale.observations = {{1, 0.1, 0.0}};
+  EXPECT_THROW(f.process(zero_scale), InputError);
 }
 
 }  // namespace

@@ -16,8 +16,10 @@ namespace omnivert::calib {
 class FeatureInitializer {
  public:
   explicit FeatureInitializer(const Options& options) : options_(options) {}
-  // Adds track `track_id`, first seen at bearing beta in frame `frame`. Returns its slot.
-  int initialize(int track_id, double beta, int frame, FilterState* state) const;
+  // Adds track `track_id`, first seen at bearing beta (sigma: Options::bearing_sigma x
+  // sigma_scale) in frame `frame`. Returns its slot.
+  int initialize(int track_id, double beta, int frame, FilterState* state,
+                 double sigma_scale = 1.0) const;
 
  private:
   Options options_;

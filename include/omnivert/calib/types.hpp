@@ -32,6 +32,9 @@ struct Extrinsics {
 struct BearingObservation {
   int track_id = -1;  // the tracker's id; the same line keeps its id along its track
   double beta = 0.0;  // bearing in the camera frame [rad], any range (wrapped internally)
+  // This bearing's noise sigma is Options::bearing_sigma x sigma_scale (> 0): a crowded
+  // line's bearing is noisier (DatasetRunOptions::crowded_sigma_scale).
+  double sigma_scale = 1.0;
 };
 
 // What the CLI feeds per image frame: the wheel travel since the previous frame (zero for
