@@ -272,6 +272,7 @@ void run_calibrate(const CalibrateArgs& a) {
   else
     std::printf("bearing sigma %.3f deg (no noise check%s)\n", rad2deg(result.bearing_sigma),
                 a.noise_check ? ": the run does not determine the extrinsics" : "");
+  if (const std::string w = calib::wheel_check_line(result); !w.empty()) std::printf("%s\n", w.c_str());
   if (result.refined && result.refinement.num_splits > 0)
     std::printf("refinement: %d tracks split where they changed line (summary.json lists them)\n",
                 result.refinement.num_splits);

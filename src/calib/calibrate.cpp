@@ -203,6 +203,37 @@ std::vector<std::string> result_warnings(const CalibrationResult& r) {
       out.emplace_back(buf);
     }
   }
+  if (const WheelCheck& w = wheel_check_of(r); wheel_check_rejects_model(w)) {
+    // The wheels' turns are (1 + s) x the robot's (eq. 15 divides by the wheel base: e (1 + s)
+    // fits); c: rotation per metre rolled that the wheels report and the robot did not make
+    // (right and left wheel scales |c| x e apart).
+    std::string what;
+    if (std::abs(w.rotation_scale) > 3.0 * w.sigma_rotation_scale) {
+      std::snprintf(buf, sizeof(buf),
+                    "the wheels report turns %.2f%% %s than the robot made (+-%.2f%%; a wheel base "
+                    "of %.4f m instead of %.4f m in wheel0/sensor.yaml would fit)",
+                    100.0 * std::abs(w.rotation_scale), w.rotation_scale > 0 ? "larger" : "smaller",
+                    100.0 * w.sigma_rotation_scale, w.wheel_base * (1.0 + w.rotation_scale),
+                    w.wheel_base);
+      what = buf;
+    }
+    if (std::abs(w.drift_per_m) > 3.0 * w.sigma_drift_per_m) {
+      std::snprintf(buf, sizeof(buf),
+                    "%sthe wheels report %.3f deg of turning per metre rolled that the robot did "
+                    "not make (+-%.3f; the right and left wheels' scales are about %.2f%% apart)",
+                    what.empty() ? "" : "; ", rad2deg(w.drift_per_m), rad2deg(w.sigma_drift_per_m),
+                    100.0 * std::abs(w.drift_per_m) * w.wheel_base);
+      what += buf;
+    }
+    if (what.empty()) what = "the wheels' rotation disagrees with the bearings'";
+    std::snprintf(buf, sizeof(buf),
+                  "wheel odometry has a systematic error that its model (eq. 31, K) does not "
+                  "describe (wheel check chi-square %.1f, 99.9%% limit %.1f): %s. The extrinsics "
+                  "may be biased by it: correct the wheel base and wheel scales in "
+                  "wheel0/sensor.yaml, or raise --odometry-inflation",
+                  w.chi2, chi2_quantile(0.999, 2), what.c_str());
+    out.emplace_back(buf);
+  }
   if (r.refined && r.refinement.covariance_ok && r.filter.covariance.allFinite()) {
     const Extrinsics& f = r.filter.extrinsics;
     const Extrinsics& b = r.refinement.extrinsics;
@@ -222,6 +253,10 @@ std::vector<std::string> result_warnings(const CalibrationResult& r) {
     }
   }
   return out;
+}
+
+const WheelCheck& wheel_check_of(const CalibrationResult& r) {
+  return r.refined ? r.refinement.noise.wheels : r.filter_noise.wheels;
 }
 
 namespace {

@@ -191,6 +191,20 @@ std::string noise_check_line(const CalibrationResult& r) {
   return buf;
 }
 
+std::string wheel_check_line(const CalibrationResult& r) {
+  const WheelCheck& w = wheel_check_of(r);
+  if (!w.ok) return {};
+  char buf[320];
+  std::snprintf(buf, sizeof(buf),
+                "wheel check over %d frames: the wheels' turns x%.4f (+-%.4f) of the robot's, "
+                "%+.3f deg/m (+-%.3f) of drift; chi-square %.1f (99.9%% limit %.1f): %s",
+                w.frames, 1.0 + w.rotation_scale, w.sigma_rotation_scale, rad2deg(w.drift_per_m),
+                rad2deg(w.sigma_drift_per_m), w.chi2, chi2_quantile(0.999, 2),
+                wheel_check_rejects_model(w) ? "a systematic wheel error (see the warning)"
+                                             : "as the odometry model allows");
+  return buf;
+}
+
 std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
   json j;
   j["tool"] = "omnivert calibrate";
@@ -295,6 +309,17 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
     auto checked = [&](double crlb, int i) {
       return num(r.noise_checked ? crlb * std::sqrt(n.covariance(i, i) / n.model_covariance(i, i)) : NAN);
     };
+    {
+      const WheelCheck& w = wheel_check_of(r);
+      nc["wheels"] = {{"checked", w.ok},
+                      {"frames", w.frames},
+                      {"rotation_scale", num(w.ok ? w.rotation_scale : NAN)},
+                      {"sigma_rotation_scale", num(w.ok ? w.sigma_rotation_scale : NAN)},
+                      {"drift_deg_per_m", num(w.ok ? rad2deg(w.drift_per_m) : NAN)},
+                      {"sigma_drift_deg_per_m", num(w.ok ? rad2deg(w.sigma_drift_per_m) : NAN)},
+                      {"chi2", num(w.ok ? w.chi2 : NAN)},
+                      {"rejects_model", wheel_check_rejects_model(w)}};
+    }
     nc["crlb_checked"] = {{"phi", checked(r.observability.phi.crlb, 0)},
                           {"rho", checked(r.observability.rho.crlb, 1)},
                           {"psi", checked(r.observability.psi.crlb, 2)}};
@@ -397,6 +422,10 @@ std::string report_html(const CalibrationResult& r, const ReportInputs& in) {
          f("%g", in.options.odometry_inflation) + ")");
   kv("bearing sigma", f("%.4f deg", rad2deg(r.bearing_sigma)));
   kv("noise check", r.noise_checked ? noise_check_line(r) : std::string("not made"));
+  {
+    const std::string w = wheel_check_line(r);
+    kv("wheel check", w.empty() ? std::string("not made") : w);
+  }
   kv("filter's window",
      r.filter.window_frames == 0
          ? std::string("none")

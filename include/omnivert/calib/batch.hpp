@@ -72,7 +72,29 @@ BatchPoint batch_point_from_filter(const CalibrationRun& run,
 // average when the assumed noise is right and above 1 when the bearings are noisier or
 // correlated along tracks (then sigma x sqrt(scale) is the independent noise that would do
 // the same harm). covariance = model + (scale - 1) bearing_part.
+// The wheel check: per frame, the wheels' rotation (eq. 15) minus the robot's at a batch
+// solution (where the bearings fix the heading far better than the wheels, in turns),
+// regressed on the solution's rotation and the distance rolled, with the weights of the
+// odometry model (eq. 31, K x1): wheels' turn = (1 + rotation_scale) x the robot's
+// + drift_per_m [rad/m] x distance + noise. rotation_scale: the wheel base in the model is
+// (1 + s) times too short (a wheel base e (1 + s) fits); drift_per_m: a rotation the wheels
+// report while rolling straight (right and left wheel scales |drift| x e apart). (The robot's
+// rotation, not the wheels', is the regressor: the wheels' own noise in it would bias the
+// scale towards 0 - 1 / (its information), -0.2 % on the synthetic paper runs.) Both are 0
+// under the model; `chi2` is the pair's chi-square(2) statistic against it. A systematic
+// wheel error is what the paper's five-fold K inflation guards against; this says when there
+// is one, and how large.
+struct WheelCheck {
+  bool ok = false;
+  double rotation_scale = 0.0, sigma_rotation_scale = 0.0;
+  double drift_per_m = 0.0, sigma_drift_per_m = 0.0;
+  double chi2 = 0.0;
+  int frames = 0;  // frames with motion used
+  double wheel_base = 0.0;  // [m], the model's e
+};
+
 struct BatchNoiseCheck {
+  WheelCheck wheels;
   bool ok = false;
   double scale = std::numeric_limits<double>::quiet_NaN();
   int clusters = 0;  // tracks
@@ -90,6 +112,9 @@ struct BatchNoiseCheck {
 // pessimistic (corridor from pixels: scale 0.16, and the covariance shrunk by it gave NEES
 // 4.9). false when the check failed or has fewer than 2 tracks.
 bool noise_check_rejects_model(const BatchNoiseCheck& check, double level = 0.01);
+// Whether the wheel check shows a systematic wheel error: its chi-square(2) statistic above
+// the 1 - level quantile (0.999: 13.8). false when the check was not made.
+bool wheel_check_rejects_model(const WheelCheck& check, double level = 0.001);
 // The scale above which it does: the 1 - level quantile of chi-square(tracks) / tracks.
 double noise_check_limit(int tracks, double level = 0.01);
 

@@ -74,7 +74,13 @@ CalibrationResult calibrate(const CalibrationRun& run,
 // distance under the filter's covariance above 16.27, chi-square with 3 degrees of freedom):
 // the filter is biased or overconfident on this run, and the refinement's answer is the one
 // to trust (seen where tracks slip onto a neighbouring line, docs/calib.md).
+// A warning, too, when the wheel check (WheelCheck, at the refinement or at the filter's
+// noise check) finds a systematic wheel error, with its size and what to correct.
 std::vector<std::string> result_warnings(const CalibrationResult& result);
+
+// The wheel check of a result: the refinement's when refined, else the filter's noise
+// check's (not made: ok = false).
+const WheelCheck& wheel_check_of(const CalibrationResult& result);
 
 // DIR/extrinsics.yaml of issue 5: phi, rho, psi, sigma_phi, sigma_rho, sigma_psi, covariance
 // (3x3, row-major), x, y, yaw (= phi + psi), T_base_cam (4x4), observable, crlb_phi,

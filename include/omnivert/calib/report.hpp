@@ -60,6 +60,9 @@ struct ReportInputs {
 // report: over how many tracks, the independent noise the errors act as, and what was done;
 // empty when no check was made.
 std::string noise_check_line(const CalibrationResult& result);
+// One line on the wheel check (WheelCheck): the wheels' turn scale and drift against the
+// robot's, and the verdict; empty when no check was made.
+std::string wheel_check_line(const CalibrationResult& result);
 
 // summary.json's text (pretty-printed JSON).
 std::string summary_json(const CalibrationResult& result, const ReportInputs& inputs);
