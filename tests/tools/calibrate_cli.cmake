@@ -5,7 +5,7 @@
 #         -DWORK=<scratch dir> -DMODE=<mode> -P calibrate_cli.cmake
 # MODE: end_to_end | straight | straight_force | wheel_gap | wheel_short | wheel_decreasing |
 #       no_wheel | few_lines | no_lines | prior_file | few_tracks | no_noise_check |
-#       tracks_file
+#       tracks_file | wheel_base_wrong
 cmake_minimum_required(VERSION 3.20)
 
 function(fail msg)
@@ -195,6 +195,35 @@ elseif(MODE STREQUAL "wheel_gap")
   string(JSON dropped GET "${json}" inputs frames_dropped_for_wheel_gaps)
   if(dropped LESS 5 OR dropped GREATER 7)
     fail("2 s at 3 Hz: expected 6 frames inside the gap, ${dropped} dropped")
+  endif()
+
+elseif(MODE STREQUAL "wheel_base_wrong")
+  # wheel0/sensor.yaml's wheel base 2% short of the robot's (0.4 m): the wheels then report
+  # turns 2% larger than the robot makes; the wheel check says so, with the wheel base that
+  # fits. The true one passes the check (end_to_end's dataset, checked here too).
+  copy_dataset(${PAPER} ${data})
+  file(READ ${data}/wheel0/sensor.yaml yaml)
+  string(REGEX REPLACE "wheel_base: 0.4" "wheel_base: 0.392157" yaml "${yaml}")
+  file(WRITE ${data}/wheel0/sensor.yaml "${yaml}")
+  run_calibrate(${data} ${out_dir})
+  if(NOT rc EQUAL 0)
+    fail("calibrate exited ${rc}: ${err}")
+  endif()
+  check_no_nan(${out_dir})
+  file(READ ${out_dir}/summary.json json)
+  string(JSON rejects GET "${json}" noise_check wheels rejects_model)
+  string(JSON s GET "${json}" noise_check wheels rotation_scale)
+  if(NOT rejects OR s LESS 0.012 OR s GREATER 0.028)
+    fail("wheel check: rejects ${rejects}, scale ${s} (expected about 0.02)")
+  endif()
+  if(NOT err MATCHES "the wheels report turns 2\\.[0-9]+% larger than the robot made .*a wheel base of 0\\.[0-9]+ m instead of 0\\.3922 m in wheel0/sensor.yaml would fit")
+    fail("no wheel warning with the wheel base that fits: ${err}")
+  endif()
+  run_calibrate(${PAPER} ${out_dir}-true)
+  file(READ ${out_dir}-true/summary.json json)
+  string(JSON rejects GET "${json}" noise_check wheels rejects_model)
+  if(rejects OR err MATCHES "wheel odometry has a systematic error")
+    fail("the true wheel base should pass the wheel check: ${err}")
   endif()
 
 elseif(MODE STREQUAL "wheel_short")
