@@ -14,6 +14,8 @@
 #include <memory>
 #include <optional>
 #include <set>
+#include <string>
+#include <vector>
 
 #include <spdlog/spdlog.h>
 
@@ -50,6 +52,7 @@ struct CalibrateArgs {
   bool force = false;
   std::string prior_file;
   std::string tracks_file;  // --tracks: an existing tracks.csv instead of tracking
+  std::vector<std::string> unused_with_tracks;  // extraction/tracking flags given with --tracks
   std::optional<double> phi, rho, psi, sigma_phi, sigma_rho, sigma_psi;
   std::optional<double> bearing_sigma_deg;
   std::optional<double> odometry_inflation;
@@ -199,6 +202,12 @@ void run_calibrate(const CalibrateArgs& a) {
              "\"Shorter lines\")";
       warnings.push_back(w);
     }
+  }
+  if (given_tracks && !a.unused_with_tracks.empty()) {
+    std::string list;
+    for (const std::string& n : a.unused_with_tracks) list += (list.empty() ? "" : ", ") + n;
+    warnings.push_back("--tracks: the tracks are read from " + a.tracks_file + "; " + list +
+                       " (extraction and tracking options) did nothing");
   }
   for (const auto& w : warnings) spdlog::warn("{}", w);
   if (Progress::enabled()) std::fprintf(stderr, "calibrate: filter%s...\n", a.refine ? " and refinement" : "");
@@ -389,7 +398,16 @@ void add_calibrate_command(CLI::App& app) {
       ->group(gm);
   add_pipeline_options(cmd, a->pipeline);
   add_tracker_options(cmd, a->tracker);
-  cmd->callback([a] { run_calibrate(*a); });
+  cmd->callback([a, cmd] {
+    // Extraction and tracking flags given with --tracks do nothing: say so.
+    a->unused_with_tracks.clear();
+    for (const CLI::Option* o : cmd->get_options())
+      if (o->count() > 0 && (o->get_group() == "Extraction (Sec. 2)" ||
+                             o->get_group() == "Descriptor (Sec. 3)" ||
+                             o->get_group() == "Tracking (Sec. 4, 9.1)"))
+        a->unused_with_tracks.push_back(o->get_name());
+    run_calibrate(*a);
+  });
 }
 
 }  // namespace omnivert::cli
