@@ -296,18 +296,6 @@ std::vector<double*> variable_blocks(Built& b) {
   return v;
 }
 
-// The error of the extrinsics measured by the data themselves (BatchNoiseCheck): at the
-// solution theta^ of the whitened problem (residuals r, Jacobian J, Fisher information
-// F = J^T J), the estimate's first-order error is -F^-1 J^T e for the true errors e. The
-// extrinsics' rows of F^-1 are A (3 x n); the model covariance is A F A^T = [F^-1]_ee, which
-// holds when every whitened error is independent with unit variance. The bearings of one
-// track are not independent (an edge's position error changes slowly from frame to frame,
-// and two nearly aligned lines pull a track's detections together), so the errors are
-// summed per track before they are squared: the cluster-robust ("sandwich") covariance
-// sum_c (A J_c^T r_c)(A J_c^T r_c)^T over clusters c (each track's bearings; each odometry
-// factor). A track's own feature point absorbs the part of its errors along its own columns
-// of J, and that part does not reach the extrinsics (A F_{:,f} = 0), so the fitted residuals
-// stand in for the true errors up to the leverage of the shared variables.
 // BatchNoiseCheck::wheels (WheelCheck): per frame, the wheels' rotation minus the solution's,
 // with the variance eq. (31) gives the wheels' (K x batch inflation, composed over the frame's
 // samples), fitted by weighted least squares as s x (the solution's rotation) + c x (distance
@@ -321,7 +309,6 @@ WheelCheck wheel_check(const Built& b,
   if (!(e > 0.0)) return out;
   Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
   Eigen::Vector2d g = Eigen::Vector2d::Zero();
-  double rr = 0.0;
   const std::size_t n = std::min(run.frames.size(), b.poses.size());
   for (std::size_t k = 1; k < n; ++k) {
     const FrameInput& f = run.frames[k];
@@ -340,7 +327,6 @@ WheelCheck wheel_check(const Built& b,
     const Eigen::Vector2d x(robot, dist);
     A += x * x.transpose() / v;
     g += x * r / v;
-    rr += r * r / v;
     ++out.frames;
   }
   const Eigen::LDLT<Eigen::Matrix2d> ldlt(A);
@@ -359,6 +345,18 @@ WheelCheck wheel_check(const Built& b,
   return out;
 }
 
+// The error of the extrinsics measured by the data themselves (BatchNoiseCheck): at the
+// solution theta^ of the whitened problem (residuals r, Jacobian J, Fisher information
+// F = J^T J), the estimate's first-order error is -F^-1 J^T e for the true errors e. The
+// extrinsics' rows of F^-1 are A (3 x n); the model covariance is A F A^T = [F^-1]_ee, which
+// holds when every whitened error is independent with unit variance. The bearings of one
+// track are not independent (an edge's position error changes slowly from frame to frame,
+// and two nearly aligned lines pull a track's detections together), so the errors are
+// summed per track before they are squared: the cluster-robust ("sandwich") covariance
+// sum_c (A J_c^T r_c)(A J_c^T r_c)^T over clusters c (each track's bearings; each odometry
+// factor). A track's own feature point absorbs the part of its errors along its own columns
+// of J, and that part does not reach the extrinsics (A F_{:,f} = 0), so the fitted residuals
+// stand in for the true errors up to the leverage of the shared variables.
 BatchNoiseCheck noise_check(Built& b, int dense_limit) {
   BatchNoiseCheck out;
   ceres::Problem::EvaluateOptions eo;
