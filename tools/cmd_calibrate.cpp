@@ -94,9 +94,8 @@ TrackDatasetResult tracks_of_dataset(const std::string& file, const dataset::Dat
   t.rows = read_tracks_csv(file);
   const auto& images = data.images();
   std::set<std::int64_t> ids;
-  for (std::size_t i = 0; i < t.rows.size(); ++i) {
-    const TrackRow& r = t.rows[i];
-    const int line = static_cast<int>(i) + 2;  // the header is line 1
+  for (const TrackRow& r : t.rows) {
+    const int line = r.source_line;
     if (r.frame >= static_cast<std::int64_t>(images.size()))
       throw InputError(file, line,
                        "frame " + std::to_string(r.frame) + " is not an image of " + data.root() +

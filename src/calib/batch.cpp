@@ -1147,9 +1147,10 @@ bool bootstrap_filter_state(const CalibrationRun& window_in,
     reject_and_solve();
     if (b.features.empty()) return fail("no track left in the window where lines do not cross");
   }
-  auto tracker_id = [&origin, &gap_origin](int id) {
-    if (origin.count(id)) id = origin.at(id);
-    return gap_origin.count(id) ? gap_origin.at(id) : id;
+  const std::map<int, int> renamed = to_tracker();
+  auto tracker_id = [&renamed](int id) {
+    const auto it = renamed.find(id);
+    return it != renamed.end() ? it->second : id;
   };
   if (!summary.IsSolutionUsable()) return fail("window solve failed: " + summary.BriefReport());
 

@@ -151,6 +151,7 @@ std::vector<TrackRow> read_tracks_csv(const fs::path& path) {
     auto field = [&](const char* name) { return fields[static_cast<std::size_t>(col.at(name))]; };
     auto has = [&](const char* name) { return col.count(name) > 0; };
     TrackRow r;
+    r.source_line = line_no;
     r.frame = parse_number<std::int64_t>(field("frame"), file, line_no, "frame");
     r.timestamp_ns =
         parse_number<std::int64_t>(field("timestamp_ns"), file, line_no, "timestamp_ns");

@@ -39,6 +39,9 @@ struct TrackRow {
   int matched_line = -1;
   // VerticalLine::crowded: another edge runs within a few pixels all along this line.
   bool crowded = false;
+  // The line of the file it was read from (read_tracks_csv; 0: not read from a file), for
+  // messages about it. Not written.
+  int source_line = 0;
 };
 
 // Appends one row per line of `frame` (in line order) from the tracker's assignments.
