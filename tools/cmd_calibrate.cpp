@@ -372,8 +372,9 @@ void add_calibrate_command(CLI::App& app) {
       ->check(kPositive)
       ->group(gm);
   cmd->add_option("--odometry-inflation", a->odometry_inflation,
-                  "Factor on the Chong-Kleeman K of wheel0/sensor.yaml, eq. (31) (default 5, the "
-                  "paper's)")
+                  "Factor on the Chong-Kleeman K of wheel0/sensor.yaml, eq. (31), in the filter "
+                  "(default 1: K as given; the paper used 5, which costs efficiency when K is "
+                  "right and helps when the wheels are off: docs/calib.md)")
       ->check(kPositive)
       ->group(gm);
   cmd->add_option("--lateral-sigma", a->lateral_sigma,

@@ -5,7 +5,7 @@
 // (calib::calibrate, docs/calib.md "The noise check").
 //
 //   calib_monte_carlo [--runs 50] [--sigma-deg 0.3] [--init anchored|inverse|naive]
-//                     [--inflation 5] [--iterations 3] [--trajectory paper|zigzag]
+//                     [--inflation 1] [--iterations 3] [--trajectory paper|zigzag]
 //                     [--bootstrap RAD] [--refine] [--seed 1] [--correlation A]
 //                     [--lateral M]
 // --init anchored (default): anchored inverse depth + camera-pose extrinsics, with the batch
@@ -97,7 +97,7 @@ int main(int argc, char** argv) {
   int runs = 50, iterations = 3;
   bool refine = false;
   double bootstrap = Options{}.bootstrap_rotation;
-  double sigma_deg = 0.3, inflation = 5.0, correlation = 0.0;
+  double sigma_deg = 0.3, inflation = 1.0, correlation = 0.0;
   double lateral = Options{}.lateral_sigma;
   std::string init = "anchored", trajectory = "paper";
   std::uint64_t seed = 1;

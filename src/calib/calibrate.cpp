@@ -230,7 +230,7 @@ std::vector<std::string> result_warnings(const CalibrationResult& r) {
                   "wheel odometry has a systematic error that its model (eq. 31, K) does not "
                   "describe (wheel check chi-square %.1f, 99.9%% limit %.1f): %s. The extrinsics "
                   "may be biased by it: correct the wheel base and wheel scales in "
-                  "wheel0/sensor.yaml, or raise --odometry-inflation",
+                  "wheel0/sensor.yaml, or raise --odometry-inflation (the paper used 5)",
                   w.chi2, chi2_quantile(0.999, 2), what.c_str());
     out.emplace_back(buf);
   }

@@ -2,7 +2,7 @@
 // EKF prediction of the self-calibration filter: dynamics eq. (29), Jacobians F_x, F_u of
 // appendix A.4 and the Chong-Kleeman odometry noise of eq. (31):
 //   X' = f(X, u),  P' = F_x P F_x^T + F_u Q F_u^T,  Q = diag(K' |d_R|, K' |d_L|),
-// with K' = K * inflation (the paper inflates K five-fold).
+// with K' = K * inflation (the paper inflates K five-fold; our default is 1: types.hpp).
 
 #include <array>
 
