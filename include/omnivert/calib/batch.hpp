@@ -135,6 +135,10 @@ struct RefinementResult {
   // Bearings left out where lines cross (Options::crossing_guard): (track id of the solved
   // run, i.e. of split_run when tracks were split, frame).
   std::vector<std::pair<int, int>> guarded;
+  // Bearings removed as outliers (the gate) or with a feature left with too few bearings:
+  // (track id of the solved run, frame). With `guarded`, what the solution did not use; the
+  // bound of Sec. 8.1 for this run is computed without them (calibrate()).
+  std::vector<std::pair<int, int>> rejected;
   CalibrationRun split_run;  // with splits: the run `solution` refers to (split parts renamed)
   // Scale of the bearing residuals at the solution, outliers removed [rad]: 1.4826 x median
   // |residual| x sqrt(bearings / (bearings - 2 features - 3)); the bearing noise the data
