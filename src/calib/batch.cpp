@@ -1282,6 +1282,13 @@ bool bootstrap_filter_state(const CalibrationRun& window_in,
       details->splits.emplace_back(gap_origin.count(id) ? gap_origin.at(id) : id, k);
     details->guarded.clear();
     for (const auto& [id, k] : b.guarded) details->guarded.emplace_back(tracker_id(id), k);
+    std::set<std::pair<int, int>> unused;
+    for (std::size_t k = 0; k < window_in.frames.size(); ++k)
+      for (const BearingObservation& o : window_in.frames[k].observations)
+        unused.emplace(o.track_id, static_cast<int>(k));
+    for (const auto& [id, k] : b.bearing_keys) unused.erase({tracker_id(id), k});
+    for (const auto& key : details->guarded) unused.erase(key);
+    details->rejected.assign(unused.begin(), unused.end());
   }
 
   std::vector<FeatureSlot> slots;

@@ -55,9 +55,11 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
   const BatchPoint filter_point = batch_point_from_filter(run, options, r.filter);
   BatchPoint at = filter_point;
   // Sec. 8.1 on the bearings the estimate used: those left out where lines cross
-  // (Options::crossing_guard) do not follow eq. (30)'s model and carry no information the
-  // estimators use.
-  CalibrationRun analysed = without_bearings(run, r.filter.guarded);
+  // (Options::crossing_guard) do not follow eq. (30)'s model, and those the gate refused are
+  // taken for outliers; neither carries information the estimators use.
+  std::vector<std::pair<int, int>> unused = r.filter.guarded;
+  unused.insert(unused.end(), r.filter.rejected.begin(), r.filter.rejected.end());
+  CalibrationRun analysed = without_bearings(run, unused);
   if (co.refine) {
     r.refinement = refine_batch(run, options, at, co.batch);
     r.refined = true;
@@ -66,7 +68,7 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
     // Neither the guarded bearings nor those the refinement rejected as outliers: the bound
     // is that of the problem the estimate solved (with the outliers' information counted,
     // corridor paper seed 27, 211 of 845 bearings rejected, the bounds came out 7% small).
-    std::vector<std::pair<int, int>> unused = r.refinement.guarded;
+    unused = r.refinement.guarded;
     unused.insert(unused.end(), r.refinement.rejected.begin(), r.refinement.rejected.end());
     analysed = without_bearings(r.refinement.num_splits > 0 ? r.refinement.split_run : run,
                                 unused);

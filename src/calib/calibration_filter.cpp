@@ -99,6 +99,11 @@ void CalibrationFilter::end_bootstrap(FrameEstimate rec) {
         const std::size_t k = static_cast<std::size_t>(frame + first);  // history_ ends before rec
         ++(k < history_.size() ? history_[k].num_guarded : rec.num_guarded);
       }
+      for (const auto& [id, frame] : details.rejected) {
+        rejected_.emplace_back(id, frame + first);
+        const std::size_t k = static_cast<std::size_t>(frame + first);
+        ++(k < history_.size() ? history_[k].num_rejected : rec.num_rejected);
+      }
       rec.extrinsics = state_.extrinsics();
       rec.covariance = state_.extrinsics_covariance();
       rec.num_features = state_.num_features();
@@ -166,6 +171,7 @@ void CalibrationFilter::step(const FrameInput& frame) {
       ++state_.mutable_slots()[z[k].slot].num_updates;
     } else {
       ++rec.num_rejected;
+      rejected_.emplace_back(state_.slots()[z[k].slot].track_id, frame_);
     }
   }
   // Tracks that start enter the state (their first bearing is used by the initialisation).
@@ -227,7 +233,8 @@ FilterResult run_filter(const CalibrationRun& run, const Options& options) {
   for (const FrameInput& f : run.frames) filter.process(f);
   filter.finish();
   return {filter.extrinsics(), filter.covariance(), filter.history(), filter.tracks(),
-          filter.splits(), filter.window_frames(), filter.window_failure(), filter.guarded()};
+          filter.splits(), filter.window_frames(), filter.window_failure(), filter.guarded(),
+          filter.rejected()};
 }
 
 }  // namespace omnivert::calib

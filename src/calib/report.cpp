@@ -264,6 +264,8 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
     j["filter"]["splits"] = splits_json(r.filter.splits);
     // Bearings left out where lines cross (Options::crossing_guard), window and EKF.
     j["filter"]["bearings_guarded"] = r.filter.guarded.size();
+    // Refused by the chi-square gate (outliers), window and EKF.
+    j["filter"]["bearings_rejected"] = r.filter.rejected.size();
   }
   if (r.refined) {
     json ref = extrinsics_json(r.refinement.extrinsics, r.refinement.covariance);

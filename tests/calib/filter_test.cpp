@@ -6,6 +6,7 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
+#include <set>
 
 #include "omnivert/calib/batch.hpp"
 #include "omnivert/calib/calibrate.hpp"
@@ -312,6 +313,55 @@ TEST(CalibrationFilter, BearingSigmaScaleWeighsLikeALargerSigma) {
   const ObservabilityReport od = analyse_observability(run.run, o, at, BatchOptions{});
   EXPECT_GT(os.phi.crlb, 1.01 * od.phi.crlb);
   EXPECT_GT(os.rho.crlb, 1.01 * od.rho.crlb);
+}
+
+// False matches (bearings 3 degrees off), in the start-up window and after it, are refused
+// by the gate and listed (tracker's id, frame); the bound of the filter's estimate is that
+// of the bearings it used: without them and the guarded ones.
+TEST(CalibrationFilter, RefusedBearingsAreListedAndLeftOutOfTheBound) {
+  SyntheticRunOptions so;
+  so.bearing_sigma = deg2rad(0.03);
+  so.seed = 2;
+  SyntheticRun run = make_synthetic_run(so);
+  const Options o = options_for(so);
+  std::set<std::pair<int, int>> planted;
+  for (std::size_t k = 5; k < run.run.frames.size(); k += 11) {
+    auto& obs = run.run.frames[k].observations;
+    if (obs.size() < 2) continue;
+    obs[1].beta += deg2rad(3.0);
+    planted.emplace(obs[1].track_id, static_cast<int>(k));
+  }
+  const CalibrationResult r = calibrate(run.run, o, {});
+  ASSERT_GT(r.filter.window_frames, 0);
+  const std::set<std::pair<int, int>> refused(r.filter.rejected.begin(), r.filter.rejected.end());
+  int in_window = 0, after = 0;
+  for (const auto& key : planted) {
+    EXPECT_TRUE(refused.count(key)) << "track " << key.first << ", frame " << key.second;
+    ++(key.second < r.filter.window_frames ? in_window : after);
+  }
+  EXPECT_GE(in_window, 3);
+  EXPECT_GE(after, 1);
+  EXPECT_LE(refused.size(), planted.size() + 3);  // few clean bearings refused
+  int counted = 0;
+  for (const FrameEstimate& h : r.filter.history) counted += h.num_rejected;
+  EXPECT_EQ(counted, static_cast<int>(r.filter.rejected.size()));
+  // The bound: that of the run without the refused and guarded bearings.
+  CalibrationRun used = run.run;
+  std::set<std::pair<int, int>> out = refused;
+  out.insert(r.filter.guarded.begin(), r.filter.guarded.end());
+  for (std::size_t k = 0; k < used.frames.size(); ++k) {
+    auto& obs = used.frames[k].observations;
+    obs.erase(std::remove_if(obs.begin(), obs.end(),
+                             [&](const BearingObservation& b) {
+                               return out.count({b.track_id, static_cast<int>(k)}) > 0;
+                             }),
+              obs.end());
+  }
+  const BatchPoint at = batch_point_from_filter(run.run, o, r.filter);
+  const ObservabilityReport expected = analyse_observability(used, o, at);
+  EXPECT_NEAR(r.observability.phi.crlb, expected.phi.crlb, 1e-9 * expected.phi.crlb);
+  EXPECT_NEAR(r.observability.rho.crlb, expected.rho.crlb, 1e-9 * expected.rho.crlb);
+  EXPECT_NEAR(r.observability.yaw.crlb, expected.yaw.crlb, 1e-9 * expected.yaw.crlb);
 }
 
 TEST(CalibrationFilter, BadInputIsAnInputError) {

@@ -180,6 +180,9 @@ struct BootstrapDetails {
   std::vector<std::pair<int, int>> splits;  // (tracker's track id, window frame of the new part)
   std::vector<std::pair<int, int>> guarded;  // (tracker's track id, window frame) left out
                                              // where lines cross (Options::crossing_guard)
+  // (tracker's track id, window frame) removed as outliers (the gate) or with a feature left
+  // without bearings: with `guarded`, what the window's solution did not use.
+  std::vector<std::pair<int, int>> rejected;
 };
 bool bootstrap_filter_state(const CalibrationRun& window,
                             const Options& options,

@@ -72,6 +72,10 @@ class CalibrationFilter {
   // Bearings left out where lines cross (Options::crossing_guard), in the window and after:
   // (tracker's track id, frame).
   const std::vector<std::pair<int, int>>& guarded() const { return guarded_; }
+  // Bearings refused by the chi-square gate, in the window and after (tracker's track id,
+  // frame). The bound of Sec. 8.1 for the filter's estimate is computed without these and
+  // the guarded ones (calibrate()).
+  const std::vector<std::pair<int, int>>& rejected() const { return rejected_; }
   int frames_processed() const { return frame_; }
   const Options& options() const { return options_; }
 
@@ -89,6 +93,7 @@ class CalibrationFilter {
   std::map<int, TrackEstimate> tracks_;
   std::vector<std::pair<int, int>> splits_;
   std::vector<std::pair<int, int>> guarded_;
+  std::vector<std::pair<int, int>> rejected_;
   int window_frames_ = 0;
   std::string window_failure_;
   bool bootstrapping_ = false;
@@ -106,7 +111,8 @@ struct FilterResult {
   std::vector<std::pair<int, int>> splits;  // CalibrationFilter::splits
   int window_frames = 0;                     // CalibrationFilter::window_frames
   std::string window_failure;                // CalibrationFilter::window_failure
-  std::vector<std::pair<int, int>> guarded;  // CalibrationFilter::guarded
+  std::vector<std::pair<int, int>> guarded;   // CalibrationFilter::guarded
+  std::vector<std::pair<int, int>> rejected;  // CalibrationFilter::rejected
 };
 FilterResult run_filter(const CalibrationRun& run, const Options& options);
 
