@@ -150,8 +150,8 @@ std::vector<double*> variable_blocks(Built& b);
 struct FeatureCovariance {
   bool ready = false, ok = false;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
-  std::map<int, int> column;                   // track id -> first column
-  std::map<int, Eigen::MatrixXd> solved;       // track id -> F^-1 (:, its two columns)
+  std::map<int, int> column;              // track id -> first column
+  std::map<int, Eigen::MatrixXd> solved;  // track id -> F^-1 (:, its two columns)
 };
 bool one_line(Built* b, int a, int c, double chi2, FeatureCovariance* cache) {
   if (!cache->ready) {
@@ -163,9 +163,12 @@ bool one_line(Built* b, int a, int c, double chi2, FeatureCovariance* cache) {
     if (!b->problem->Evaluate(eo, nullptr, nullptr, nullptr, &crs)) return false;
     const Eigen::SparseMatrix<double> J = sparse_jacobian(crs);
     Eigen::SparseMatrix<double> F = J.transpose() * J;
-    // The ridge of the window's covariance (bootstrap_filter_state): weights spanning ten
-    // orders of magnitude.
-    for (int i = 0; i < F.rows(); ++i) F.coeffRef(i, i) *= 1.0 + 1e-10;
+    // The ridge of the noise check (weights spanning ten orders of magnitude); a variable
+    // without any residual left gets a unit diagonal.
+    for (int i = 0; i < F.rows(); ++i) {
+      double& d = F.coeffRef(i, i);
+      d = d > 0.0 ? d * (1.0 + 1e-10) : 1.0;
+    }
     cache->ldlt.compute(F);
     cache->ok = cache->ldlt.info() == Eigen::Success && (cache->ldlt.vectorD().array() > 0).all();
     int col = 3 * (static_cast<int>(b->poses.size()) - 1);
