@@ -123,6 +123,30 @@ int drop_unobserved_features(Built* b, int min_bearings) {
   return static_cast<int>(drop.size());
 }
 
+// Removes the features that the solution puts closer than `min_range` to the camera centre
+// (eq. 16-17) at a frame with one of their bearings (Options::min_feature_range), with their
+// bearings and any prior on them. Returns how many features.
+int drop_collapsed_features(Built* b, double min_range) {
+  std::set<int> drop;
+  for (const auto& [id, k] : b->bearing_keys) {
+    const auto& p = b->poses[static_cast<std::size_t>(k)];
+    const auto& f = b->features.at(id);
+    const double a = p[2] + b->ex[0];
+    const double range =
+        std::hypot(f[0] - p[0] - b->ex[1] * std::cos(a), f[1] - p[1] - b->ex[1] * std::sin(a));
+    if (!(range >= min_range)) drop.insert(id);
+  }
+  if (drop.empty()) return 0;
+  filter_bearings(b, [&](ceres::ResidualBlockId, const std::pair<int, int>& key) {
+    return !drop.count(key.first);
+  });
+  for (int id : drop) {
+    b->problem->RemoveParameterBlock(b->features.at(id).data());  // and its residual blocks
+    b->features.erase(id);
+  }
+  return static_cast<int>(drop.size());
+}
+
 // Removes the bearings whose whitened residual exceeds `threshold` (the filter's chi-square
 // gate, in sigmas) at the current solution, then the features left with fewer than
 // `min_bearings` bearings (drop_unobserved_features). Returns how many bearings.
@@ -753,6 +777,8 @@ RefinementResult refine_batch(const CalibrationRun& run,
                          chi2_quantile(options.gate_probability, 2)) > 0)
       ceres::Solve(so, b.problem.get(), &summary);
     res.num_rejected = 0;
+    if (drop_collapsed_features(&b, options.min_feature_range) > 0)
+      ceres::Solve(so, b.problem.get(), &summary);
     for (int round = 0; round < 3; ++round) {
       // Two bearings at least determine a feature point.
       const int n = reject_outliers(&b, gate, 2);
@@ -1212,6 +1238,10 @@ bool bootstrap_filter_state(const CalibrationRun& window_in,
   auto reject_and_solve = [&] {
     if (reject_crossings(&b, options.crossing_guard, options.max_missed_frames, 1, to_tracker(),
                          chi2_quantile(options.gate_probability, 2)) > 0) {
+      if (b.features.empty()) return;
+      ceres::Solve(so, b.problem.get(), &summary);
+    }
+    if (drop_collapsed_features(&b, options.min_feature_range) > 0) {
       if (b.features.empty()) return;
       ceres::Solve(so, b.problem.get(), &summary);
     }

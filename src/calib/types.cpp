@@ -45,6 +45,8 @@ bool Options::IsValid(std::string* why) const {
       return fail(why, "prior sigmas of phi, rho, psi must all be > 0");
   if (!finite_positive(naive_distance) || !finite_positive(naive_distance_sigma))
     return fail(why, "naive_distance and naive_distance_sigma must be > 0 [m]");
+  if (!(std::isfinite(min_feature_range) && min_feature_range >= 0.0))
+    return fail(why, "min_feature_range must be >= 0");
   if (!finite_positive(min_feature_distance) || !(max_feature_distance > min_feature_distance))
     return fail(why, "need 0 < min_feature_distance < max_feature_distance");
   if (!(prior.rho < min_feature_distance))

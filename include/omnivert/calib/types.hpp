@@ -103,6 +103,12 @@ struct Options {
   double naive_distance_sigma = 2.0;   // [m] (kNaive)
   double min_feature_distance = 1.0;   // [m] (kInverseDistance: 2-sigma range of the prior)
   double max_feature_distance = 20.0;  // [m]
+  // A feature that a batch solve (window, refinement) puts closer than this to the camera at
+  // a frame that sees it has collapsed onto the camera, where its bearing (eq. 30) is not
+  // defined and its information without bound (synthetic, tracks broken every ~10 frames, 0.1
+  // degree, seed 2: a feature 3e-9 m from the camera, information 1e21 on rho, the filter's
+  // sigmas 1e-6 and its NEES 2.7e7). Such a feature is left out with its bearings.
+  double min_feature_range = 0.05;  // [m]
   double convert_ratio = 0.05;         // sigma_D / D below which (q, theta) -> (D, theta); 0: never
   // Delayed initialisation (kAnchoredInverseDepth only): the frames up to the first turn are
   // solved as a batch and the filter starts from that solution (bootstrap_filter_state).
