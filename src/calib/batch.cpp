@@ -100,6 +100,19 @@ int filter_bearings(Built* b, Keep keep) {
   return n;
 }
 
+// Removes the given features with their bearings and any prior on them. Returns how many.
+int remove_features(Built* b, const std::set<int>& drop) {
+  if (drop.empty()) return 0;
+  filter_bearings(b, [&](ceres::ResidualBlockId, const std::pair<int, int>& key) {
+    return !drop.count(key.first);
+  });
+  for (int id : drop) {
+    b->problem->RemoveParameterBlock(b->features.at(id).data());  // and its residual blocks
+    b->features.erase(id);
+  }
+  return static_cast<int>(drop.size());
+}
+
 // Removes the features left with fewer than `min_bearings` bearings (with their remaining
 // bearings and any prior on them): their information is singular. Measured: hall zigzag,
 // seed 1, every bearing of one track was an outlier in the filter's bootstrap window, whose
@@ -112,15 +125,7 @@ int drop_unobserved_features(Built* b, int min_bearings) {
   std::set<int> drop;
   for (const auto& [id, f] : b->features)
     if (count[id] < min_bearings) drop.insert(id);
-  if (drop.empty()) return 0;
-  filter_bearings(b, [&](ceres::ResidualBlockId, const std::pair<int, int>& key) {
-    return !drop.count(key.first);
-  });
-  for (int id : drop) {
-    b->problem->RemoveParameterBlock(b->features.at(id).data());  // and its residual blocks
-    b->features.erase(id);
-  }
-  return static_cast<int>(drop.size());
+  return remove_features(b, drop);
 }
 
 // Removes the features that the solution puts closer than `min_range` to the camera centre
@@ -136,15 +141,7 @@ int drop_collapsed_features(Built* b, double min_range) {
         std::hypot(f[0] - p[0] - b->ex[1] * std::cos(a), f[1] - p[1] - b->ex[1] * std::sin(a));
     if (!(range >= min_range)) drop.insert(id);
   }
-  if (drop.empty()) return 0;
-  filter_bearings(b, [&](ceres::ResidualBlockId, const std::pair<int, int>& key) {
-    return !drop.count(key.first);
-  });
-  for (int id : drop) {
-    b->problem->RemoveParameterBlock(b->features.at(id).data());  // and its residual blocks
-    b->features.erase(id);
-  }
-  return static_cast<int>(drop.size());
+  return remove_features(b, drop);
 }
 
 // Removes the bearings whose whitened residual exceeds `threshold` (the filter's chi-square
