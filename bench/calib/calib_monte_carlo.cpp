@@ -7,13 +7,15 @@
 //   calib_monte_carlo [--runs 50] [--sigma-deg 0.3] [--init anchored|inverse|naive]
 //                     [--inflation 1] [--iterations 3] [--trajectory paper|zigzag]
 //                     [--bootstrap RAD] [--refine] [--seed 1] [--correlation A]
-//                     [--lateral M]
+//                     [--lateral M] [--break P]
 // --init anchored (default): anchored inverse depth + camera-pose extrinsics, with the batch
 //   window up to the first turn (--bootstrap, rad of rotation; 0: no window);
 // --init inverse: the paper's state eq. (28) with undelayed inverse-distance features;
 // --init naive: NOTES Sec. 5's naive initialisation.
 // --correlation A: AR(1) coefficient of each track's bearing errors from frame to frame.
 // --lateral M: sideways slip per step allowed by the batch problems (window, refinement).
+// --break P: each track gets a new id with probability P per frame (a tracker that loses
+//   lines and finds them again; docs/calib.md, "Pieces of one line").
 // Diagnostics (environment): PRIOR_AT_TRUTH=s (prior centred on truth, sigma s), PRIOR_SIGMA=s,
 // DMIN/DMAX (feature distance prior), CONVERT (convert_ratio), NO_SECOND_ORDER, VERBOSE.
 #include <Eigen/Cholesky>
@@ -97,7 +99,7 @@ int main(int argc, char** argv) {
   int runs = 50, iterations = 3;
   bool refine = false;
   double bootstrap = Options{}.bootstrap_rotation;
-  double sigma_deg = 0.3, inflation = 1.0, correlation = 0.0;
+  double sigma_deg = 0.3, inflation = 1.0, correlation = 0.0, break_probability = 0.0;
   double lateral = Options{}.lateral_sigma;
   std::string init = "anchored", trajectory = "paper";
   std::uint64_t seed = 1;
@@ -115,6 +117,8 @@ int main(int argc, char** argv) {
       sigma_deg = std::atof(next());
     else if (!std::strcmp(argv[i], "--correlation"))
       correlation = std::atof(next());
+    else if (!std::strcmp(argv[i], "--break"))
+      break_probability = std::atof(next());
     else if (!std::strcmp(argv[i], "--init"))
       init = next();
     else if (!std::strcmp(argv[i], "--inflation"))
@@ -139,6 +143,7 @@ int main(int argc, char** argv) {
   SyntheticRunOptions so;
   so.bearing_sigma = deg2rad(sigma_deg);
   so.bearing_correlation = correlation;
+  so.break_probability = break_probability;
   so.trajectory = trajectory == "zigzag" ? Trajectory::kZigzag : Trajectory::kPaper;
   Options fo;
   fo.wheel_base = so.wheel_base;
@@ -217,13 +222,14 @@ int main(int argc, char** argv) {
   progress.finish();
   std::printf(
       "trajectory %s, bearing noise %.2f deg, init %s, bootstrap %.2f rad, K inflation "
-      "%.1f, iterations %d, runs %d from seed %llu\n",
+      "%.1f, iterations %d, track break probability %.2f, runs %d from seed %llu\n",
       trajectory.c_str(),
       sigma_deg,
       init.c_str(),
       bootstrap,
       inflation,
       iterations,
+      break_probability,
       runs,
       static_cast<unsigned long long>(seed));
   const Eigen::Vector3d crlb = (crlb_sq / runs).cwiseSqrt();
