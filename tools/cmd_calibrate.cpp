@@ -402,9 +402,8 @@ void add_calibrate_command(CLI::App& app) {
     // Extraction and tracking flags given with --tracks do nothing: say so.
     a->unused_with_tracks.clear();
     for (const CLI::Option* o : cmd->get_options())
-      if (o->count() > 0 && (o->get_group() == "Extraction (Sec. 2)" ||
-                             o->get_group() == "Descriptor (Sec. 3)" ||
-                             o->get_group() == "Tracking (Sec. 4, 9.1)"))
+      if (o->count() > 0 && (o->get_group() == kExtractionGroup ||
+                             o->get_group() == kDescriptorGroup || o->get_group() == kTrackingGroup))
         a->unused_with_tracks.push_back(o->get_name());
     run_calibrate(*a);
   });

@@ -537,7 +537,7 @@ void add_dataset_options(CLI::App* cmd, DatasetArgs& a) {
   cmd->add_flag("!--linear-intensity",
                 a.pipeline.descriptor.log_intensity,
                 "Gradients of the grey level I (the paper) instead of log(2 + I)")
-      ->group("Descriptor (Sec. 3)");
+      ->group(kDescriptorGroup);
 }
 
 }  // namespace

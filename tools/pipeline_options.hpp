@@ -13,8 +13,12 @@
 
 namespace omnivert::cli {
 
+// The help groups of these options (cmd_calibrate names them when --tracks makes them idle).
+inline constexpr const char* kExtractionGroup = "Extraction (Sec. 2)";
+inline constexpr const char* kDescriptorGroup = "Descriptor (Sec. 3)";
+
 inline void add_pipeline_options(CLI::App* cmd, FeaturePipelineOptions& o) {
-  const std::string g = "Extraction (Sec. 2)";
+  const std::string g = kExtractionGroup;
   static const std::map<std::string, LineThreshold> kThreshold{
       {"fraction", LineThreshold::kFractionOfAnnulus},
       {"adaptive", LineThreshold::kAdaptive},
@@ -57,7 +61,7 @@ inline void add_pipeline_options(CLI::App* cmd, FeaturePipelineOptions& o) {
                 "cam0/sensor.yaml gives it; by default a given centre is used as it is")
       ->group(g);
 
-  const std::string d = "Descriptor (Sec. 3)";
+  const std::string d = kDescriptorGroup;
   static const std::map<std::string, DescriptorSmoothing> kSmoothing{
       {"blur", DescriptorSmoothing::kGaussianBlur}, {"weight", DescriptorSmoothing::kGaussianWeight}};
   static const std::map<std::string, DescriptorNormalization> kNorm{

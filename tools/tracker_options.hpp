@@ -59,8 +59,11 @@ struct TrackerFlags {
   }
 };
 
+// The help group of these options.
+inline constexpr const char* kTrackingGroup = "Tracking (Sec. 4, 9.1)";
+
 inline void add_tracker_options(CLI::App* cmd, TrackerFlags& t) {
-  const std::string g = "Tracking (Sec. 4, 9.1)";
+  const std::string g = kTrackingGroup;
   cmd->add_option(
          "--rules",
          t.rules,

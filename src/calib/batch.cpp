@@ -113,6 +113,22 @@ int remove_features(Built* b, const std::set<int>& drop) {
   return static_cast<int>(drop.size());
 }
 
+// The bearings of `run` that the solved problem `b` neither uses nor guarded (outliers, and
+// those of features removed), as (track id of `run`, frame); `to_run` maps the problem's
+// track ids to `run`'s (renamed parts of a track).
+template <typename ToRun>
+std::vector<std::pair<int, int>> unused_bearings(const CalibrationRun& run,
+                                                 const Built& b,
+                                                 ToRun to_run) {
+  std::set<std::pair<int, int>> out;
+  for (std::size_t k = 0; k < run.frames.size(); ++k)
+    for (const BearingObservation& o : run.frames[k].observations)
+      out.emplace(o.track_id, static_cast<int>(k));
+  for (const auto& [id, k] : b.bearing_keys) out.erase({to_run(id), k});
+  for (const auto& [id, k] : b.guarded) out.erase({to_run(id), k});
+  return {out.begin(), out.end()};
+}
+
 // Removes the features left with fewer than `min_bearings` bearings (with their remaining
 // bearings and any prior on them): their information is singular. Measured: hall zigzag,
 // seed 1, every bearing of one track was an outlier in the filter's bootstrap window, whose
@@ -162,6 +178,20 @@ int reject_outliers(Built* b, double threshold, int min_bearings) {
 Eigen::SparseMatrix<double> sparse_jacobian(const ceres::CRSMatrix& crs);
 std::vector<double*> variable_blocks(Built& b);
 
+// F = J^T J with a tiny ridge, relative to each variable's own information (their scales
+// differ by orders of magnitude): it keeps a feature seen without parallax from making F
+// singular. A variable without any residual left (a feature whose bearings were all removed
+// as outliers: hall zigzag, seed 1) has an empty row and column; a unit diagonal leaves it
+// out of everything else.
+Eigen::SparseMatrix<double> information_with_ridge(const Eigen::SparseMatrix<double>& J) {
+  Eigen::SparseMatrix<double> F = J.transpose() * J;
+  for (int i = 0; i < F.rows(); ++i) {
+    double& d = F.coeffRef(i, i);
+    d = d > 0.0 ? d * (1.0 + 1e-10) : 1.0;
+  }
+  return F;
+}
+
 // Whether tracks a and c are one line: the Wald statistic of "one feature point" (f_a = f_c)
 // at the current solution, d^T Cov(d)^-1 d with d = f_a - f_c and Cov(d) from the inverse of
 // the whole problem's information (poses and extrinsics free: held fixed, the poses' own
@@ -182,15 +212,7 @@ bool one_line(Built* b, int a, int c, double chi2, FeatureCovariance* cache) {
     eo.apply_loss_function = false;
     ceres::CRSMatrix crs;
     if (!b->problem->Evaluate(eo, nullptr, nullptr, nullptr, &crs)) return false;
-    const Eigen::SparseMatrix<double> J = sparse_jacobian(crs);
-    Eigen::SparseMatrix<double> F = J.transpose() * J;
-    // The ridge of the noise check (weights spanning ten orders of magnitude); a variable
-    // without any residual left gets a unit diagonal.
-    for (int i = 0; i < F.rows(); ++i) {
-      double& d = F.coeffRef(i, i);
-      d = d > 0.0 ? d * (1.0 + 1e-10) : 1.0;
-    }
-    cache->ldlt.compute(F);
+    cache->ldlt.compute(information_with_ridge(sparse_jacobian(crs)));
     cache->ok = cache->ldlt.info() == Eigen::Success && (cache->ldlt.vectorD().array() > 0).all();
     int col = 3 * (static_cast<int>(b->poses.size()) - 1);
     for (const auto& [id, f] : b->features) {
@@ -482,16 +504,7 @@ BatchNoiseCheck noise_check(Built& b, int dense_limit) {
   }
   if (row != m) return out;
   const Eigen::SparseMatrix<double> J = sparse_jacobian(crs);
-  Eigen::SparseMatrix<double> F = J.transpose() * J;
-  // A tiny ridge, relative to each variable's own information (their scales differ by
-  // orders of magnitude), keeps a feature seen without parallax from making F singular. A
-  // variable without any residual left (a feature whose bearings were all removed as
-  // outliers: hall zigzag, seed 1) has an empty row and column; a unit diagonal leaves it
-  // out of everything else.
-  for (int i = 0; i < n; ++i) {
-    double& d = F.coeffRef(i, i);
-    d = d > 0.0 ? d * (1.0 + 1e-10) : 1.0;
-  }
+  const Eigen::SparseMatrix<double> F = information_with_ridge(J);
   // F^-1 is needed column by column for every bearing (the leverage below). Below a few
   // thousand variables the dense inverse is the cheaper way (hall zigzag, 316 tracks, 1440
   // variables: the sparse solves took 60 s, their factor fills in); above, sparse solves.
@@ -800,17 +813,8 @@ RefinementResult refine_batch(const CalibrationRun& run,
   }
   if (res.num_splits > 0) res.split_run = std::move(split_run);
   res.guarded = b.guarded;
-  {
-    // Every bearing of the solved run that is neither in the final problem nor guarded.
-    std::set<std::pair<int, int>> out;
-    const CalibrationRun& solved = res.num_splits > 0 ? res.split_run : run;
-    for (std::size_t k = 0; k < solved.frames.size(); ++k)
-      for (const BearingObservation& o : solved.frames[k].observations)
-        out.emplace(o.track_id, static_cast<int>(k));
-    for (const auto& key : b.bearing_keys) out.erase(key);
-    for (const auto& key : b.guarded) out.erase(key);
-    res.rejected.assign(out.begin(), out.end());
-  }
+  res.rejected =
+      unused_bearings(res.num_splits > 0 ? res.split_run : run, b, [](int id) { return id; });
   res.num_bearings = b.num_bearings;
   res.num_features = static_cast<int>(b.features.size());
   {
@@ -1389,13 +1393,7 @@ bool bootstrap_filter_state(const CalibrationRun& window_in,
       details->splits.emplace_back(gap_origin.count(id) ? gap_origin.at(id) : id, k);
     details->guarded.clear();
     for (const auto& [id, k] : b.guarded) details->guarded.emplace_back(tracker_id(id), k);
-    std::set<std::pair<int, int>> unused;
-    for (std::size_t k = 0; k < window_in.frames.size(); ++k)
-      for (const BearingObservation& o : window_in.frames[k].observations)
-        unused.emplace(o.track_id, static_cast<int>(k));
-    for (const auto& [id, k] : b.bearing_keys) unused.erase({tracker_id(id), k});
-    for (const auto& key : details->guarded) unused.erase(key);
-    details->rejected.assign(unused.begin(), unused.end());
+    details->rejected = unused_bearings(window_in, b, tracker_id);
   }
 
   std::vector<FeatureSlot> slots;

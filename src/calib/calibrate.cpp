@@ -21,12 +21,15 @@
 namespace omnivert::calib {
 
 namespace {
-// The run without the given (track id, frame) bearings.
+// The run without the given (track id, frame) bearings: those guarded where lines cross and
+// those refused as outliers.
 CalibrationRun without_bearings(const CalibrationRun& run,
-                                const std::vector<std::pair<int, int>>& keys) {
-  if (keys.empty()) return run;
+                                const std::vector<std::pair<int, int>>& guarded,
+                                const std::vector<std::pair<int, int>>& rejected) {
+  if (guarded.empty() && rejected.empty()) return run;
   std::map<int, std::set<int>> by_frame;  // frame -> track ids
-  for (const auto& [id, k] : keys) by_frame[k].insert(id);
+  for (const auto& [id, k] : guarded) by_frame[k].insert(id);
+  for (const auto& [id, k] : rejected) by_frame[k].insert(id);
   CalibrationRun out = run;
   for (const auto& [k, ids] : by_frame) {
     if (k < 0 || k >= static_cast<int>(out.frames.size())) continue;
@@ -57,9 +60,7 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
   // Sec. 8.1 on the bearings the estimate used: those left out where lines cross
   // (Options::crossing_guard) do not follow eq. (30)'s model, and those the gate refused are
   // taken for outliers; neither carries information the estimators use.
-  std::vector<std::pair<int, int>> unused = r.filter.guarded;
-  unused.insert(unused.end(), r.filter.rejected.begin(), r.filter.rejected.end());
-  CalibrationRun analysed = without_bearings(run, unused);
+  CalibrationRun analysed = without_bearings(run, r.filter.guarded, r.filter.rejected);
   if (co.refine) {
     r.refinement = refine_batch(run, options, at, co.batch);
     r.refined = true;
@@ -68,10 +69,8 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
     // Neither the guarded bearings nor those the refinement rejected as outliers: the bound
     // is that of the problem the estimate solved (with the outliers' information counted,
     // corridor paper seed 27, 211 of 845 bearings rejected, the bounds came out 7% small).
-    unused = r.refinement.guarded;
-    unused.insert(unused.end(), r.refinement.rejected.begin(), r.refinement.rejected.end());
     analysed = without_bearings(r.refinement.num_splits > 0 ? r.refinement.split_run : run,
-                                unused);
+                                r.refinement.guarded, r.refinement.rejected);
     lap("refinement");
   }
   // Sec. 8.1 at the best estimate of the trajectory, the features and the extrinsics.

@@ -186,8 +186,8 @@ std::vector<BearingUpdateResult> Updater::update(const std::vector<BearingMeasur
   std::vector<int> used;
   std::vector<double> r_var;
   for (std::size_t k = 0; k < z_all.size(); ++k) {
-    const double rk =
-        var * z_all[k].sigma_scale * z_all[k].sigma_scale + (options_.second_order_noise ? second_order_variance(*state, z_all[k]) : 0.0);
+    const double rk = var * z_all[k].sigma_scale * z_all[k].sigma_scale +
+                      (options_.second_order_noise ? second_order_variance(*state, z_all[k]) : 0.0);
     const double r = angle_diff(z_all[k].beta, h0(k));
     const double S = H.row(k).dot(P0 * H.row(k).transpose()) + rk;
     results[k].chi2 = r * r / S;
