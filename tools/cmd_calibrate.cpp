@@ -284,6 +284,13 @@ void run_calibrate(const CalibrateArgs& a) {
   if (result.refined && result.refinement.num_splits > 0)
     std::printf("refinement: %d tracks split where they changed line (summary.json lists them)\n",
                 result.refinement.num_splits);
+  if (!result.filter.joins.empty())
+    std::printf("filter: %zu tracks joined to the line they continue after the tracker lost it\n",
+                result.filter.joins.size());
+  if (result.refined && !result.refinement.merges.empty())
+    std::printf("refinement: %zu tracks joined to the line they continue after the tracker lost "
+                "it (summary.json lists them)\n",
+                result.refinement.merges.size());
   std::printf("Cramer-Rao bound of this run: phi %.3f deg, rho %.2f mm, psi %.3f deg\n",
               rad2deg(o.phi.crlb), o.rho.crlb * 1e3, rad2deg(o.psi.crlb));
   if (truth) {

@@ -7,7 +7,7 @@
 //   calib_monte_carlo [--runs 50] [--sigma-deg 0.3] [--init anchored|inverse|naive]
 //                     [--inflation 1] [--iterations 3] [--trajectory paper|zigzag]
 //                     [--bootstrap RAD] [--refine] [--seed 1] [--correlation A]
-//                     [--lateral M] [--break P]
+//                     [--lateral M] [--break P] [--no-merge]
 // --init anchored (default): anchored inverse depth + camera-pose extrinsics, with the batch
 //   window up to the first turn (--bootstrap, rad of rotation; 0: no window);
 // --init inverse: the paper's state eq. (28) with undelayed inverse-distance features;
@@ -16,14 +16,17 @@
 // --lateral M: sideways slip per step allowed by the batch problems (window, refinement).
 // --break P: each track gets a new id with probability P per frame (a tracker that loses
 //   lines and finds them again; docs/calib.md, "Pieces of one line").
+// --no-merge: the refinement does not join the pieces of one line (BatchOptions::merge_pieces).
 // Diagnostics (environment): PRIOR_AT_TRUTH=s (prior centred on truth, sigma s), PRIOR_SIGMA=s,
-// DMIN/DMAX (feature distance prior), CONVERT (convert_ratio), NO_SECOND_ORDER, VERBOSE.
+// DMIN/DMAX (feature distance prior), CONVERT (convert_ratio), NO_SECOND_ORDER,
+// NO_FILTER_JOIN (Options::join_pieces off), VERBOSE, WINDOW_NEES.
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -56,6 +59,11 @@ struct Stats {
     yaw_deg.push_back(std::abs(rad2deg(angle_diff(est.yaw(), truth.yaw()))));
     nees.push_back(e.dot(cov.ldlt().solve(e)));
   }
+  Eigen::Vector3d rms() const {
+    Eigen::Vector3d r = Eigen::Vector3d::Zero();
+    for (const auto& e : err) r += e.cwiseProduct(e);
+    return (r / std::max<double>(static_cast<double>(err.size()), 1.0)).cwiseSqrt();
+  }
 };
 
 double median(std::vector<double> v) {
@@ -67,9 +75,7 @@ double median(std::vector<double> v) {
 
 void print(const char* name, const Stats& s, const Eigen::Vector3d& crlb) {
   const int n = static_cast<int>(s.err.size());
-  Eigen::Vector3d rms = Eigen::Vector3d::Zero();
-  for (const auto& e : s.err) rms += e.cwiseProduct(e);
-  rms = (rms / std::max(n, 1)).cwiseSqrt();
+  const Eigen::Vector3d rms = s.rms();
   double mean_nees = 0;
   for (double v : s.nees) mean_nees += v;
   mean_nees /= std::max(n, 1);
@@ -99,6 +105,9 @@ int main(int argc, char** argv) {
   int runs = 50, iterations = 3;
   bool refine = false;
   double bootstrap = Options{}.bootstrap_rotation;
+  bool merge = true;
+  Eigen::Vector3d crlb_joined_sq = Eigen::Vector3d::Zero();
+  int all_merges = 0, wrong_merges = 0, filter_joins = 0, filter_wrong = 0;
   double sigma_deg = 0.3, inflation = 1.0, correlation = 0.0, break_probability = 0.0;
   double lateral = Options{}.lateral_sigma;
   std::string init = "anchored", trajectory = "paper";
@@ -133,6 +142,8 @@ int main(int argc, char** argv) {
       bootstrap = std::atof(next());
     else if (!std::strcmp(argv[i], "--lateral"))
       lateral = std::atof(next());
+    else if (!std::strcmp(argv[i], "--no-merge"))
+      merge = false;
     else if (!std::strcmp(argv[i], "--seed"))
       seed = std::strtoull(next(), nullptr, 10);
     else {
@@ -166,6 +177,7 @@ int main(int argc, char** argv) {
   if (const char* c = std::getenv("DMAX")) fo.max_feature_distance = std::atof(c);
   if (const char* c = std::getenv("CONVERT")) fo.convert_ratio = std::atof(c);
   if (std::getenv("NO_SECOND_ORDER")) fo.second_order_noise = false;
+  if (std::getenv("NO_FILTER_JOIN")) fo.join_pieces = false;
   fo.bootstrap_rotation = bootstrap;
   Stats filt, ref, ref_checked, filt_checked;
   std::vector<double> scales;
@@ -183,10 +195,32 @@ int main(int argc, char** argv) {
     if (refine) {
       CalibrateOptions co{.refine = true};
       co.batch.lateral_sigma = lateral;
+      co.batch.merge_pieces = merge;
       cr = calibrate(run.run, fo, co);
     }
     const FilterResult fr = refine ? cr.filter : run_filter(run.run, fo);
     filt.add(fr.extrinsics, refine ? cr.filter_model_covariance : fr.covariance, run.truth);
+    if (std::getenv("MISSING")) {
+      std::map<int, std::pair<int, int>> span;
+      std::map<int, int> n;
+      for (int k = 0; k < static_cast<int>(run.run.frames.size()); ++k)
+        for (const auto& o : run.run.frames[k].observations) {
+          if (!n[o.track_id]++) span[o.track_id].first = k;
+          span[o.track_id].second = k;
+        }
+      for (const auto& [id, c] : n)
+        if (c >= 3 && !fr.tracks.count(id))
+          std::printf("missing track %d: %d bearings, frames %d-%d (window %d)\n", id, c,
+                      span[id].first, span[id].second, fr.window_frames);
+    }
+    if (std::getenv("WINDOW_NEES") && fr.window_frames > 0) {
+      const FrameEstimate& w = fr.history[static_cast<std::size_t>(fr.window_frames - 1)];
+      const Eigen::Vector3d e(angle_diff(w.extrinsics.phi, run.truth.phi), w.extrinsics.rho - run.truth.rho,
+                              angle_diff(w.extrinsics.psi, run.truth.psi));
+      std::printf("window %d frames of %zu: nees %.2f; end %.2f; joins %zu\n", fr.window_frames,
+                  run.run.frames.size(), e.dot(w.covariance.ldlt().solve(e)), filt.nees.back(),
+                  fr.joins.size());
+    }
     if (std::getenv("VERBOSE") && !filt.nees.empty())
       std::printf("run %d: nees %.1f  phi %.4f rho %.4f psi %.4f\n",
                   r,
@@ -203,6 +237,19 @@ int main(int argc, char** argv) {
     crlb_sq += Eigen::Vector3d(obs.phi.crlb, obs.rho.crlb, obs.psi.crlb).cwiseAbs2();
     crlb_yaw_sq += obs.yaw.crlb * obs.yaw.crlb;
     crlb_pos_sq += obs.x.crlb * obs.x.crlb + obs.y.crlb * obs.y.crlb;
+    if (break_probability > 0.0) {
+      // The bound with each line's pieces under one id: what joining them can reach.
+      CalibrationRun joined = run.run;
+      BatchPoint at = truth;
+      at.features.clear();
+      for (FrameInput& f : joined.frames)
+        for (BearingObservation& o : f.observations) {
+          o.track_id = run.track_feature.at(o.track_id);
+          at.features[o.track_id] = run.features[static_cast<std::size_t>(o.track_id)];
+        }
+      const ObservabilityReport j = analyse_observability(joined, fo, at);
+      crlb_joined_sq += Eigen::Vector3d(j.phi.crlb, j.rho.crlb, j.psi.crlb).cwiseAbs2();
+    }
     if (refine) {
       if (cr.refinement.covariance_ok) {
         ref.add(cr.refinement.extrinsics, cr.refinement_model_covariance, run.truth);
@@ -216,6 +263,39 @@ int main(int argc, char** argv) {
       } else {
         ++ref.failures;
       }
+      int wrong = 0;  // merges of two different lines
+      for (const auto& [a, c] : cr.refinement.merges) {
+        const auto ia = run.track_feature.find(a), ic = run.track_feature.find(c);
+        if (ia != run.track_feature.end() && ic != run.track_feature.end() && ia->second != ic->second)
+          ++wrong;
+      }
+      wrong_merges += wrong;
+      for (const auto& [a, c] : cr.filter.joins) {
+        ++filter_joins;
+        const auto ia = run.track_feature.find(a), ic = run.track_feature.find(c);
+        if (ia != run.track_feature.end() && ic != run.track_feature.end() && ia->second != ic->second)
+          ++filter_wrong;
+      }
+      all_merges += static_cast<int>(cr.refinement.merges.size());
+      if (std::getenv("VERBOSE"))
+        std::printf("run %d: refinement %s nees %.1f  phi %.4f rho %.4f psi %.4f  merges %zu "
+                    "(%d of two lines) splits %d\n",
+                    r,
+                    cr.refinement.covariance_ok ? "" : "(no covariance)",
+                    cr.refinement.covariance_ok ? ref.nees.back() : 0.0,
+                    cr.refinement.extrinsics.phi,
+                    cr.refinement.extrinsics.rho,
+                    cr.refinement.extrinsics.psi,
+                    cr.refinement.merges.size(),
+                    wrong,
+                    cr.refinement.num_splits);
+      if (std::getenv("VERBOSE"))
+        std::printf("   cost %.1f -> %.1f, %d iterations, %d bearings, %d rejected, %zu guarded, %d "
+                    "features, filter joins %zu, filter tracks %zu\n",
+                    cr.refinement.initial_cost, cr.refinement.final_cost, cr.refinement.iterations,
+                    cr.refinement.num_bearings, cr.refinement.num_rejected,
+                    cr.refinement.guarded.size(), cr.refinement.num_features, cr.filter.joins.size(),
+                    cr.filter.tracks.size());
     }
     progress.update(r + 1);
   }
@@ -241,8 +321,22 @@ int main(int argc, char** argv) {
       rad2deg(crlb(2)),
       rad2deg(std::sqrt(crlb_yaw_sq / runs)),
       1e3 * std::sqrt(crlb_pos_sq / runs));
+  if (break_probability > 0.0) {
+    const Eigen::Vector3d j = (crlb_joined_sq / runs).cwiseSqrt();
+    std::printf("CRLB with each line's pieces joined: phi %.3f deg  rho %.2f mm  psi %.3f deg\n",
+                rad2deg(j(0)), 1e3 * j(1), rad2deg(j(2)));
+    if (refine && !ref.nees.empty())
+      std::printf("refinement RMS / that bound: phi %.2f  rho %.2f  psi %.2f\n",
+                  ref.rms()(0) / j(0), ref.rms()(1) / j(1), ref.rms()(2) / j(2));
+  }
   print("filter", filt, crlb);
   if (refine) print("filter + refinement", ref, crlb);
+  if (refine && filter_joins > 0)
+    std::printf("filter: %d new tracks joined to a feature, %d of them to another line\n",
+                filter_joins, filter_wrong);
+  if (refine && all_merges > 0)
+    std::printf("refinement: %d pieces of tracks joined, %d of them to another line\n", all_merges,
+                wrong_merges);
   if (refine && !scales.empty()) {
     double ms = 0;
     for (double v : scales) ms += v;

@@ -60,7 +60,9 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
   // Sec. 8.1 on the bearings the estimate used: those left out where lines cross
   // (Options::crossing_guard) do not follow eq. (30)'s model, and those the gate refused are
   // taken for outliers; neither carries information the estimators use.
-  CalibrationRun analysed = without_bearings(run, r.filter.guarded, r.filter.rejected);
+  // Pieces of one line that the filter joined (Options::join_pieces) are one feature there.
+  CalibrationRun analysed =
+      join_tracks(without_bearings(run, r.filter.guarded, r.filter.rejected), r.filter.joins);
   if (co.refine) {
     r.refinement = refine_batch(run, options, at, co.batch);
     r.refined = true;
@@ -69,7 +71,7 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
     // Neither the guarded bearings nor those the refinement rejected as outliers: the bound
     // is that of the problem the estimate solved (with the outliers' information counted,
     // corridor paper seed 27, 211 of 845 bearings rejected, the bounds came out 7% small).
-    analysed = without_bearings(r.refinement.num_splits > 0 ? r.refinement.split_run : run,
+    analysed = without_bearings(r.refinement.renamed() ? r.refinement.solved_run : run,
                                 r.refinement.guarded, r.refinement.rejected);
     lap("refinement");
   }
@@ -104,14 +106,18 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
     };
     BatchOptions unsplit = co.batch;
     unsplit.split_chi2 = 0.0;
-    // The filter's tracks: split where its window split them (FilterResult::splits), each
-    // part starting at the track's filter estimate. (With no splits anywhere, the refinement
+    unsplit.merge_pieces = false;
+    // The filter's tracks: joined where it joined them (FilterResult::joins) and split where
+    // its window split them (FilterResult::splits), each part starting at the track's filter
+    // estimate. (With no splits anywhere, the refinement
     // already solved this very problem.)
-    if (r.refined && co.batch.split_chi2 <= 0.0 && r.filter.splits.empty()) {
+    if (r.refined && !r.refinement.renamed() && r.filter.splits.empty() &&
+        r.filter.joins.empty()) {
       r.filter_noise = r.refinement.noise;
     } else {
       std::map<int, int> origin;
-      const CalibrationRun filter_run = split_tracks(run, r.filter.splits, &origin);
+      const CalibrationRun filter_run =
+          split_tracks(join_tracks(run, r.filter.joins), r.filter.splits, &origin);
       BatchPoint start = filter_point;
       for (const auto& [id, tracker] : origin)
         if (const auto it = filter_point.features.find(tracker); it != filter_point.features.end())

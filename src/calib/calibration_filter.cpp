@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <set>
 #include <string>
 
@@ -94,6 +95,20 @@ void CalibrationFilter::end_bootstrap(FrameEstimate rec) {
         tracks_[id] = t;
       }
       for (const auto& [id, frame] : details.splits) splits_.emplace_back(id, frame + first);
+      // Pieces of one line joined in the window: later bearings of any piece are the line's.
+      std::map<int, int> earlier;  // joined piece -> the piece it continues
+      for (const auto& [to, id] : details.joins) earlier[id] = to;
+      for (const auto& [id, to] : earlier) {
+        int root = to;
+        for (auto it = earlier.find(root); it != earlier.end(); it = earlier.find(root))
+          root = it->second;
+        joined_to_[id] = root;
+        joins_.emplace_back(root, id);
+        if (const auto t = tracks_.find(root); t != tracks_.end()) {
+          tracks_[id] = t->second;
+          tracks_[id].track_id = id;
+        }
+      }
       for (const auto& [id, frame] : details.guarded) {
         guarded_.emplace_back(id, frame + first);
         const std::size_t k = static_cast<std::size_t>(frame + first);  // history_ ends before rec
@@ -150,8 +165,10 @@ void CalibrationFilter::step(const FrameInput& frame) {
   }
   std::vector<const BearingObservation*> fresh;
   std::vector<BearingMeasurement> z;
+  std::vector<int> z_ids;  // each bearing's own track id (a joined track's, not its feature's)
+  std::set<int> measured;  // slots with a bearing in this frame
   for (const BearingObservation& o : frame.observations) {
-    const int slot = state_.find(o.track_id);
+    const int slot = slot_of(o.track_id);
     if (slot < 0) {
       fresh.push_back(&o);
       continue;
@@ -162,8 +179,18 @@ void CalibrationFilter::step(const FrameInput& frame) {
       guarded_.emplace_back(o.track_id, frame_);
       continue;
     }
+    if (!measured.insert(slot).second) {
+      // A feature's old track came back beside the track joined to it: one line seen twice
+      // is not a bearing of eq. (30); the second is refused.
+      ++rec.num_rejected;
+      rejected_.emplace_back(o.track_id, frame_);
+      continue;
+    }
     z.push_back({slot, o.beta, o.sigma_scale});
+    z_ids.push_back(o.track_id);
   }
+  if (options_.join_pieces && !fresh.empty())
+    fresh = join_pieces(std::move(fresh), &z, &z_ids);
   const std::vector<BearingUpdateResult> results = updater_.update(z, &state_);
   for (std::size_t k = 0; k < z.size(); ++k) {
     if (results[k].accepted) {
@@ -171,7 +198,7 @@ void CalibrationFilter::step(const FrameInput& frame) {
       ++state_.mutable_slots()[z[k].slot].num_updates;
     } else {
       ++rec.num_rejected;
-      rejected_.emplace_back(state_.slots()[z[k].slot].track_id, frame_);
+      rejected_.emplace_back(z_ids[k], frame_);
     }
   }
   // Tracks that start enter the state (their first bearing is used by the initialisation).
@@ -216,7 +243,60 @@ void CalibrationFilter::step(const FrameInput& frame) {
   ++frame_;
 }
 
+int CalibrationFilter::slot_of(int track_id) const {
+  const auto it = joined_to_.find(track_id);
+  return state_.find(it != joined_to_.end() ? it->second : track_id);
+}
+
+// Options::join_pieces. Candidates for a new track's first bearing: the features of the
+// state whose point is known (kPoint, kDistance: a feature still in inverse depth predicts a
+// wide fan of bearings, where any line would pass) and not seen in this frame, whose gate
+// (eq. 30's innovation, Updater::innovation_chi2) the bearing passes. A new track with exactly
+// one candidate, which no other new track has as a candidate, continues it. (The crossing
+// guard is not asked: the old piece of a line that was not joined stays in the state for
+// max_missed_frames frames, where it crowds the new piece of the same line; two features near
+// the bearing are two candidates, and nothing is joined.)
+std::vector<const BearingObservation*> CalibrationFilter::join_pieces(
+    std::vector<const BearingObservation*> fresh,
+    std::vector<BearingMeasurement>* z,
+    std::vector<int>* z_ids) {
+  std::vector<int> candidate(fresh.size(), -1);
+  std::map<int, int> claims;  // slot -> new tracks that have it as a candidate
+  for (std::size_t i = 0; i < fresh.size(); ++i) {
+    int found = 0;
+    for (int s = 0; s < state_.num_features(); ++s) {
+      const FeatureSlot& slot = state_.slots()[s];
+      if (slot.last_seen_frame == frame_ ||
+          !(slot.param == FeatureParam::kPoint || slot.param == FeatureParam::kDistance))
+        continue;
+      const BearingMeasurement m{s, fresh[i]->beta, fresh[i]->sigma_scale};
+      if (!(updater_.innovation_chi2(state_, m) <= updater_.gate())) continue;
+      ++claims[s];
+      candidate[i] = s;
+      ++found;
+    }
+    if (found != 1) candidate[i] = -1;
+  }
+  std::vector<const BearingObservation*> left;
+  for (std::size_t i = 0; i < fresh.size(); ++i) {
+    const int s = candidate[i];
+    if (s < 0 || claims[s] != 1) {
+      left.push_back(fresh[i]);
+      continue;
+    }
+    FeatureSlot& slot = state_.mutable_slots()[s];
+    joined_to_[fresh[i]->track_id] = slot.track_id;
+    joins_.emplace_back(slot.track_id, fresh[i]->track_id);
+    slot.last_seen_frame = frame_;
+    z->push_back({s, fresh[i]->beta, fresh[i]->sigma_scale});
+    z_ids->push_back(fresh[i]->track_id);
+  }
+  return left;
+}
+
 void CalibrationFilter::record_tracks() {
+  std::map<int, std::vector<int>> joined;  // feature's track id -> tracks joined to it
+  for (const auto& [id, to] : joined_to_) joined[to].push_back(id);
   for (int s = 0; s < state_.num_features(); ++s) {
     const FeatureSlot& slot = state_.slots()[s];
     if (slot.last_seen_frame != frame_ && tracks_.count(slot.track_id)) continue;
@@ -225,6 +305,11 @@ void CalibrationFilter::record_tracks() {
     t.frame = frame_;
     t.D_theta = state_.feature_distance_form(s, &t.covariance);
     t.num_updates = slot.num_updates;
+    if (const auto it = joined.find(slot.track_id); it != joined.end())
+      for (int id : it->second) {
+        tracks_[id] = t;
+        tracks_[id].track_id = id;
+      }
   }
 }
 
@@ -234,7 +319,7 @@ FilterResult run_filter(const CalibrationRun& run, const Options& options) {
   filter.finish();
   return {filter.extrinsics(), filter.covariance(), filter.history(), filter.tracks(),
           filter.splits(), filter.window_frames(), filter.window_failure(), filter.guarded(),
-          filter.rejected()};
+          filter.rejected(), filter.joins()};
 }
 
 }  // namespace omnivert::calib

@@ -258,6 +258,7 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
   {
     // Tracks split in the filter's bootstrap window (they slipped onto a neighbouring line).
     j["filter"]["tracks_split"] = r.filter.splits.size();
+    j["filter"]["tracks_joined"] = r.filter.joins.size();
     j["filter"]["window_frames"] = r.filter.window_frames;
     j["filter"]["window_solved"] = r.filter.window_frames > 0 && r.filter.window_failure.empty();
     if (!r.filter.window_failure.empty()) j["filter"]["window_failure"] = r.filter.window_failure;
@@ -279,6 +280,12 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
     ref["tracks_split"] = r.refinement.num_splits;
     ref["features"] = r.refinement.num_features;
     ref["splits"] = splits_json(r.refinement.splits);
+    ref["tracks_merged"] = r.refinement.merges.size();
+    {
+      nlohmann::json m = nlohmann::json::array();
+      for (const auto& [a, c] : r.refinement.merges) m.push_back({{"track_id", a}, {"joined", c}});
+      ref["merges"] = m;
+    }
     ref["bearing_residual_sigma_deg"] = num(rad2deg(r.refinement.bearing_residual_sigma));
     ref["initial_cost"] = num(r.refinement.initial_cost);
     ref["final_cost"] = num(r.refinement.final_cost);
@@ -436,7 +443,9 @@ std::string report_html(const CalibrationResult& r, const ReportInputs& in) {
                     ? ", " + std::to_string(r.filter.splits.size()) +
                           " tracks split where they changed line; " +
                           std::to_string(r.filter.guarded.size()) +
-                          " bearings left out where lines cross (window and filter)"
+                          " bearings left out where lines cross (window and filter); " +
+                          std::to_string(r.filter.joins.size()) +
+                          " tracks joined to the line they continue (window and filter)"
                     : std::string(": could not be solved (") + r.filter.window_failure +
                           "), the filter ran over it from the prior"));
   if (r.refined)
@@ -447,7 +456,8 @@ std::string report_html(const CalibrationResult& r, const ReportInputs& in) {
                          std::to_string(r.refinement.guarded.size()) +
                          " left out where lines cross), " +
                          std::to_string(r.refinement.num_splits) + " tracks split where they " +
-                         "changed line");
+                         "changed line, " + std::to_string(r.refinement.merges.size()) +
+                         " joined to the line they continue");
   kv("time: tracking / calibration", f("%.1f s", in.seconds_tracking) + " / " + f("%.1f s", in.seconds_calibration));
   h << "</table>\n";
   if (!in.warnings.empty()) {

@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "omnivert/calib/model.hpp"
 #include "omnivert/core/angles.hpp"
@@ -169,6 +170,23 @@ double Updater::second_order_variance(const FilterState& state, const BearingMea
     for (int b = 0; b < d; ++b) Pb(a, b) = state.P()(idx[a], idx[b]);
   const Eigen::MatrixXd M = Hxx * Pb;
   return 0.5 * (M * M).trace();
+}
+
+double Updater::innovation_chi2(const FilterState& state, const BearingMeasurement& z) const {
+  Eigen::MatrixXd H;
+  const Eigen::VectorXd h = predict(state, state.x(), {z}, &H);
+  const double var = options_.bearing_sigma * options_.bearing_sigma * z.sigma_scale * z.sigma_scale +
+                     (options_.second_order_noise ? second_order_variance(state, z) : 0.0);
+  const double r = angle_diff(z.beta, h(0));
+  // H P H^T over H's nonzero entries (the feature's block and the extrinsics): O(1), not
+  // O(dim^2), for the filter's search among the features (Options::join_pieces).
+  std::vector<int> nz;
+  for (int i = 0; i < H.cols(); ++i)
+    if (H(0, i) != 0.0) nz.push_back(i);
+  double hph = 0.0;
+  for (int i : nz)
+    for (int j : nz) hph += H(0, i) * state.P()(i, j) * H(0, j);
+  return r * r / (hph + var);
 }
 
 std::vector<BearingUpdateResult> Updater::update(const std::vector<BearingMeasurement>& z_all,

@@ -49,6 +49,12 @@ struct BatchOptions {
   double split_keep_fraction = 0.5;  // a round splits the tracks within this factor of the
                                      // strongest statistic (the rest are judged after re-solving)
   int split_rounds = 10;
+  // Pieces of one line: a track that starts within Options::max_missed_frames frames after
+  // another ended, and whose bearings one point explains with the other's (a Wald test with
+  // the whole problem's covariance, chi-square(2) at Options::gate_probability), is taken for
+  // the same line, lost and found again by the tracker under a new id, and joined to it
+  // (docs/calib.md, "Broken tracks"). false: off.
+  bool merge_pieces = true;
   // The noise check (BatchNoiseCheck) inverts the information matrix densely up to this many
   // variables, and uses sparse solves above (the same numbers; tested).
   int noise_check_dense_limit = 3000;
@@ -131,15 +137,23 @@ struct RefinementResult {
   int num_rejected = 0;  // bearings removed as outliers (|residual| > the filter's gate)
   int num_features = 0;  // tracks in the problem (after splitting)
   int num_splits = 0;    // tracks split in two (BatchOptions::split_chi2)
-  std::vector<std::pair<int, int>> splits;  // (tracker's track id, first frame of the new part)
+  // (track id, first frame of the new part): the tracker's id, or with merges the id of the
+  // line's first piece.
+  std::vector<std::pair<int, int>> splits;
+  // Pieces of one line joined (BatchOptions::merge_pieces): (earlier track id, later track
+  // id), the later piece's bearings renamed to the line's first piece.
+  std::vector<std::pair<int, int>> merges;
   // Bearings left out where lines cross (Options::crossing_guard): (track id of the solved
-  // run, i.e. of split_run when tracks were split, frame).
+  // run, i.e. of solved_run when tracks were split or merged, frame).
   std::vector<std::pair<int, int>> guarded;
   // Bearings removed as outliers (the gate) or with a feature left with too few bearings:
   // (track id of the solved run, frame). With `guarded`, what the solution did not use; the
   // bound of Sec. 8.1 for this run is computed without them (calibrate()).
   std::vector<std::pair<int, int>> rejected;
-  CalibrationRun split_run;  // with splits: the run `solution` refers to (split parts renamed)
+  // With splits or merges (renamed()): the run `solution` refers to (split parts and merged
+  // pieces renamed); otherwise empty, and `solution` refers to the run given.
+  CalibrationRun solved_run;
+  bool renamed() const { return num_splits > 0 || !merges.empty(); }
   // Scale of the bearing residuals at the solution, outliers removed [rad]: 1.4826 x median
   // |residual| x sqrt(bearings / (bearings - 2 features - 3)); the bearing noise the data
   // has (infinity without redundancy).
@@ -183,6 +197,10 @@ struct BootstrapDetails {
   // (tracker's track id, window frame) removed as outliers (the gate) or with a feature left
   // without bearings: with `guarded`, what the window's solution did not use.
   std::vector<std::pair<int, int>> rejected;
+  // Pieces of one line joined in the window (find_merges, Options::join_pieces): (tracker's
+  // id of an earlier piece, of the piece joined to it). The line's feature is in the state
+  // under its first piece's id; the filter takes later bearings of any of its pieces for it.
+  std::vector<std::pair<int, int>> joins;
 };
 bool bootstrap_filter_state(const CalibrationRun& window,
                             const Options& options,
@@ -197,6 +215,14 @@ bool bootstrap_filter_state(const CalibrationRun& window,
 CalibrationRun split_tracks(const CalibrationRun& run,
                             const std::vector<std::pair<int, int>>& splits,
                             std::map<int, int>* origin = nullptr);
+
+// The run with pieces of one line under one id (RefinementResult::merges,
+// FilterResult::joins: pairs (earlier piece's id, joined piece's id)): each joined piece takes
+// the id of its line's first piece (chains followed). `renamed` (optional) receives each
+// renamed id -> its new id.
+CalibrationRun join_tracks(const CalibrationRun& run,
+                           const std::vector<std::pair<int, int>>& joins,
+                           std::map<int, int>* renamed = nullptr);
 
 // Verdict on one parameter (or combination) of the extrinsics.
 struct ParameterVerdict {

@@ -76,6 +76,10 @@ class CalibrationFilter {
   // frame). The bound of Sec. 8.1 for the filter's estimate is computed without these and
   // the guarded ones (calibrate()).
   const std::vector<std::pair<int, int>>& rejected() const { return rejected_; }
+  // New tracks taken for the continuation of a feature in the state (Options::join_pieces):
+  // (the feature's track id, the new track's id). The new track's bearings update that
+  // feature, and tracks() lists it with the feature's estimate.
+  const std::vector<std::pair<int, int>>& joins() const { return joins_; }
   int frames_processed() const { return frame_; }
   const Options& options() const { return options_; }
 
@@ -83,6 +87,13 @@ class CalibrationFilter {
   void step(const FrameInput& frame);
   void end_bootstrap(FrameEstimate rec);
   void record_tracks();
+  // The slot of a track (through joins_), -1 when not in the state.
+  int slot_of(int track_id) const;
+  // Joins the new tracks in `fresh` that continue a feature of the state (Options::join_pieces)
+  // and appends their bearings to z / z_ids; returns the new tracks left.
+  std::vector<const BearingObservation*> join_pieces(std::vector<const BearingObservation*> fresh,
+                                                     std::vector<BearingMeasurement>* z,
+                                                     std::vector<int>* z_ids);
   Options options_;
   FilterState state_;
   Propagator propagator_;
@@ -94,6 +105,8 @@ class CalibrationFilter {
   std::vector<std::pair<int, int>> splits_;
   std::vector<std::pair<int, int>> guarded_;
   std::vector<std::pair<int, int>> rejected_;
+  std::vector<std::pair<int, int>> joins_;
+  std::map<int, int> joined_to_;  // new track id -> the feature's track id
   int window_frames_ = 0;
   std::string window_failure_;
   bool bootstrapping_ = false;
@@ -113,6 +126,7 @@ struct FilterResult {
   std::string window_failure;                // CalibrationFilter::window_failure
   std::vector<std::pair<int, int>> guarded;   // CalibrationFilter::guarded
   std::vector<std::pair<int, int>> rejected;  // CalibrationFilter::rejected
+  std::vector<std::pair<int, int>> joins;     // CalibrationFilter::joins
 };
 FilterResult run_filter(const CalibrationRun& run, const Options& options);
 

@@ -136,6 +136,15 @@ struct Options {
   int update_iterations = 3;        // 1: plain EKF; >1: iterated EKF (Gauss-Newton)
   double gate_probability = 0.999;  // chi-square gate of each bearing (1 dof); 1: no gate
   int max_missed_frames = 20;       // a track not seen for this many frames has ended
+  // Pieces of one line: the tracker lost a line and found it again under a new id. In the
+  // start-up window the pieces are joined as the refinement joins them (BatchOptions::
+  // merge_pieces); after it, a track that starts where a feature of the state, whose point is
+  // known (converted, convert_ratio) and which is not seen in this frame, is predicted (its
+  // first bearing within the gate of that feature and of no other, and no other new track
+  // claiming it) continues that feature. Without this each piece was a feature of its own and
+  // the filter was overconfident (tracks broken every ~10 frames: NEES 9.0; docs/calib.md,
+  // "Broken tracks"). false: off.
+  bool join_pieces = true;
   int min_track_length = 3;         // batch/observability: shorter tracks are ignored
   // Crossing guard [rad]: a bearing is not used while another feature's predicted bearing
   // is within this angle of its own (filter: features in the state; batches: tracks over

@@ -45,6 +45,11 @@ class Updater {
   // (Gauss-Newton on the same prior). Returns one result per measurement.
   std::vector<BearingUpdateResult> update(const std::vector<BearingMeasurement>& z,
                                           FilterState* state) const;
+  // The gate's statistic of one bearing against the state's prediction, without updating:
+  // the normalised innovation squared r^2 / (H P H^T + R) (R with the second-order term).
+  double innovation_chi2(const FilterState& state, const BearingMeasurement& z) const;
+  // The chi-square gate (Options::gate_probability, 1 degree of freedom).
+  double gate() const { return gate_; }
 
  private:
   // Predicted bearings and Jacobian (m x dim) at state x.
