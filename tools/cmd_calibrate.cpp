@@ -59,6 +59,7 @@ struct CalibrateArgs {
   double max_wheel_gap = 0.5;
   double crowded_sigma = calib::DatasetRunOptions{}.crowded_sigma_scale;
   double split_chi2 = calib::BatchOptions{}.split_chi2;
+  bool no_join = false;
   double lateral_sigma = calib::BatchOptions{}.lateral_sigma;
   double crossing_guard_deg = rad2deg(calib::Options{}.crossing_guard);
   FeaturePipelineOptions pipeline;
@@ -118,6 +119,7 @@ calib::BatchOptions batch_options(const CalibrateArgs& a) {
   calib::BatchOptions b;
   b.split_chi2 = a.split_chi2;
   b.lateral_sigma = a.lateral_sigma;
+  b.merge_pieces = !a.no_join;
   return b;
 }
 
@@ -145,6 +147,7 @@ void run_calibrate(const CalibrateArgs& a) {
   if (a.bearing_sigma_deg) opt.bearing_sigma = deg2rad(*a.bearing_sigma_deg);
   if (a.odometry_inflation) opt.odometry_inflation = *a.odometry_inflation;
   opt.split_chi2 = a.split_chi2;
+  opt.join_pieces = !a.no_join;
   opt.lateral_sigma = a.lateral_sigma;
   opt.crossing_guard = deg2rad(a.crossing_guard_deg);
   if (!opt.IsValid(&why)) throw InputError("invalid calibration options: " + why);
@@ -336,6 +339,10 @@ void add_calibrate_command(CLI::App& app) {
                   "track that slipped onto a neighbouring line); 0 turns splitting off")
       ->check(kNonNegative)
       ->capture_default_str();
+  cmd->add_flag("--no-join", a->no_join,
+                "Filter (window and after) and refinement: keep a track that starts where a line "
+                "the tracker lost is predicted as a line of its own, instead of joining it to that "
+                "line (docs/calib.md, \"Broken tracks\")");
   cmd->add_option("--crossing-guard", a->crossing_guard_deg,
                   "Leave out a track's bearings while another line is predicted within this "
                   "angle [degrees] of it (the extractor merges lines that close, and the "
