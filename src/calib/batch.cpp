@@ -858,6 +858,29 @@ CalibrationRun split_round(const CalibrationRun& original,
   return next;
 }
 
+// Rounds of joining the pieces of one line (refinement and window), each on the problem
+// solved again after the last.
+constexpr int kMergeRounds = 10;
+
+// One round of joining (find_merges) on the solved problem `b`: `run` renamed (merge_tracks),
+// `at` the solution with the joined pieces' points dropped (each line starts at its first
+// piece's), the joins appended to *joins. Returns false when nothing joins.
+bool merge_round(Built* b,
+                 const Options& options,
+                 CalibrationRun* run,
+                 BatchPoint* at,
+                 std::vector<std::pair<int, int>>* joins) {
+  const std::vector<std::pair<int, int>> found =
+      find_merges(b, options.max_missed_frames, chi2_quantile(options.gate_probability, 2));
+  if (found.empty()) return false;
+  *at = point_of(*b);
+  std::map<int, int> renamed;
+  *run = merge_tracks(*run, found, &renamed);
+  for (const auto& [id, into] : renamed) at->features.erase(id);
+  joins->insert(joins->end(), found.begin(), found.end());
+  return true;
+}
+
 }  // namespace
 
 bool wheel_check_rejects_model(const WheelCheck& check, double level) {
@@ -948,15 +971,9 @@ RefinementResult refine_batch(const CalibrationRun& run,
   // id), and the problem built and solved again, each line starting at its first piece's
   // point.
   CalibrationRun merged = run;
-  for (int round = 0; batch.merge_pieces && round < 10; ++round) {
-    const std::vector<std::pair<int, int>> found =
-        find_merges(&b, options.max_missed_frames, chi2_quantile(options.gate_probability, 2));
-    if (found.empty()) break;
-    BatchPoint at = point_of(b);
-    std::map<int, int> renamed;
-    merged = merge_tracks(merged, found, &renamed);
-    for (const auto& [id, into] : renamed) at.features.erase(id);
-    res.merges.insert(res.merges.end(), found.begin(), found.end());
+  for (int round = 0; batch.merge_pieces && round < kMergeRounds; ++round) {
+    BatchPoint at;
+    if (!merge_round(&b, options, &merged, &at, &res.merges)) break;
     b = build(merged, options, at, batch, batch.robust);
     ceres::Solve(so, b.problem.get(), &summary);
     reject_and_solve();
@@ -1428,15 +1445,9 @@ bool bootstrap_filter_state(const CalibrationRun& window_in,
   // (BootstrapDetails::joins).
   CalibrationRun merged_window = window;
   std::vector<std::pair<int, int>> window_merges;  // (first piece's id, joined piece's id)
-  for (int round = 0; options.join_pieces && round < 10; ++round) {
-    const std::vector<std::pair<int, int>> found =
-        find_merges(&b, options.max_missed_frames, chi2_quantile(options.gate_probability, 2));
-    if (found.empty()) break;
-    BatchPoint at = point_of(b);
-    std::map<int, int> renamed_now;
-    merged_window = merge_tracks(merged_window, found, &renamed_now);
-    for (const auto& [id, into] : renamed_now) at.features.erase(id);
-    window_merges.insert(window_merges.end(), found.begin(), found.end());
+  for (int round = 0; options.join_pieces && round < kMergeRounds; ++round) {
+    BatchPoint at;
+    if (!merge_round(&b, options, &merged_window, &at, &window_merges)) break;
     index_tracks(merged_window);
     b = build_window(merged_window, at);
     if (b.features.empty()) return fail("no track with two bearings in the window");
