@@ -244,8 +244,11 @@ void CalibrationFilter::step(const FrameInput& frame) {
 }
 
 int CalibrationFilter::slot_of(int track_id) const {
-  const auto it = joined_to_.find(track_id);
-  return state_.find(it != joined_to_.end() ? it->second : track_id);
+  // A joined track's feature, while it is in the state; after it left (its line unseen for
+  // max_missed_frames frames) the track is a feature of its own again once it has entered.
+  if (const auto it = joined_to_.find(track_id); it != joined_to_.end())
+    if (const int s = state_.find(it->second); s >= 0) return s;
+  return state_.find(track_id);
 }
 
 // Options::join_pieces. Candidates for a new track's first bearing: the features of the

@@ -87,7 +87,8 @@ class CalibrationFilter {
   void step(const FrameInput& frame);
   void end_bootstrap(FrameEstimate rec);
   void record_tracks();
-  // The slot of a track (through joins_), -1 when not in the state.
+  // The slot of a track (a joined track's feature while that is in the state), -1 when not
+  // in the state.
   int slot_of(int track_id) const;
   // Joins the new tracks in `fresh` that continue a feature of the state (Options::join_pieces)
   // and appends their bearings to z / z_ids; returns the new tracks left.
