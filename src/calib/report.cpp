@@ -259,6 +259,11 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
     // Tracks split in the filter's bootstrap window (they slipped onto a neighbouring line).
     j["filter"]["tracks_split"] = r.filter.splits.size();
     j["filter"]["tracks_joined"] = r.filter.joins.size();
+    {
+      nlohmann::json m = nlohmann::json::array();
+      for (const auto& [a, c] : r.filter.joins) m.push_back({{"track_id", a}, {"joined", c}});
+      j["filter"]["joins"] = m;
+    }
     j["filter"]["window_frames"] = r.filter.window_frames;
     j["filter"]["window_solved"] = r.filter.window_frames > 0 && r.filter.window_failure.empty();
     if (!r.filter.window_failure.empty()) j["filter"]["window_failure"] = r.filter.window_failure;

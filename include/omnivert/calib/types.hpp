@@ -140,8 +140,9 @@ struct Options {
   // start-up window the pieces are joined as the refinement joins them (BatchOptions::
   // merge_pieces); after it, a track that starts where a feature of the state, whose point is
   // known (converted, convert_ratio) and which is not seen in this frame, is predicted (its
-  // first bearing within the gate of that feature and of no other, and no other new track
-  // claiming it) continues that feature. Without this each piece was a feature of its own and
+  // first bearing within the gate of that feature and of no other, no other new track
+  // claiming it, and no feature seen in this frame within crossing_guard of it) continues
+  // that feature. Without this each piece was a feature of its own and
   // the filter was overconfident (tracks broken every ~10 frames: NEES 9.0; docs/calib.md,
   // "Broken tracks"). false: off.
   bool join_pieces = true;
