@@ -263,20 +263,21 @@ int main(int argc, char** argv) {
       } else {
         ++ref.failures;
       }
-      int wrong = 0;  // merges of two different lines
-      for (const auto& [a, c] : cr.refinement.merges) {
-        const auto ia = run.track_feature.find(a), ic = run.track_feature.find(c);
-        if (ia != run.track_feature.end() && ic != run.track_feature.end() && ia->second != ic->second)
-          ++wrong;
-      }
+      // Joins of two different lines (pieces whose true features differ).
+      auto of_two_lines = [&run](const std::vector<std::pair<int, int>>& joins) {
+        int n = 0;
+        for (const auto& [a, c] : joins) {
+          const auto ia = run.track_feature.find(a), ic = run.track_feature.find(c);
+          n += ia != run.track_feature.end() && ic != run.track_feature.end() &&
+               ia->second != ic->second;
+        }
+        return n;
+      };
+      const int wrong = of_two_lines(cr.refinement.merges);
       wrong_merges += wrong;
-      for (const auto& [a, c] : cr.filter.joins) {
-        ++filter_joins;
-        const auto ia = run.track_feature.find(a), ic = run.track_feature.find(c);
-        if (ia != run.track_feature.end() && ic != run.track_feature.end() && ia->second != ic->second)
-          ++filter_wrong;
-      }
       all_merges += static_cast<int>(cr.refinement.merges.size());
+      filter_joins += static_cast<int>(cr.filter.joins.size());
+      filter_wrong += of_two_lines(cr.filter.joins);
       if (std::getenv("VERBOSE"))
         std::printf("run %d: refinement %s nees %.1f  phi %.4f rho %.4f psi %.4f  merges %zu "
                     "(%d of two lines) splits %d\n",

@@ -443,28 +443,6 @@ std::vector<std::pair<int, int>> find_merges(Built* b, int max_gap, double chi2)
   return out;
 }
 
-// The run with each joined piece renamed to the first piece of its line (chains of pairs
-// followed to their start: in a pair (a, c), a was seen first). `renamed` (optional)
-// receives each renamed id -> its new id.
-CalibrationRun merge_tracks(const CalibrationRun& run,
-                            const std::vector<std::pair<int, int>>& merges,
-                            std::map<int, int>* renamed = nullptr) {
-  std::map<int, int> predecessor;
-  for (const auto& [a, c] : merges) predecessor[c] = a;
-  std::map<int, int> root;
-  for (const auto& [c, a] : predecessor) {
-    int r = a;
-    for (auto it = predecessor.find(r); it != predecessor.end(); it = predecessor.find(r))
-      r = it->second;
-    root[c] = r;
-  }
-  CalibrationRun out = run;
-  for (FrameInput& f : out.frames)
-    for (BearingObservation& o : f.observations)
-      if (const auto it = root.find(o.track_id); it != root.end()) o.track_id = it->second;
-  if (renamed) *renamed = std::move(root);
-  return out;
-}
 
 // Track splitting (BatchOptions::split_chi2). A track that slipped onto a neighbouring line
 // (a door leaf 6 cm inside its frame) is two features glued together: from the frame of the
@@ -862,7 +840,7 @@ CalibrationRun split_round(const CalibrationRun& original,
 // solved again after the last.
 constexpr int kMergeRounds = 10;
 
-// One round of joining (find_merges) on the solved problem `b`: `run` renamed (merge_tracks),
+// One round of joining (find_merges) on the solved problem `b`: `run` renamed (join_tracks),
 // `at` the solution with the joined pieces' points dropped (each line starts at its first
 // piece's), the joins appended to *joins. Returns false when nothing joins.
 bool merge_round(Built* b,
@@ -875,7 +853,7 @@ bool merge_round(Built* b,
   if (found.empty()) return false;
   *at = point_of(*b);
   std::map<int, int> renamed;
-  *run = merge_tracks(*run, found, &renamed);
+  *run = join_tracks(*run, found, &renamed);
   for (const auto& [id, into] : renamed) at->features.erase(id);
   joins->insert(joins->end(), found.begin(), found.end());
   return true;
@@ -1644,10 +1622,28 @@ bool bootstrap_filter_state(const CalibrationRun& window_in,
   return true;
 }
 
+std::map<int, int> join_roots(const std::vector<std::pair<int, int>>& joins) {
+  std::map<int, int> earlier;  // joined piece -> the piece it continues
+  for (const auto& [a, c] : joins) earlier[c] = a;
+  std::map<int, int> root;
+  for (const auto& [c, a] : earlier) {
+    int r = a;
+    for (auto it = earlier.find(r); it != earlier.end(); it = earlier.find(r)) r = it->second;
+    root[c] = r;
+  }
+  return root;
+}
+
 CalibrationRun join_tracks(const CalibrationRun& run,
                            const std::vector<std::pair<int, int>>& joins,
                            std::map<int, int>* renamed) {
-  return merge_tracks(run, joins, renamed);
+  std::map<int, int> root = join_roots(joins);
+  CalibrationRun out = run;
+  for (FrameInput& f : out.frames)
+    for (BearingObservation& o : f.observations)
+      if (const auto it = root.find(o.track_id); it != root.end()) o.track_id = it->second;
+  if (renamed) *renamed = std::move(root);
+  return out;
 }
 
 CalibrationRun split_tracks(const CalibrationRun& run,

@@ -96,12 +96,7 @@ void CalibrationFilter::end_bootstrap(FrameEstimate rec) {
       }
       for (const auto& [id, frame] : details.splits) splits_.emplace_back(id, frame + first);
       // Pieces of one line joined in the window: later bearings of any piece are the line's.
-      std::map<int, int> earlier;  // joined piece -> the piece it continues
-      for (const auto& [to, id] : details.joins) earlier[id] = to;
-      for (const auto& [id, to] : earlier) {
-        int root = to;
-        for (auto it = earlier.find(root); it != earlier.end(); it = earlier.find(root))
-          root = it->second;
+      for (const auto& [id, root] : join_roots(details.joins)) {
         joined_to_[id] = root;
         joins_.emplace_back(root, id);
         if (const auto t = tracks_.find(root); t != tracks_.end()) {
@@ -283,16 +278,20 @@ std::vector<const BearingObservation*> CalibrationFilter::join_pieces(
       if (std::abs(angle_diff(o, b)) < options_.crossing_guard) return true;
     return false;
   };
+  // The features that may be continued, the same for every new track of the frame.
+  std::vector<int> eligible;
+  for (int s = 0; s < state_.num_features(); ++s) {
+    const FeatureSlot& slot = state_.slots()[s];
+    if (slot.last_seen_frame != frame_ &&
+        (slot.param == FeatureParam::kPoint || slot.param == FeatureParam::kDistance) &&
+        !crowded(s))
+      eligible.push_back(s);
+  }
   std::vector<int> candidate(fresh.size(), -1);
   std::map<int, int> claims;  // slot -> new tracks that have it as a candidate
   for (std::size_t i = 0; i < fresh.size(); ++i) {
     int found = 0;
-    for (int s = 0; s < state_.num_features(); ++s) {
-      const FeatureSlot& slot = state_.slots()[s];
-      if (slot.last_seen_frame == frame_ ||
-          !(slot.param == FeatureParam::kPoint || slot.param == FeatureParam::kDistance))
-        continue;
-      if (crowded(s)) continue;
+    for (int s : eligible) {
       const BearingMeasurement m{s, fresh[i]->beta, fresh[i]->sigma_scale};
       if (!(updater_.innovation_chi2(state_, m) <= updater_.gate())) continue;
       ++claims[s];

@@ -177,6 +177,14 @@ nlohmann::json splits_json(const std::vector<std::pair<int, int>>& splits) {
   return a;
 }
 
+// Pieces of one line joined as [{"track_id", "joined"}]: the earlier piece's id and the joined
+// piece's.
+nlohmann::json joins_json(const std::vector<std::pair<int, int>>& joins) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const auto& [track, joined] : joins) a.push_back({{"track_id", track}, {"joined", joined}});
+  return a;
+}
+
 std::string noise_check_line(const CalibrationResult& r) {
   if (!r.noise_checked) return {};
   char buf[256];
@@ -259,11 +267,7 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
     // Tracks split in the filter's bootstrap window (they slipped onto a neighbouring line).
     j["filter"]["tracks_split"] = r.filter.splits.size();
     j["filter"]["tracks_joined"] = r.filter.joins.size();
-    {
-      nlohmann::json m = nlohmann::json::array();
-      for (const auto& [a, c] : r.filter.joins) m.push_back({{"track_id", a}, {"joined", c}});
-      j["filter"]["joins"] = m;
-    }
+    j["filter"]["joins"] = joins_json(r.filter.joins);
     j["filter"]["window_frames"] = r.filter.window_frames;
     j["filter"]["window_solved"] = r.filter.window_frames > 0 && r.filter.window_failure.empty();
     if (!r.filter.window_failure.empty()) j["filter"]["window_failure"] = r.filter.window_failure;
@@ -286,11 +290,7 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
     ref["features"] = r.refinement.num_features;
     ref["splits"] = splits_json(r.refinement.splits);
     ref["tracks_merged"] = r.refinement.merges.size();
-    {
-      nlohmann::json m = nlohmann::json::array();
-      for (const auto& [a, c] : r.refinement.merges) m.push_back({{"track_id", a}, {"joined", c}});
-      ref["merges"] = m;
-    }
+    ref["merges"] = joins_json(r.refinement.merges);
     ref["bearing_residual_sigma_deg"] = num(rad2deg(r.refinement.bearing_residual_sigma));
     ref["initial_cost"] = num(r.refinement.initial_cost);
     ref["final_cost"] = num(r.refinement.final_cost);

@@ -172,11 +172,16 @@ double Updater::second_order_variance(const FilterState& state, const BearingMea
   return 0.5 * (M * M).trace();
 }
 
+double Updater::measurement_variance(const FilterState& state, const BearingMeasurement& z) const {
+  const double var = options_.bearing_sigma * options_.bearing_sigma;
+  return var * z.sigma_scale * z.sigma_scale +
+         (options_.second_order_noise ? second_order_variance(state, z) : 0.0);
+}
+
 double Updater::innovation_chi2(const FilterState& state, const BearingMeasurement& z) const {
   Eigen::MatrixXd H;
   const Eigen::VectorXd h = predict(state, state.x(), {z}, &H);
-  const double var = options_.bearing_sigma * options_.bearing_sigma * z.sigma_scale * z.sigma_scale +
-                     (options_.second_order_noise ? second_order_variance(state, z) : 0.0);
+  const double var = measurement_variance(state, z);
   const double r = angle_diff(z.beta, h(0));
   // H P H^T over H's nonzero entries (the feature's block and the extrinsics): O(1), not
   // O(dim^2), for the filter's search among the features (Options::join_pieces).
@@ -193,7 +198,6 @@ std::vector<BearingUpdateResult> Updater::update(const std::vector<BearingMeasur
                                                  FilterState* state) const {
   std::vector<BearingUpdateResult> results(z_all.size());
   if (z_all.empty()) return results;
-  const double var = options_.bearing_sigma * options_.bearing_sigma;
   const Eigen::VectorXd x0 = state->x();
   const Eigen::MatrixXd P0 = state->P();
 
@@ -204,8 +208,7 @@ std::vector<BearingUpdateResult> Updater::update(const std::vector<BearingMeasur
   std::vector<int> used;
   std::vector<double> r_var;
   for (std::size_t k = 0; k < z_all.size(); ++k) {
-    const double rk = var * z_all[k].sigma_scale * z_all[k].sigma_scale +
-                      (options_.second_order_noise ? second_order_variance(*state, z_all[k]) : 0.0);
+    const double rk = measurement_variance(*state, z_all[k]);
     const double r = angle_diff(z_all[k].beta, h0(k));
     const double S = H.row(k).dot(P0 * H.row(k).transpose()) + rk;
     results[k].chi2 = r * r / S;

@@ -223,6 +223,9 @@ CalibrationRun split_tracks(const CalibrationRun& run,
 CalibrationRun join_tracks(const CalibrationRun& run,
                            const std::vector<std::pair<int, int>>& joins,
                            std::map<int, int>* renamed = nullptr);
+// Each joined piece's line: joined piece's id -> the id of its line's first piece (chains of
+// (earlier, later) pairs followed to their start). What join_tracks renames by.
+std::map<int, int> join_roots(const std::vector<std::pair<int, int>>& joins);
 
 // Verdict on one parameter (or combination) of the extrinsics.
 struct ParameterVerdict {

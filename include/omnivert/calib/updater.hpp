@@ -57,6 +57,8 @@ class Updater {
                           const Eigen::VectorXd& x,
                           const std::vector<BearingMeasurement>& z,
                           Eigen::MatrixXd* H) const;
+  // R of one bearing: bearing_sigma^2 x sigma_scale^2, plus the second-order term when on.
+  double measurement_variance(const FilterState& state, const BearingMeasurement& z) const;
   // Variance added by the curvature of h (second-order filter), see the source.
   double second_order_variance(const FilterState& state, const BearingMeasurement& z) const;
   Options options_;
