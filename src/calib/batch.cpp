@@ -874,6 +874,21 @@ bool noise_check_rejects_model(const BatchNoiseCheck& check, double level) {
   return check.scale > noise_check_limit(check.clusters, level);
 }
 
+double noise_check_lower_limit(int tracks, double level) {
+  return chi2_quantile(level, tracks) / tracks;
+}
+
+bool noise_check_finds_less_noise(const BatchNoiseCheck& check, double level) {
+  if (!check.ok || check.clusters < 2 || !(level > 0.0 && level < 0.5)) return false;
+  return check.scale < noise_check_lower_limit(check.clusters, level);
+}
+
+NoiseVerdict noise_check_verdict(const BatchNoiseCheck& check, double level) {
+  if (noise_check_rejects_model(check, level)) return NoiseVerdict::kMoreNoise;
+  if (noise_check_finds_less_noise(check, level)) return NoiseVerdict::kLessNoise;
+  return NoiseVerdict::kAgrees;
+}
+
 std::vector<Eigen::Vector3d> dead_reckoning(const CalibrationRun& run, double wheel_base) {
   std::vector<Eigen::Vector3d> poses;
   poses.reserve(run.frames.size());

@@ -168,6 +168,15 @@ std::string f(const char* format, double v) {
   return b;
 }
 
+const char* verdict_name(NoiseVerdict v) {
+  switch (v) {
+    case NoiseVerdict::kMoreNoise: return "more noise";
+    case NoiseVerdict::kLessNoise: return "less noise";
+    case NoiseVerdict::kAgrees: break;
+  }
+  return "agrees";
+}
+
 }  // namespace
 
 // Track splits as [{"track_id", "frame"}]: the tracker's id and the first frame of the new part.
@@ -187,15 +196,28 @@ nlohmann::json joins_json(const std::vector<std::pair<int, int>>& joins) {
 
 std::string noise_check_line(const CalibrationResult& r) {
   if (!r.noise_checked) return {};
-  char buf[256];
+  char verdict[320] = "as the model allows: sigmas kept";
+  if (r.noise_verdict == NoiseVerdict::kMoreNoise)
+    std::snprintf(verdict, sizeof verdict,
+                  "more than the model allows (x%.2f or more has a 1%% chance under it): sigmas "
+                  "scaled by %.2f",
+                  noise_check_limit(r.noise.clusters), std::sqrt(r.noise_ratio));
+  else if (r.noise_verdict == NoiseVerdict::kLessNoise && r.noise_applied)
+    std::snprintf(verdict, sizeof verdict,
+                  "less than the model assumes (x%.2f or less has a 1%% chance under it): the "
+                  "bearings' share of the covariance scaled by %.2f, sigmas by %.2f overall",
+                  noise_check_lower_limit(r.noise.clusters), r.noise.scale,
+                  std::sqrt(r.noise_ratio));
+  else if (r.noise_verdict == NoiseVerdict::kLessNoise)
+    std::snprintf(verdict, sizeof verdict,
+                  "less than the model assumes, but the filter's covariance shrunk by it would "
+                  "not be positive definite: sigmas kept");
+  char buf[512];
   std::snprintf(buf, sizeof(buf),
                 "noise check over %d tracks: the errors along the tracks act as %.3f deg of "
                 "independent noise (variance x%.2f; %s)",
                 r.noise.clusters, rad2deg(r.bearing_sigma * std::sqrt(r.noise.scale)),
-                r.noise.scale,
-                r.noise_applied ? f("the model is rejected: sigmas scaled by %.2f",
-                                    std::sqrt(r.noise_ratio)).c_str()
-                                : "not more than the model allows: sigmas kept");
+                r.noise.scale, verdict);
   return buf;
 }
 
@@ -301,6 +323,7 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
     json nc;
     nc["checked"] = r.noise_checked;
     nc["applied"] = r.noise_applied;  // the check rejected the model: covariance replaced
+    nc["verdict"] = verdict_name(r.noise_verdict);
     nc["scale"] = num(n.ok ? n.scale : NAN);
     nc["tracks"] = n.clusters;
     nc["effective_bearing_sigma_deg"] = num(n.ok ? rad2deg(r.bearing_sigma * std::sqrt(n.scale)) : NAN);
@@ -308,7 +331,8 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
     nc["of"] = r.refined && r.refinement.covariance_ok ? "refinement" : "filter";
     nc["filter_scale"] = num(r.filter_noise.ok ? r.filter_noise.scale : NAN);
     nc["filter_variance_ratio"] = num(r.filter_noise.ok ? r.filter_noise_ratio : NAN);
-    nc["filter_applied"] = r.filter_noise_ratio != 1.0;
+    nc["filter_applied"] = r.filter_noise_applied;
+    nc["filter_verdict"] = verdict_name(r.filter_noise_verdict);
     auto mat = [&](const Eigen::Matrix3d& m, bool ok) {
       json a = json::array();
       for (int i = 0; i < 9; ++i) a.push_back(num(ok && m.allFinite() ? m(i / 3, i % 3) : NAN));
