@@ -202,16 +202,14 @@ std::string noise_check_line(const CalibrationResult& r) {
                   "more than the model allows (x%.2f or more has a 1%% chance under it): sigmas "
                   "scaled by %.2f",
                   noise_check_limit(r.noise.clusters), std::sqrt(r.noise_ratio));
-  else if (r.noise_verdict == NoiseVerdict::kLessNoise && r.noise_applied)
-    std::snprintf(verdict, sizeof verdict,
-                  "less than the model assumes (x%.2f or less has a 1%% chance under it): the "
-                  "bearings' share of the covariance scaled by %.2f, sigmas by %.2f overall",
-                  noise_check_lower_limit(r.noise.clusters), r.noise.scale,
-                  std::sqrt(r.noise_ratio));
   else if (r.noise_verdict == NoiseVerdict::kLessNoise)
     std::snprintf(verdict, sizeof verdict,
-                  "less than the model assumes, but the filter's covariance shrunk by it would "
-                  "not be positive definite: sigmas kept");
+                  "less than the model assumes (x%.2f or less has a 1%% chance under it): sigmas "
+                  "kept, on the safe side, as errors that the estimate absorbs, such as a bias "
+                  "all tracks share, do not show here; --bearing-sigma %.3f would weight the "
+                  "bearings as the data say",
+                  noise_check_lower_limit(r.noise.clusters),
+                  rad2deg(r.bearing_sigma * std::sqrt(r.noise.scale)));
   char buf[512];
   std::snprintf(buf, sizeof(buf),
                 "noise check over %d tracks: the errors along the tracks act as %.3f deg of "

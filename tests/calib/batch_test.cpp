@@ -13,6 +13,7 @@
 
 #include "omnivert/calib/batch.hpp"
 #include "omnivert/calib/calibrate.hpp"
+#include "omnivert/calib/report.hpp"
 #include "omnivert/calib/calibration_filter.hpp"
 #include "omnivert/calib/model.hpp"
 #include "omnivert/calib/synthetic_run.hpp"
@@ -656,9 +657,11 @@ TEST(NoiseCheck, FindsErrorsCorrelatedAlongTracks) {
 
 // Bearings four times less noisy than assumed (variance / 16), the case of a camera better
 // than the default --bearing-sigma: the check finds less noise than the model assumes
-// (NoiseVerdict::kLessNoise) and the reported covariances shrink, in the bearings' share only
-// (CalibrateOptions::noise_check). The camera's yaw phi + psi is what the bearings determine;
-// phi, rho and psi one by one, the wheels (the paper trajectory's one turn).
+// (NoiseVerdict::kLessNoise), says so and names the sigma the data want, and keeps the
+// model's covariances (CalibrateOptions::noise_check: shrunk, they made runs whose errors the
+// check cannot see overconfident). The camera's yaw phi + psi, which the bearings determine,
+// is then reported with sigmas too large; phi, rho and psi one by one, which the wheels
+// determine in the paper trajectory's one turn, are not.
 TEST(NoiseCheck, FindsBearingsLessNoisyThanAssumed) {
   SyntheticRunOptions so;
   so.bearing_sigma = deg2rad(0.0125);
@@ -666,60 +669,42 @@ TEST(NoiseCheck, FindsBearingsLessNoisyThanAssumed) {
   o.bearing_sigma = deg2rad(0.05);  // what the model assumes
   const int runs = 12;
   int less = 0, filter_less = 0;
-  double scale = 0, yaw_model = 0, yaw_reported = 0, nees_model = 0, nees_reported = 0;
-  auto yaw_z2 = [](const CalibrationResult& r, const Eigen::Matrix3d& c, const Extrinsics& t) {
-    const double e = r.refinement.extrinsics.phi + r.refinement.extrinsics.psi - t.phi - t.psi;
-    return e * e / (c(0, 0) + c(2, 2) + 2.0 * c(0, 2));
-  };
+  double scale = 0, yaw = 0;
   for (int k = 0; k < runs; ++k) {
     so.seed = 400 + static_cast<std::uint64_t>(k);
     const SyntheticRun run = make_synthetic_run(so);
     const CalibrationResult r = calibrate(run.run, o, {.refine = true});
     ASSERT_TRUE(r.noise_checked && r.refinement.covariance_ok) << "seed " << so.seed;
     scale += r.noise.scale;
-    const Eigen::Matrix3d& model = r.refinement_model_covariance;
     if (r.noise_verdict == NoiseVerdict::kLessNoise) {
       ++less;
-      // The check's model + (scale - 1) x its bearing part: the wheels' share (model - bearing
-      // part) kept.
-      const Eigen::Matrix3d expected =
-          r.noise.model_covariance + (r.noise.scale - 1.0) * r.noise.bearing_part;
-      EXPECT_LT((r.refinement.covariance - expected).norm(), 1e-9 * model.norm()) << so.seed;
-      EXPECT_EQ(r.covariance, r.refinement.covariance);
+      EXPECT_LT(r.noise.scale, noise_check_lower_limit(r.noise.clusters));
+      EXPECT_NE(noise_check_line(r).find("less than the model assumes"), std::string::npos);
+      EXPECT_NE(noise_check_line(r).find("--bearing-sigma"), std::string::npos);
     }
-    if (r.filter_noise_verdict == NoiseVerdict::kLessNoise && r.filter_noise_applied) {
-      ++filter_less;
-      const Eigen::Matrix3d expected = r.filter_model_covariance + r.filter_noise.covariance -
-                                       r.filter_noise.model_covariance;
-      EXPECT_LT((r.filter.covariance - expected).norm(), 1e-9 * expected.norm()) << so.seed;
-    }
-    yaw_model += yaw_z2(r, model, run.truth);
-    yaw_reported += yaw_z2(r, r.refinement.covariance, run.truth);
-    nees_model += test_support::nees(r.refinement.extrinsics, model, run.truth);
-    nees_reported += test_support::nees(r.refinement.extrinsics, r.refinement.covariance, run.truth);
+    if (r.filter_noise_verdict == NoiseVerdict::kLessNoise) ++filter_less;
+    // Kept: the model's covariances.
+    EXPECT_FALSE(r.noise_applied);
+    EXPECT_FALSE(r.filter_noise_applied);
+    EXPECT_EQ(r.refinement.covariance, r.refinement_model_covariance);
+    EXPECT_EQ(r.filter.covariance, r.filter_model_covariance);
+    const Eigen::Matrix3d& c = r.refinement.covariance;
+    const double e = r.refinement.extrinsics.phi + r.refinement.extrinsics.psi - run.truth.phi -
+                     run.truth.psi;
+    yaw += e * e / (c(0, 0) + c(2, 2) + 2.0 * c(0, 2));
   }
   scale /= runs;
-  yaw_model /= runs;
-  yaw_reported /= runs;
-  nees_model /= runs;
-  nees_reported /= runs;
+  yaw /= runs;
   RecordProperty("scale", std::to_string(scale));
-  RecordProperty("yaw_model", std::to_string(yaw_model));
-  RecordProperty("yaw_reported", std::to_string(yaw_reported));
-  RecordProperty("nees_model", std::to_string(nees_model));
-  RecordProperty("nees_reported", std::to_string(nees_reported));
+  RecordProperty("yaw_z2", std::to_string(yaw));
   // Measured: 10 of 12 runs below the limit (chi-square(G) / G's 1% point, 0.26 for 10
   // tracks), the filter's check too in 10; scale 0.18 in the mean (the bearings' variance is
-  // 1/16 of the model's; the rest is the check's spread over 10 tracks); the yaw's mean squared
-  // normalised error 0.21 under the model and 0.99 under the reported covariance; NEES 1.29 ->
-  // 2.43.
+  // 1/16 of the model's; the rest is the check's spread over 10 tracks); the yaw's mean
+  // squared normalised error 0.21 (0.99 under the covariance shrunk by the check).
   EXPECT_GE(less, 9);
   EXPECT_GE(filter_less, 9);
   EXPECT_LT(scale, 0.4);
-  EXPECT_LT(yaw_model, 0.5);
-  EXPECT_GT(yaw_reported, 0.5);
-  EXPECT_LT(yaw_reported, 2.0);
-  EXPECT_GT(nees_reported, nees_model + 0.5);
+  EXPECT_LT(yaw, 0.5);
 }
 }  // namespace
 }  // namespace omnivert::calib

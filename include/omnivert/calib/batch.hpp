@@ -103,7 +103,7 @@ struct BatchNoiseCheck {
   WheelCheck wheels;
   bool ok = false;
   double scale = std::numeric_limits<double>::quiet_NaN();
-  int clusters = 0;  // tracks
+  int clusters = 0;  // tracks, the pieces that may be one line counted once (batch.cpp, line_groups)
   Eigen::Matrix3d model_covariance = Eigen::Matrix3d::Zero();
   Eigen::Matrix3d bearing_part = Eigen::Matrix3d::Zero();
   Eigen::Matrix3d bearing_clustered = Eigen::Matrix3d::Zero();
@@ -116,16 +116,14 @@ struct BatchNoiseCheck {
 // false when the check failed or has fewer than 2 tracks.
 bool noise_check_rejects_model(const BatchNoiseCheck& check, double level = 0.01);
 // Whether a check shows less noise than the model assumes: its scale below the `level`
-// quantile of chi-square(G) / G. (Until session 13 the check was one-sided: with the mirror
-// centre found anew in every image, errors shared by the tracks of a frame went into the
-// poses, where the check cannot see them, and shrinking by a low scale gave NEES 4.9 in the
-// corridor. With the centre taken as given they are gone: from pixels, corridor, paper
-// trajectory, 37 of 100 runs fall below the limit, and their covariances shrunk by the check
-// bring the mean NEES from 2.52 to 2.72 (filter) and 2.60 to 2.80 (refinement); docs/calib.md,
-// "The noise check".) false when the check failed or has fewer than 2 tracks.
+// quantile of chi-square(G) / G. calibrate() reports it and keeps the model's covariances:
+// the check cannot see errors that the estimate absorbs (a bias all tracks share goes into
+// the extrinsics), and shrunk by it, runs from pixels with broken tracks that were
+// overconfident already became more so (docs/calib.md, "The noise check"). false when the
+// check failed or has fewer than 2 tracks.
 bool noise_check_finds_less_noise(const BatchNoiseCheck& check, double level = 0.01);
-// The two tests above together (each at `level`, so the model is kept with probability
-// 1 - 2 level when it is right).
+// The two tests above together (each at `level`: under the model, "agrees" with
+// probability 1 - 2 level).
 enum class NoiseVerdict { kAgrees, kMoreNoise, kLessNoise };
 NoiseVerdict noise_check_verdict(const BatchNoiseCheck& check, double level = 0.01);
 // Whether the wheel check shows a systematic wheel error: its chi-square(2) statistic above
