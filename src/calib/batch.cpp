@@ -602,51 +602,6 @@ WheelCheck wheel_check(const Built& b,
 // factor). A track's own feature point absorbs the part of its errors along its own columns
 // of J, and that part does not reach the extrinsics (A F_{:,f} = 0), so the fitted residuals
 // stand in for the true errors up to the leverage of the shared variables.
-// The tracks that may be pieces of one line, grouped: chains of tracks, each following the
-// one before it in time without sharing a frame, at any distance in time, that one point
-// explains (the Wald statistic of one_line below chi-square(2)'s 99.9% point); as in
-// find_merges, each track has at most one successor and one predecessor, the pairs with the
-// smallest statistic first (linked freely, a piece too short to have a depth passes with
-// every track along its line of sight and the chains swallow the run: corridor, paper
-// trajectory, tracks broken every ~10 frames, seed 14: 24 tracks in 2 groups). Returns track
-// id -> its group's representative. For the noise check, whose clusters must be independent:
-// the pieces of a line that the joins left apart (find_merges wants the likelihood ratio too,
-// and pieces at most max_missed_frames apart) share that line's error, and counted as
-// clusters of their own they make the check see less noise than there is (from pixels,
-// tracks broken every ~10 frames, office zigzag seed 22: the filter's NEES 12 -> 57 when the
-// check's lower side shrank its covariance).
-std::map<int, int> line_groups(Built* b) {
-  const std::map<int, std::vector<int>> frames_of = track_frames(*b);
-  const double chi2 = chi2_quantile(0.999, 2);
-  FeatureCovariance covariance;
-  std::vector<std::tuple<double, int, int>> passing;  // (statistic, a, c), a seen first
-  for (auto ia = frames_of.begin(); ia != frames_of.end(); ++ia)
-    for (auto ic = std::next(ia); ic != frames_of.end(); ++ic) {
-      if (share_a_frame(ia->second, ic->second)) continue;
-      const bool a_first = ia->second.front() <= ic->second.front();
-      const int a = a_first ? ia->first : ic->first, c = a_first ? ic->first : ia->first;
-      if (const double t = one_line_statistic(b, a, c, &covariance); t < chi2)
-        passing.emplace_back(t, a, c);
-    }
-  std::sort(passing.begin(), passing.end());
-  std::map<int, int> parent;
-  for (const auto& entry : frames_of) parent[entry.first] = entry.first;
-  auto find = [&parent](int x) {
-    while (parent.at(x) != x) x = parent[x] = parent.at(parent.at(x));
-    return x;
-  };
-  std::set<int> has_successor, has_predecessor;
-  for (const auto& [t, a, c] : passing) {
-    if (has_successor.count(a) || has_predecessor.count(c) || find(a) == find(c)) continue;
-    has_successor.insert(a);
-    has_predecessor.insert(c);
-    parent[find(a)] = find(c);
-  }
-  std::map<int, int> out;
-  for (const auto& entry : parent) out[entry.first] = find(entry.first);
-  return out;
-}
-
 BatchNoiseCheck noise_check(Built& b, int dense_limit) {
   BatchNoiseCheck out;
   ceres::Problem::EvaluateOptions eo;
@@ -660,16 +615,17 @@ BatchNoiseCheck noise_check(Built& b, int dense_limit) {
   const int m = crs.num_rows, n = crs.num_cols;
   if (m != static_cast<int>(r.size()) || n < 3) return out;
   // Cluster of each residual row: odometry factors (3 rows each) are their own clusters,
-  // the bearings of a track one cluster, the tracks that may be one line one cluster
-  // (line_groups).
-  const std::map<int, int> group = line_groups(&b);
+  // the bearings of a track one cluster. (Pieces of one line that the joins left apart are
+  // not independent clusters. Grouped by a chain of Wald tests for the check (session 13),
+  // they changed the verdicts of 1 in 25 runs from pixels with tracks broken every ~10
+  // frames, and took 2 of the 3 "more noise" verdicts away: not kept.)
   std::vector<int> cluster(m);
   int row = 0, next = 0;
   for (std::size_t i = 0; i < b.odometry_blocks.size(); ++i, ++next)
     for (int k = 0; k < 3; ++k) cluster[row++] = next;
   std::map<int, int> of_track;
   for (const auto& key : b.bearing_keys) {
-    auto [it, fresh] = of_track.emplace(group.at(key.first), next);
+    auto [it, fresh] = of_track.emplace(key.first, next);
     if (fresh) ++next;
     cluster[row++] = it->second;
   }

@@ -103,7 +103,7 @@ struct BatchNoiseCheck {
   WheelCheck wheels;
   bool ok = false;
   double scale = std::numeric_limits<double>::quiet_NaN();
-  int clusters = 0;  // tracks, the pieces that may be one line counted once (batch.cpp, line_groups)
+  int clusters = 0;  // tracks
   Eigen::Matrix3d model_covariance = Eigen::Matrix3d::Zero();
   Eigen::Matrix3d bearing_part = Eigen::Matrix3d::Zero();
   Eigen::Matrix3d bearing_clustered = Eigen::Matrix3d::Zero();

@@ -30,7 +30,7 @@ struct CalibrateOptions {
   // verdict reported (noise_check_line names the sigma the data want): shrunk by the check
   // (session 13), the corridor's runs from pixels came inside the NEES interval (2.52 -> 2.72),
   // but with tracks broken every ~10 frames runs already overconfident became more so
-  // (corridor, paper trajectory, refinement 3.25 -> 3.95, 25 runs): the check cannot see
+  // (corridor, paper trajectory, refinement 3.25 -> 4.12, 25 runs): the check cannot see
   // errors that the parameters absorb, such as a bias that all tracks share, and a low scale
   // is no proof that there are none (docs/calib.md, "The noise check").
   // false: no check, the model's covariances.
