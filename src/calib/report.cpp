@@ -205,9 +205,8 @@ std::string noise_check_line(const CalibrationResult& r) {
   else if (r.noise_verdict == NoiseVerdict::kLessNoise)
     std::snprintf(verdict, sizeof verdict,
                   "less than the model assumes (x%.2f or less has a 1%% chance under it): sigmas "
-                  "kept, on the safe side, as errors that the estimate absorbs, such as a bias "
-                  "all tracks share, do not show here; --bearing-sigma %.3f would weight the "
-                  "bearings as the data say",
+                  "kept, on the safe side; --bearing-sigma %.3f would weight the bearings as "
+                  "the data say",
                   noise_check_lower_limit(r.noise.clusters),
                   rad2deg(r.bearing_sigma * std::sqrt(r.noise.scale)));
   char buf[512];
