@@ -872,9 +872,16 @@ double noise_check_limit(int tracks, double level) {
   return chi2_quantile(1.0 - level, tracks) / tracks;
 }
 
+namespace {
+// Whether a check can be judged at `level` (noise_check_rejects_model and
+// noise_check_finds_less_noise).
+bool judgeable(const BatchNoiseCheck& check, double level) {
+  return check.ok && check.clusters >= 2 && level > 0.0 && level < 0.5;
+}
+}  // namespace
+
 bool noise_check_rejects_model(const BatchNoiseCheck& check, double level) {
-  if (!check.ok || check.clusters < 2 || !(level > 0.0 && level < 0.5)) return false;
-  return check.scale > noise_check_limit(check.clusters, level);
+  return judgeable(check, level) && check.scale > noise_check_limit(check.clusters, level);
 }
 
 double noise_check_lower_limit(int tracks, double level) {
@@ -882,8 +889,7 @@ double noise_check_lower_limit(int tracks, double level) {
 }
 
 bool noise_check_finds_less_noise(const BatchNoiseCheck& check, double level) {
-  if (!check.ok || check.clusters < 2 || !(level > 0.0 && level < 0.5)) return false;
-  return check.scale < noise_check_lower_limit(check.clusters, level);
+  return judgeable(check, level) && check.scale < noise_check_lower_limit(check.clusters, level);
 }
 
 NoiseVerdict noise_check_verdict(const BatchNoiseCheck& check, double level) {

@@ -174,6 +174,11 @@ CalibrationResult calibrate(const CalibrationRun& run,
   return calibrate_once(run, options, co);
 }
 
+double effective_bearing_sigma(const CalibrationResult& r) {
+  return r.noise.ok ? r.bearing_sigma * std::sqrt(r.noise.scale)
+                    : std::numeric_limits<double>::quiet_NaN();
+}
+
 std::vector<std::string> result_warnings(const CalibrationResult& r) {
   std::vector<std::string> out;
   char buf[1024];
@@ -207,7 +212,7 @@ std::vector<std::string> result_warnings(const CalibrationResult& r) {
     const double limit = noise_check_limit(g);
     if (noise_check_rejects_model(r.noise)) {
       std::snprintf(buf, sizeof(buf), "To weight the bearings as the data say, run again with "
-                    "--bearing-sigma %.3f", rad2deg(r.bearing_sigma * std::sqrt(r.noise.scale)));
+                    "--bearing-sigma %.3f", rad2deg(effective_bearing_sigma(r)));
       std::string remedy = buf;
       if (!r.refined)
         remedy += "; or add --refine, which splits tracks that slipped onto a neighbouring "

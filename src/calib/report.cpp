@@ -208,12 +208,12 @@ std::string noise_check_line(const CalibrationResult& r) {
                   "kept, on the safe side; --bearing-sigma %.3f would weight the bearings as "
                   "the data say",
                   noise_check_lower_limit(r.noise.clusters),
-                  rad2deg(r.bearing_sigma * std::sqrt(r.noise.scale)));
+                  rad2deg(effective_bearing_sigma(r)));
   char buf[512];
   std::snprintf(buf, sizeof(buf),
                 "noise check over %d tracks: the errors along the tracks act as %.3f deg of "
                 "independent noise (variance x%.2f; %s)",
-                r.noise.clusters, rad2deg(r.bearing_sigma * std::sqrt(r.noise.scale)),
+                r.noise.clusters, rad2deg(effective_bearing_sigma(r)),
                 r.noise.scale, verdict);
   return buf;
 }
@@ -323,7 +323,7 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
     nc["verdict"] = verdict_name(r.noise_verdict);
     nc["scale"] = num(n.ok ? n.scale : NAN);
     nc["tracks"] = n.clusters;
-    nc["effective_bearing_sigma_deg"] = num(n.ok ? rad2deg(r.bearing_sigma * std::sqrt(n.scale)) : NAN);
+    nc["effective_bearing_sigma_deg"] = num(rad2deg(effective_bearing_sigma(r)));
     nc["variance_ratio"] = num(r.noise_checked ? r.noise_ratio : NAN);  // 1 when not applied
     nc["of"] = r.refined && r.refinement.covariance_ok ? "refinement" : "filter";
     nc["filter_scale"] = num(r.filter_noise.ok ? r.filter_noise.scale : NAN);

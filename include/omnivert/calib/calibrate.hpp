@@ -74,6 +74,10 @@ struct CalibrationResult {
   bool observable() const { return observability.all_determined(); }
 };
 
+// The independent bearing noise [rad] that would do the harm the noise check found:
+// bearing_sigma x sqrt(noise.scale) (the sigma its messages advise); NaN when not checked.
+double effective_bearing_sigma(const CalibrationResult& result);
+
 // Throws InputError on invalid options or input (non-finite values, repeated track ids).
 CalibrationResult calibrate(const CalibrationRun& run,
                             const Options& options,
