@@ -1648,13 +1648,20 @@ bool bootstrap_filter_state(const CalibrationRun& window_in,
 
 std::map<int, int> join_roots(const std::vector<std::pair<int, int>>& joins) {
   std::map<int, int> earlier;  // joined piece -> the piece it continues
-  for (const auto& [a, c] : joins) earlier[c] = a;
-  std::map<int, int> root;
-  for (const auto& [c, a] : earlier) {
-    int r = a;
-    for (auto it = earlier.find(r); it != earlier.end(); it = earlier.find(r)) r = it->second;
-    root[c] = r;
+  auto root_of = [&earlier](int x) {
+    for (auto it = earlier.find(x); it != earlier.end(); it = earlier.find(x)) x = it->second;
+    return x;
+  };
+  // A join that would close a loop is left out (the first join of a piece is kept), so the
+  // chains end. The window reports its joins by the tracker's ids, and two pieces of one
+  // tracker id (parted at a gap or a slip, then joined) gave (T, T), or T -> U -> T: the
+  // chain never ended (corridor zigzag seed 28 with --track-bias-sigma hung here).
+  for (const auto& [a, c] : joins) {
+    if (a == c || earlier.count(c) || root_of(a) == c) continue;
+    earlier[c] = a;
   }
+  std::map<int, int> root;
+  for (const auto& [c, a] : earlier) root[c] = root_of(a);
   return root;
 }
 

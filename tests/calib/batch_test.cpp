@@ -384,6 +384,18 @@ TEST(CrossingGuard, PiecesOfOneLineDoNotGuardEachOther) {
 // (BatchOptions::merge_pieces) and so reaches nearly the precision of the whole tracks.
 // Seeds 69 and 90: with the Wald test alone, 2 and 4 joins were of two lines (a three-bearing
 // piece has no depth and passed it at 0.00), and the refinement ended with NEES 46 and 1547.
+// Chains of joins are followed to the line's first piece; a join of a piece to itself, a
+// second join of one piece and one that closes a loop are left out, so every chain ends (the
+// window reports joins by the tracker's ids, and a corridor zigzag run hung on (T, T)).
+TEST(PiecesOfOneLine, JoinChainsEndAtTheFirstPiece) {
+  const std::map<int, int> r = join_roots({{1, 2}, {2, 3}, {3, 3}, {3, 1}, {5, 2}, {7, 8}});
+  const std::map<int, int> expected = {{2, 1}, {3, 1}, {8, 7}};
+  EXPECT_EQ(r, expected);
+  EXPECT_TRUE(join_roots({{4, 4}}).empty());
+  const std::map<int, int> two = join_roots({{4, 6}, {6, 4}});
+  EXPECT_EQ(two, (std::map<int, int>{{6, 4}}));
+}
+
 TEST(PiecesOfOneLine, AreJoinedOnlyWithTheirOwnLine) {
   for (const int s : {1, 7, 69, 90}) {
     SyntheticRunOptions so;
