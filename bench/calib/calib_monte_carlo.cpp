@@ -8,6 +8,7 @@
 //                     [--inflation 1] [--iterations 3] [--trajectory paper|zigzag]
 //                     [--bootstrap RAD] [--refine] [--seed 1] [--correlation A]
 //                     [--lateral M] [--break P] [--no-merge] [--model-sigma-deg S]
+//                     [--bias-deg B] [--model-bias-deg B]
 // --init anchored (default): anchored inverse depth + camera-pose extrinsics, with the batch
 //   window up to the first turn (--bootstrap, rad of rotation; 0: no window);
 // --init inverse: the paper's state eq. (28) with undelayed inverse-distance features;
@@ -18,6 +19,9 @@
 //   lines and finds them again; docs/calib.md, "Pieces of one line").
 // --model-sigma-deg S: the bearing sigma the filter and the batches assume (default: the
 //   simulated one), to study the noise check (docs/calib.md, "The noise check").
+// --bias-deg B: a constant bearing error per line, sigma B degrees (SyntheticRunOptions::
+//   track_bias_sigma); --model-bias-deg B: the one the estimators assume (Options::
+//   track_bias_sigma; default: the simulated one).
 // --no-merge: the refinement does not join the pieces of one line (BatchOptions::merge_pieces).
 // Diagnostics (environment): PRIOR_AT_TRUTH=s (prior centred on truth, sigma s), PRIOR_SIGMA=s,
 // DMIN/DMAX (feature distance prior), CONVERT (convert_ratio), NO_SECOND_ORDER,
@@ -112,6 +116,7 @@ int main(int argc, char** argv) {
   int all_merges = 0, wrong_merges = 0, filter_joins = 0, filter_wrong = 0;
   double sigma_deg = 0.3, model_sigma_deg = -1.0, inflation = 1.0, correlation = 0.0, break_probability = 0.0;
   double lateral = Options{}.lateral_sigma;
+  double bias_deg = 0.0, model_bias_deg = -1.0;
   std::string init = "anchored", trajectory = "paper";
   std::uint64_t seed = 1;
   for (int i = 1; i < argc; ++i) {
@@ -128,6 +133,10 @@ int main(int argc, char** argv) {
       sigma_deg = std::atof(next());
     else if (!std::strcmp(argv[i], "--model-sigma-deg"))  // what the filter assumes (default: the truth)
       model_sigma_deg = std::atof(next());
+    else if (!std::strcmp(argv[i], "--bias-deg"))
+      bias_deg = std::atof(next());
+    else if (!std::strcmp(argv[i], "--model-bias-deg"))
+      model_bias_deg = std::atof(next());
     else if (!std::strcmp(argv[i], "--correlation"))
       correlation = std::atof(next());
     else if (!std::strcmp(argv[i], "--break"))
@@ -158,6 +167,7 @@ int main(int argc, char** argv) {
   SyntheticRunOptions so;
   so.bearing_sigma = deg2rad(sigma_deg);
   so.bearing_correlation = correlation;
+  so.track_bias_sigma = deg2rad(bias_deg);
   so.break_probability = break_probability;
   so.trajectory = trajectory == "zigzag" ? Trajectory::kZigzag : Trajectory::kPaper;
   Options fo;
@@ -165,6 +175,7 @@ int main(int argc, char** argv) {
   fo.odometry_K = so.odometry_K;
   fo.odometry_inflation = inflation;
   fo.bearing_sigma = model_sigma_deg > 0 ? deg2rad(model_sigma_deg) : so.bearing_sigma;
+  fo.track_bias_sigma = model_bias_deg >= 0 ? deg2rad(model_bias_deg) : so.track_bias_sigma;
   fo.update_iterations = iterations;
   fo.lateral_sigma = lateral;
   fo.feature_init = init == "naive"     ? FeatureInit::kNaive
@@ -306,10 +317,14 @@ int main(int argc, char** argv) {
   }
   progress.finish();
   std::printf(
-      "trajectory %s, bearing noise %.2f deg, init %s, bootstrap %.2f rad, K inflation "
-      "%.1f, iterations %d, track break probability %.2f, runs %d from seed %llu\n",
+      "trajectory %s, bearing noise %.4f deg + per line %.4f (model %.4f + %.4f), init %s, "
+      "bootstrap %.2f rad, K inflation %.1f, iterations %d, track break probability %.2f, runs "
+      "%d from seed %llu\n",
       trajectory.c_str(),
       sigma_deg,
+      bias_deg,
+      rad2deg(fo.bearing_sigma),
+      rad2deg(fo.track_bias_sigma),
       init.c_str(),
       bootstrap,
       inflation,

@@ -46,6 +46,7 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
                                  const CalibrateOptions& co) {
   CalibrationResult r;
   r.bearing_sigma = options.bearing_sigma;
+  r.track_bias_sigma = options.track_bias_sigma;
   // Each stage's time, on the log's debug level (omnivert -v).
   auto t = std::chrono::steady_clock::now();
   auto lap = [&t](const char* stage) {
@@ -179,6 +180,33 @@ double effective_bearing_sigma(const CalibrationResult& r) {
                     : std::numeric_limits<double>::quiet_NaN();
 }
 
+double effective_track_bias_sigma(const CalibrationResult& r) {
+  return r.noise.ok ? r.track_bias_sigma * std::sqrt(r.noise.scale)
+                    : std::numeric_limits<double>::quiet_NaN();
+}
+
+std::string bearing_noise_text(double bearing_sigma, double track_bias_sigma) {
+  char buf[96];
+  if (track_bias_sigma > 0.0)
+    std::snprintf(buf, sizeof buf, "%.3f deg + %.3f deg per track", rad2deg(bearing_sigma),
+                  rad2deg(track_bias_sigma));
+  else
+    std::snprintf(buf, sizeof buf, "%.3f deg", rad2deg(bearing_sigma));
+  return buf;
+}
+
+std::string noise_check_flags(const CalibrationResult& r) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "--bearing-sigma %.3f", rad2deg(effective_bearing_sigma(r)));
+  std::string out = buf;
+  if (r.track_bias_sigma > 0.0) {
+    std::snprintf(buf, sizeof buf, " --track-bias-sigma %.3f",
+                  rad2deg(effective_track_bias_sigma(r)));
+    out += buf;
+  }
+  return out;
+}
+
 std::vector<std::string> result_warnings(const CalibrationResult& r) {
   std::vector<std::string> out;
   char buf[1024];
@@ -212,7 +240,7 @@ std::vector<std::string> result_warnings(const CalibrationResult& r) {
     const double limit = noise_check_limit(g);
     if (noise_check_rejects_model(r.noise)) {
       std::snprintf(buf, sizeof(buf), "To weight the bearings as the data say, run again with "
-                    "--bearing-sigma %.3f", rad2deg(effective_bearing_sigma(r)));
+                    "%s", noise_check_flags(r).c_str());
       std::string remedy = buf;
       if (!r.refined)
         remedy += "; or add --refine, which splits tracks that slipped onto a neighbouring "
@@ -220,10 +248,11 @@ std::vector<std::string> result_warnings(const CalibrationResult& r) {
                   "and then treats each as one feature, which the check sees)";
       std::snprintf(buf, sizeof(buf),
                     "the bearings' errors, summed along each track, are larger than the bearing "
-                    "sigma of %.3f deg allows (variance x%.2f over %d tracks; under the model "
+                    "sigma of %s allows (variance x%.2f over %d tracks; under the model "
                     "x%.2f or more has a 1%% chance): the sigmas reported include it (noise "
                     "check). %s",
-                    rad2deg(r.bearing_sigma), r.noise.scale, g, limit,
+                    bearing_noise_text(r.bearing_sigma, r.track_bias_sigma).c_str(),
+                    r.noise.scale, g, limit,
                     remedy.c_str());
       out.emplace_back(buf);
     }

@@ -65,10 +65,30 @@ int FeatureInitializer::initialize(int track_id,
       break;
     }
   }
+  Eigen::VectorXd var_noise = var_n;
+  if (options_.track_bias_sigma > 0.0) {
+    // The track's constant bearing error b (Options::track_bias_sigma) enters as one more
+    // entry, at 0 with its prior. The first bearing is eq. (30) + b + noise, so the block was
+    // computed from beta - b: its column for b is minus the column for beta, and the block
+    // and b start correlated.
+    slot.bias = true;
+    const int k = static_cast<int>(y.size());
+    y.conservativeResize(k + 1);
+    y(k) = 0.0;
+    G_ex.conservativeResize(k + 1, Eigen::NoChange);
+    G_ex.row(k).setZero();
+    Eigen::MatrixXd G(k + 1, 3);
+    G.setZero();
+    G.topLeftCorner(k, 2) = G_n;
+    G.block(0, 2, k, 1) = -G_n.col(1);
+    G(k, 2) = 1.0;
+    G_n = G;
+    var_noise = Eigen::Vector3d(var_n(0), var_n(1), std::pow(options_.track_bias_sigma, 2));
+  }
   const Eigen::MatrixXd& P = state->P();
   const Eigen::MatrixXd P_yx = G_ex * P.middleRows(e, 3);
-  const Eigen::MatrixXd P_yy =
-      G_ex * P.block(e, e, 3, 3) * G_ex.transpose() + G_n * var_n.asDiagonal() * G_n.transpose();
+  const Eigen::MatrixXd P_yy = G_ex * P.block(e, e, 3, 3) * G_ex.transpose() +
+                               G_n * var_noise.asDiagonal() * G_n.transpose();
   (void)n;
   state->add_feature(slot, y, P_yx, P_yy);
   return state->num_features() - 1;

@@ -47,10 +47,11 @@ Eigen::Matrix3d FilterState::extrinsics_covariance() const {
 
 Eigen::Vector2d FilterState::feature_distance_form(int slot, Eigen::Matrix2d* cov) const {
   const FeatureSlot& s = slots_[slot];
-  const Eigen::VectorXd f = x_.segment(s.index, s.size);
-  const Eigen::MatrixXd C = P_.block(s.index, s.index, s.size, s.size);
+  const int ps = feature_param_size(s.param);  // the point's entries (not a bias)
+  const Eigen::VectorXd f = x_.segment(s.index, ps);
+  const Eigen::MatrixXd C = P_.block(s.index, s.index, ps, ps);
   Eigen::Vector2d out;
-  Eigen::MatrixXd J(2, s.size);
+  Eigen::MatrixXd J(2, ps);
   switch (s.param) {
     case FeatureParam::kDistance:
       out = f;
@@ -83,7 +84,7 @@ void FilterState::reindex() {
   int i = 0;
   for (FeatureSlot& s : slots_) {
     s.index = i;
-    s.size = feature_param_size(s.param);
+    s.size = feature_param_size(s.param) + (s.bias ? 1 : 0);
     i += s.size;
   }
 }
@@ -108,6 +109,7 @@ void FilterState::add_feature(FeatureSlot slot,
   P.block(nf, nf, k, k) = 0.5 * (P_ff + P_ff.transpose());
   x_ = std::move(x);
   P_ = std::move(P);
+  assert(k == feature_param_size(slot.param) + (slot.bias ? 1 : 0));
   slot.size = k;
   slots_.push_back(slot);
   reindex();
@@ -139,7 +141,8 @@ void FilterState::reparametrise(int slot,
                                 const Eigen::VectorXd& y,
                                 const Eigen::MatrixXd& J) {
   const int n = dim();
-  const int a = slots_[slot].index, k = slots_[slot].size;
+  // The parametrisation's entries [a, a + k); a bias entry after them stays (identity).
+  const int a = slots_[slot].index, k = feature_param_size(slots_[slot].param);
   const int m = static_cast<int>(y.size());
   assert(J.rows() == m && J.cols() == k);
   Eigen::MatrixXd T = Eigen::MatrixXd::Zero(n - k + m, n);

@@ -205,16 +205,15 @@ std::string noise_check_line(const CalibrationResult& r) {
   else if (r.noise_verdict == NoiseVerdict::kLessNoise)
     std::snprintf(verdict, sizeof verdict,
                   "less than the model assumes (x%.2f or less has a 1%% chance under it): sigmas "
-                  "kept, on the safe side; --bearing-sigma %.3f would weight the bearings as "
-                  "the data say",
-                  noise_check_lower_limit(r.noise.clusters),
-                  rad2deg(effective_bearing_sigma(r)));
-  char buf[512];
+                  "kept, on the safe side; %s would weight the bearings as the data say",
+                  noise_check_lower_limit(r.noise.clusters), noise_check_flags(r).c_str());
+  char buf[640];
   std::snprintf(buf, sizeof(buf),
-                "noise check over %d tracks: the errors along the tracks act as %.3f deg of "
-                "independent noise (variance x%.2f; %s)",
-                r.noise.clusters, rad2deg(effective_bearing_sigma(r)),
-                r.noise.scale, verdict);
+                "noise check over %d tracks: the errors along the tracks act as %s of "
+                "%s (variance x%.2f; %s)",
+                r.noise.clusters,
+                bearing_noise_text(effective_bearing_sigma(r), effective_track_bias_sigma(r)).c_str(),
+                r.track_bias_sigma > 0.0 ? "noise" : "independent noise", r.noise.scale, verdict);
   return buf;
 }
 
@@ -259,6 +258,7 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
   inputs["odometry_K_m"] = num(in.options.odometry_K);
   inputs["odometry_inflation"] = num(in.options.odometry_inflation);
   inputs["bearing_sigma_deg"] = num(rad2deg(r.bearing_sigma));
+  inputs["track_bias_sigma_deg"] = num(rad2deg(r.track_bias_sigma));
 
   inputs["prior"] = {{"phi", num(in.options.prior.phi)},
                      {"rho", num(in.options.prior.rho)},
@@ -324,6 +324,7 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
     nc["scale"] = num(n.ok ? n.scale : NAN);
     nc["tracks"] = n.clusters;
     nc["effective_bearing_sigma_deg"] = num(rad2deg(effective_bearing_sigma(r)));
+    nc["effective_track_bias_sigma_deg"] = num(rad2deg(effective_track_bias_sigma(r)));
     nc["variance_ratio"] = num(r.noise_checked ? r.noise_ratio : NAN);  // 1 when not applied
     nc["of"] = r.refined && r.refinement.covariance_ok ? "refinement" : "filter";
     nc["filter_scale"] = num(r.filter_noise.ok ? r.filter_noise.scale : NAN);
@@ -455,7 +456,7 @@ std::string report_html(const CalibrationResult& r, const ReportInputs& in) {
   kv("wheel base e / Chong-Kleeman K (x inflation)",
      f("%.4f m", in.options.wheel_base) + " / " + f("%.3g m", in.options.odometry_K) + " (x" +
          f("%g", in.options.odometry_inflation) + ")");
-  kv("bearing sigma", f("%.4f deg", rad2deg(r.bearing_sigma)));
+  kv("bearing sigma", bearing_noise_text(r.bearing_sigma, r.track_bias_sigma));
   kv("noise check", r.noise_checked ? noise_check_line(r) : std::string("not made"));
   {
     const std::string w = wheel_check_line(r);

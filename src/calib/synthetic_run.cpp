@@ -31,7 +31,8 @@ void add_turn(double angle, double turn_step, double e, std::vector<Step>* steps
 SyntheticRun make_synthetic_run(const SyntheticRunOptions& o) {
   if (!(o.straight_length > 0.0) || !(o.step > 0.0) || !(o.turn_step > 0.0) ||
       !(o.wheel_base > 0.0) || o.num_features < 1 || !(o.min_distance > o.truth.rho) ||
-      !(o.max_distance > o.min_distance) || !(o.bearing_sigma >= 0.0) || !(o.odometry_K >= 0.0) ||
+      !(o.max_distance > o.min_distance) || !(o.bearing_sigma >= 0.0) ||
+      !(o.track_bias_sigma >= 0.0) || !(o.odometry_K >= 0.0) ||
       o.zigzag_legs < 1 || !(o.bearing_correlation >= 0.0 && o.bearing_correlation < 1.0))
     throw InputError("synthetic run: invalid options");
   std::mt19937_64 rng(o.seed);
@@ -88,6 +89,11 @@ SyntheticRun make_synthetic_run(const SyntheticRunOptions& o) {
     track_of[j] = next_id++;
     out.track_feature[track_of[j]] = static_cast<int>(j);
   }
+  std::vector<double> bias(out.features.size(), 0.0);  // per line, all its pieces
+  if (o.track_bias_sigma > 0.0) {
+    std::mt19937_64 bias_rng(o.seed ^ 0x9e3779b97f4a7c15ULL);
+    for (double& b : bias) b = o.track_bias_sigma * normal(bias_rng);
+  }
   for (std::size_t k = 0; k < out.true_poses.size(); ++k) {
     FrameInput f;
     if (k > 0) {
@@ -102,7 +108,7 @@ SyntheticRun make_synthetic_run(const SyntheticRunOptions& o) {
       }
       const double n = normal(rng);
       error[j] = k == 0 ? o.bearing_sigma * n : a * error[j] + innovation * o.bearing_sigma * n;
-      const double beta = bearing_from_geometry(out.true_poses[k], out.features[j], o.truth) + error[j];
+      const double beta = bearing_from_geometry(out.true_poses[k], out.features[j], o.truth) + error[j] + bias[j];
       f.observations.push_back({track_of[j], wrap_angle(beta)});
     }
     out.run.frames.push_back(std::move(f));

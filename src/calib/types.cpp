@@ -38,6 +38,8 @@ bool Options::IsValid(std::string* why) const {
   if (!std::isfinite(odometry_variance_floor) || odometry_variance_floor <= 0.0)
     return fail(why, "odometry_variance_floor must be > 0 [m^2]");
   if (!finite_positive(bearing_sigma)) return fail(why, "bearing_sigma must be > 0 [rad]");
+  if (!(std::isfinite(track_bias_sigma) && track_bias_sigma >= 0.0))
+    return fail(why, "track_bias_sigma must be >= 0 [rad] (0: no per-track bias)");
   if (!std::isfinite(prior.phi) || !std::isfinite(prior.psi) || !finite_positive(prior.rho))
     return fail(why, "prior: phi and psi must be finite and rho > 0");
   for (int i = 0; i < 3; ++i)

@@ -130,6 +130,10 @@ Eigen::VectorXd Updater::predict(const FilterState& state,
         break;
       }
     }
+    if (s.bias) {  // Options::track_bias_sigma: eq. (30) + the track's constant error b
+      h(k) += x(s.bias_index());
+      (*H)(k, s.bias_index()) = 1.0;
+    }
   }
   return h;
 }

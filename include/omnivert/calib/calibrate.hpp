@@ -49,6 +49,7 @@ struct CalibrationResult {
   Extrinsics extrinsics;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   double bearing_sigma = 0.0;  // the bearing sigma used by the models [rad]
+  double track_bias_sigma = 0.0;  // Options::track_bias_sigma used by the models [rad]
   // Refinement only: its covariance came from the Fisher information of the observability
   // analysis (the inverse of the same information) because ceres::Covariance failed.
   bool covariance_from_information = false;
@@ -77,6 +78,15 @@ struct CalibrationResult {
 // The independent bearing noise [rad] that would do the harm the noise check found:
 // bearing_sigma x sqrt(noise.scale) (the sigma its messages advise); NaN when not checked.
 double effective_bearing_sigma(const CalibrationResult& result);
+// The same for the per-track part (Options::track_bias_sigma): track_bias_sigma x
+// sqrt(noise.scale); 0 when the model has none, NaN when not checked.
+double effective_track_bias_sigma(const CalibrationResult& result);
+// The bearing noise model in words, e.g. "0.025 deg" or "0.018 deg + 0.016 deg per track",
+// for sigmas in radians.
+std::string bearing_noise_text(double bearing_sigma, double track_bias_sigma);
+// The flags that would weight the bearings as the noise check found them, e.g.
+// "--bearing-sigma 0.014" or "--bearing-sigma 0.014 --track-bias-sigma 0.012".
+std::string noise_check_flags(const CalibrationResult& result);
 
 // Throws InputError on invalid options or input (non-finite values, repeated track ids).
 CalibrationResult calibrate(const CalibrationRun& run,

@@ -31,6 +31,11 @@ struct FeatureSlot {
   int first_frame = 0;
   int last_seen_frame = 0;
   int num_updates = 0;
+  // Options::track_bias_sigma > 0: the block ends with one more entry, the track's constant
+  // bearing error b (each bearing is eq. (30) + b); size is then feature_param_size + 1.
+  bool bias = false;
+  // Index in x of b (bias only).
+  int bias_index() const { return index + size - 1; }
 };
 
 class FilterState {
@@ -69,7 +74,8 @@ class FilterState {
   // Marginalisation: removes the feature's rows and columns.
   void remove_feature(int slot);
   // Changes a block's parametrisation: x_block <- y (new size m), P <- T P T^T with T the
-  // identity except J (m x size) on the block.
+  // identity except J (m x the parametrisation's size) on the block; a track's bias entry
+  // (FeatureSlot::bias) is kept as it is.
   void reparametrise(int slot,
                      FeatureParam param,
                      const Eigen::VectorXd& y,

@@ -94,6 +94,13 @@ struct Options {
   double odometry_variance_floor = 1e-12;  // [m^2], keeps the noise positive at rest
   // Camera.
   double bearing_sigma = 0.3 * 3.14159265358979323846 / 180.0;  // [rad]
+  // [rad] A constant bearing error per track, b ~ N(0, track_bias_sigma^2) (0: none). Each
+  // bearing is then predicted as eq. (30) + b, with bearing_sigma the error that changes from
+  // frame to frame. The filter carries b as one more entry of the track's block
+  // (FeatureSlot::bias); the batch problems (window, refinement, bound) as one parameter per
+  // track with that prior. Against the ground truth our extractor's bearings have both parts
+  // (docs/calib.md, "Per-track bearing bias").
+  double track_bias_sigma = 0.0;
   // Prior on (phi, rho, psi): the paper's hand measurement with wide sigmas.
   Extrinsics prior{0.0, 0.2, 0.0};
   Eigen::Vector3d prior_sigma{0.8, 0.1, 0.8};  // [rad, m, rad]
