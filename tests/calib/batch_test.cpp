@@ -384,16 +384,23 @@ TEST(CrossingGuard, PiecesOfOneLineDoNotGuardEachOther) {
 // (BatchOptions::merge_pieces) and so reaches nearly the precision of the whole tracks.
 // Seeds 69 and 90: with the Wald test alone, 2 and 4 joins were of two lines (a three-bearing
 // piece has no depth and passed it at 0.00), and the refinement ended with NEES 46 and 1547.
-// Chains of joins are followed to the line's first piece; a join of a piece to itself, a
-// second join of one piece and one that closes a loop are left out, so every chain ends (the
-// window reports joins by the tracker's ids, and a corridor zigzag run hung on (T, T)).
+// Chains of joins are followed to the line's first piece; of two joins of one piece the last
+// counts; a join of a piece to itself and one that closes a loop are left out, so every chain
+// ends (the window reports joins by the tracker's ids, and a corridor zigzag run hung on
+// (T, T)).
 TEST(PiecesOfOneLine, JoinChainsEndAtTheFirstPiece) {
+  // Taken from the last: 8 -> 7, 2 -> 5, 1 -> 3, (3, 3) left out, 3 -> 2; (1, 2) is a second
+  // join of 2, left out. The chains: 1 -> 3 -> 2 -> 5.
   const std::map<int, int> r = join_roots({{1, 2}, {2, 3}, {3, 3}, {3, 1}, {5, 2}, {7, 8}});
-  const std::map<int, int> expected = {{2, 1}, {3, 1}, {8, 7}};
+  const std::map<int, int> expected = {{1, 5}, {2, 5}, {3, 5}, {8, 7}};
   EXPECT_EQ(r, expected);
   EXPECT_TRUE(join_roots({{4, 4}}).empty());
+  // A loop: the last pair is kept, the one that would close the loop left out.
   const std::map<int, int> two = join_roots({{4, 6}, {6, 4}});
-  EXPECT_EQ(two, (std::map<int, int>{{6, 4}}));
+  EXPECT_EQ(two, (std::map<int, int>{{4, 6}}));
+  // Without loops or repeats, plain chains.
+  const std::map<int, int> chain = join_roots({{1, 2}, {2, 3}, {3, 4}});
+  EXPECT_EQ(chain, (std::map<int, int>{{2, 1}, {3, 1}, {4, 1}}));
 }
 
 TEST(PiecesOfOneLine, AreJoinedOnlyWithTheirOwnLine) {

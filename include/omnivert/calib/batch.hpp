@@ -236,9 +236,9 @@ CalibrationRun join_tracks(const CalibrationRun& run,
                            const std::vector<std::pair<int, int>>& joins,
                            std::map<int, int>* renamed = nullptr);
 // Each joined piece's line: joined piece's id -> the id of its line's first piece (chains of
-// (earlier, later) pairs followed to their start). What join_tracks renames by. A pair that
-// joins a piece to itself, a second pair for a piece already joined, or a pair that would
-// close a loop is left out: every chain ends.
+// (earlier, later) pairs followed to their start). What join_tracks renames by. Of several
+// pairs for one piece the last counts; a pair that joins a piece to itself or would close a
+// loop is left out: every chain ends.
 std::map<int, int> join_roots(const std::vector<std::pair<int, int>>& joins);
 
 // Verdict on one parameter (or combination) of the extrinsics.
