@@ -5,7 +5,7 @@
 #         -DWORK=<scratch dir> -DMODE=<mode> -P calibrate_cli.cmake
 # MODE: end_to_end | straight | straight_force | wheel_gap | wheel_short | wheel_decreasing |
 #       no_wheel | few_lines | no_lines | prior_file | few_tracks | no_noise_check |
-#       tracks_file | wheel_base_wrong
+#       tracks_file | wheel_base_wrong | track_bias
 cmake_minimum_required(VERSION 3.20)
 
 function(fail msg)
@@ -48,6 +48,20 @@ function(check_no_nan out_dir)
   if(leftovers)
     fail("temporary files left: ${leftovers}")
   endif()
+endfunction()
+
+# run_calibrate that must succeed: exit 0, no NaN in any output; sets out, err and json (the
+# summary) in the caller.
+function(run_calibrate_ok data out_dir)
+  run_calibrate(${data} ${out_dir} ${ARGN})
+  if(NOT rc EQUAL 0)
+    fail("calibrate exited ${rc}: ${err}")
+  endif()
+  check_no_nan(${out_dir})
+  file(READ ${out_dir}/summary.json j)
+  set(out "${out}" PARENT_SCOPE)
+  set(err "${err}" PARENT_SCOPE)
+  set(json "${j}" PARENT_SCOPE)
 endfunction()
 
 # Copy of a dataset to damage.
@@ -117,12 +131,7 @@ if(MODE STREQUAL "end_to_end")
   endif()
 
 elseif(MODE STREQUAL "no_noise_check")
-  run_calibrate(${PAPER} ${out_dir} --refine --no-noise-check)
-  if(NOT rc EQUAL 0)
-    fail("calibrate exited ${rc}: ${err}")
-  endif()
-  check_no_nan(${out_dir})
-  file(READ ${out_dir}/summary.json json)
+  run_calibrate_ok(${PAPER} ${out_dir} --refine --no-noise-check)
   string(JSON checked GET "${json}" noise_check checked)
   string(JSON m0 GET "${json}" noise_check refinement_model_covariance 0)
   string(JSON r0 GET "${json}" result covariance 0)
@@ -136,12 +145,7 @@ elseif(MODE STREQUAL "no_noise_check")
 elseif(MODE STREQUAL "track_bias")
   # --track-bias-sigma: a constant bearing error per track in the models; the terminal, the
   # summary and the report name the two-part noise model; a negative value is refused.
-  run_calibrate(${PAPER} ${out_dir} --refine --bearing-sigma 0.018 --track-bias-sigma 0.016)
-  if(NOT rc EQUAL 0)
-    fail("calibrate exited ${rc}: ${err}")
-  endif()
-  check_no_nan(${out_dir})
-  file(READ ${out_dir}/summary.json json)
+  run_calibrate_ok(${PAPER} ${out_dir} --refine --bearing-sigma 0.018 --track-bias-sigma 0.016)
   string(JSON b GET "${json}" inputs track_bias_sigma_deg)
   string(JSON s GET "${json}" inputs bearing_sigma_deg)
   if(NOT b GREATER 0.01599 OR NOT b LESS 0.01601 OR NOT s GREATER 0.01799 OR NOT s LESS 0.01801)
@@ -235,12 +239,7 @@ elseif(MODE STREQUAL "wheel_base_wrong")
   file(READ ${data}/wheel0/sensor.yaml yaml)
   string(REGEX REPLACE "wheel_base: 0.4" "wheel_base: 0.392157" yaml "${yaml}")
   file(WRITE ${data}/wheel0/sensor.yaml "${yaml}")
-  run_calibrate(${data} ${out_dir})
-  if(NOT rc EQUAL 0)
-    fail("calibrate exited ${rc}: ${err}")
-  endif()
-  check_no_nan(${out_dir})
-  file(READ ${out_dir}/summary.json json)
+  run_calibrate_ok(${data} ${out_dir})
   string(JSON rejects GET "${json}" noise_check wheels rejects_model)
   string(JSON s GET "${json}" noise_check wheels rotation_scale)
   if(NOT rejects OR s LESS 0.012 OR s GREATER 0.028)
