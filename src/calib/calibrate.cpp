@@ -99,8 +99,8 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
     // covariance is replaced by the checked one only when the check shows more noise than the
     // model allows (noise_check_verdict): with 10-15 tracks one run's scale is uncertain, and
     // applied always it made the refinement's NEES worse where the model is right (synthetic
-    // 0.3 degree, 50 runs: 3.50 -> 5.18). Less noise is reported, not applied
-    // (CalibrateOptions::noise_check).
+    // 0.3 degree, 50 runs: 3.50 -> 5.18). Less noise is applied only where few pieces of
+    // lines were joined (CalibrateOptions::noise_check, noise_check_lower_max_joins).
     auto ratio_of = [](const BatchNoiseCheck& n) {
       const Eigen::LDLT<Eigen::Matrix3d> model(n.model_covariance);
       if (!n.ok || model.info() != Eigen::Success) return 0.0;
@@ -133,13 +133,28 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
       r.noise = r.filter_noise;
       r.filter_noise_verdict = noise_check_verdict(r.filter_noise, co.noise_check_level);
       r.noise_verdict = r.filter_noise_verdict;
-      // Applied only when the check shows more noise (CalibrateOptions::noise_check).
+      // Applied when the check shows more noise, or less where the tracker kept its lines
+      // (CalibrateOptions::noise_check).
       if (r.filter_noise_verdict == NoiseVerdict::kMoreNoise) {
         r.filter.covariance *= ratio;
         r.filter_noise_applied = true;
         r.filter_noise_ratio = ratio;
         r.noise_applied = true;
         r.noise_ratio = ratio;
+      } else if (r.filter_noise_verdict == NoiseVerdict::kLessNoise &&
+                 co.noise_check_lower_max_joins >= 0.0 &&
+                 static_cast<double>(r.filter.joins.size()) <=
+                     co.noise_check_lower_max_joins * r.filter_noise.clusters) {
+        const Eigen::Matrix3d shrunk =
+            r.filter.covariance + r.filter_noise.covariance - r.filter_noise.model_covariance;
+        const Eigen::LLT<Eigen::Matrix3d> llt(shrunk);
+        if (llt.info() == Eigen::Success && shrunk.allFinite()) {
+          r.filter.covariance = 0.5 * (shrunk + shrunk.transpose());
+          r.filter_noise_applied = true;
+          r.filter_noise_ratio = ratio;
+          r.noise_applied = true;
+          r.noise_ratio = ratio;
+        }
       }
     }
     if (r.refined && r.refinement.covariance_ok) {
@@ -151,7 +166,10 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
         r.noise_checked = true;
         r.noise = r.refinement.noise;
         r.noise_verdict = noise_check_verdict(r.noise, co.noise_check_level);
-        if (r.noise_verdict == NoiseVerdict::kMoreNoise) {
+        if (r.noise_verdict == NoiseVerdict::kMoreNoise ||
+            (r.noise_verdict == NoiseVerdict::kLessNoise && co.noise_check_lower_max_joins >= 0.0 &&
+             static_cast<double>(r.refinement.merges.size()) <=
+                 co.noise_check_lower_max_joins * r.noise.clusters)) {
           r.noise_applied = true;
           r.noise_ratio = ratio;
           r.refinement.covariance = r.noise.covariance;

@@ -202,11 +202,21 @@ std::string noise_check_line(const CalibrationResult& r) {
                   "more than the model allows (x%.2f or more has a 1%% chance under it): sigmas "
                   "scaled by %.2f",
                   noise_check_limit(r.noise.clusters), std::sqrt(r.noise_ratio));
+  else if (r.noise_verdict == NoiseVerdict::kLessNoise && r.noise_applied)
+    std::snprintf(verdict, sizeof verdict,
+                  "less than the model assumes (x%.2f or less has a 1%% chance under it): sigmas "
+                  "scaled by %.2f; %s would weight the bearings so from the start",
+                  noise_check_lower_limit(r.noise.clusters), std::sqrt(r.noise_ratio),
+                  noise_check_flags(r).c_str());
   else if (r.noise_verdict == NoiseVerdict::kLessNoise)
     std::snprintf(verdict, sizeof verdict,
                   "less than the model assumes (x%.2f or less has a 1%% chance under it): sigmas "
-                  "kept, on the safe side; %s would weight the bearings as the data say",
-                  noise_check_lower_limit(r.noise.clusters), noise_check_flags(r).c_str());
+                  "kept, on the safe side, as %zu pieces of lines were joined (pieces left apart "
+                  "hide noise from this check); %s would weight the bearings as the data say",
+                  noise_check_lower_limit(r.noise.clusters),
+                  r.refined && r.refinement.covariance_ok ? r.refinement.merges.size()
+                                                          : r.filter.joins.size(),
+                  noise_check_flags(r).c_str());
   char buf[640];
   std::snprintf(buf, sizeof(buf),
                 "noise check over %d tracks: the errors along the tracks act as %s of "
