@@ -34,9 +34,9 @@ struct CalibrateOptions {
   // check, which then reads less noise than there is: shrunk without this guard, runs with
   // tracks broken every ~10 frames became overconfident (session 13: corridor, paper
   // trajectory, refinement 3.25 -> 4.12, 25 runs), with it they are untouched (they join
-  // 2.6-8.5 pieces per track; our tracker's runs from pixels at most 0.6) and the corridor's
-  // runs from pixels come closer to the NEES interval (200 seeds: 2.31 -> 2.48; docs/calib.md,
-  // "The noise check", session 14). Otherwise the verdict is reported and the covariances
+  // 2.6-7.4 pieces per track, medians by row; our tracker's runs from pixels at most 0.6),
+  // and the corridor's runs from pixels come closer to the NEES interval (200 seeds: 2.31 ->
+  // 2.48; docs/calib.md, "The noise check", session 14). Otherwise the verdict is reported and the covariances
   // kept (noise_check_line names the sigma the data want).
   // false: no check, the model's covariances.
   bool noise_check = true;
