@@ -650,6 +650,31 @@ TEST(NoiseCheck, AgreesWithTheModelWithPerLineBias) {
   EXPECT_LT(scale, 1.3);
 }
 
+// The warning that the filter's gate refused many bearings counts the frames after the
+// start-up window only: the window's own outliers (counted in its frames) are no sign of a
+// filter that diverged; where the window failed, the filter ran over those frames and they
+// count.
+TEST(ResultWarnings, GateRefusalsCountAfterTheWindow) {
+  CalibrationResult r;
+  r.filter.window_frames = 10;
+  r.filter.history.resize(30);
+  for (int k = 0; k < 10; ++k) r.filter.history[k].num_rejected = 20;  // the window's outliers
+  for (int k = 10; k < 30; ++k) r.filter.history[k].num_updates = 10;
+  auto warns = [](const CalibrationResult& c) {
+    for (const std::string& m : result_warnings(c))
+      if (m.find("chi-square gate refused") != std::string::npos) return true;
+    return false;
+  };
+  EXPECT_FALSE(warns(r));  // 0 of 200 after the window
+  r.filter.window_failure = "window solve failed";
+  EXPECT_TRUE(warns(r));  // 200 of 400 over the whole run, the EKF's own
+  r.filter.window_failure.clear();
+  for (int k = 10; k < 30; ++k) r.filter.history[k].num_rejected = 4;  // 80 of 280
+  EXPECT_TRUE(warns(r));
+  for (int k = 10; k < 30; ++k) r.filter.history[k].num_rejected = 2;  // 40 of 240
+  EXPECT_FALSE(warns(r));
+}
+
 // The dense inverse (small problems) and the sparse solves (large ones) give the same check.
 TEST(NoiseCheck, DenseAndSparseLeverageAgree) {
   SyntheticRunOptions so;

@@ -102,7 +102,8 @@ CalibrationResult calibrate(const CalibrationRun& run,
                             const CalibrateOptions& calibrate_options = {});
 
 // What a user should be told about a result (empty when nothing): the filter's gate refused
-// more than 20% of the bearings (it has probably diverged, or the tracks mix lines), and,
+// more than 20% of the bearings after its start-up window (it has probably diverged, or the
+// tracks mix lines), and,
 // when refined, the refinement lies outside the filter's 99.9% ellipsoid (squared Mahalanobis
 // distance under the filter's covariance above 16.27, chi-square with 3 degrees of freedom):
 // the filter is biased or overconfident on this run, and the refinement's answer is the one
