@@ -53,33 +53,33 @@ struct OdometryResidual {
   }
 };
 
-// Bearing factor: beta = atan2(y_f - y_C, x_f - x_C) - (theta_R + phi + psi), residual wrapped.
+// Bearing factor: beta = atan2(y_f - y_C, x_f - x_C) - (theta_R + phi + psi), residual wrapped
+// to (-pi, pi] and whitened; `offset` is added to the prediction (a track's constant error).
+template <typename T>
+T bearing_residual(double beta, double inv_sigma, const T* pose, const T* f, const T* ex,
+                   const T& offset) {
+  const T a = pose[2] + ex[0];
+  const T xc = pose[0] + ex[1] * cos(a);
+  const T yc = pose[1] + ex[1] * sin(a);
+  const T pred = atan2(f[1] - yc, f[0] - xc) - (pose[2] + ex[0] + ex[2]) + offset;
+  const T d = T(beta) - pred;
+  return atan2(sin(d), cos(d)) * inv_sigma;
+}
 struct BearingResidual {
   double beta, inv_sigma;
   template <typename T>
   bool operator()(const T* pose, const T* f, const T* ex, T* r) const {
-    const T a = pose[2] + ex[0];
-    const T xc = pose[0] + ex[1] * cos(a);
-    const T yc = pose[1] + ex[1] * sin(a);
-    const T pred = atan2(f[1] - yc, f[0] - xc) - (pose[2] + ex[0] + ex[2]);
-    const T d = T(beta) - pred;
-    r[0] = atan2(sin(d), cos(d)) * inv_sigma;  // wrapped to (-pi, pi]
+    r[0] = bearing_residual(beta, inv_sigma, pose, f, ex, T(0.0));
     return true;
   }
 };
-
 // Options::track_bias_sigma: the bearing with the track's constant error b added to
 // eq. (30)'s prediction, and b's prior.
 struct BiasedBearingResidual {
   double beta, inv_sigma;
   template <typename T>
   bool operator()(const T* pose, const T* f, const T* ex, const T* bias, T* r) const {
-    const T a = pose[2] + ex[0];
-    const T xc = pose[0] + ex[1] * cos(a);
-    const T yc = pose[1] + ex[1] * sin(a);
-    const T pred = atan2(f[1] - yc, f[0] - xc) - (pose[2] + ex[0] + ex[2]) + bias[0];
-    const T d = T(beta) - pred;
-    r[0] = atan2(sin(d), cos(d)) * inv_sigma;
+    r[0] = bearing_residual(beta, inv_sigma, pose, f, ex, bias[0]);
     return true;
   }
 };
@@ -659,16 +659,13 @@ BatchNoiseCheck noise_check(Built& b, int dense_limit) {
   for (std::size_t i = 0; i < b.odometry_blocks.size(); ++i, ++next)
     for (int k = 0; k < 3; ++k) cluster[row++] = next;
   std::map<int, int> of_track;
-  for (const auto& key : b.bearing_keys) {
-    auto [it, fresh] = of_track.emplace(key.first, next);
-    if (fresh) ++next;
-    cluster[row++] = it->second;
-  }
-  for (const auto& [id, block] : b.bias_priors) {
+  auto track_cluster = [&of_track, &next](int id) {
     auto [it, fresh] = of_track.emplace(id, next);
     if (fresh) ++next;
-    cluster[row++] = it->second;
-  }
+    return it->second;
+  };
+  for (const auto& key : b.bearing_keys) cluster[row++] = track_cluster(key.first);
+  for (const auto& [id, block] : b.bias_priors) cluster[row++] = track_cluster(id);
   if (row != m) return out;
   const Eigen::SparseMatrix<double> J = sparse_jacobian(crs);
   const Eigen::SparseMatrix<double> F = information_with_ridge(J);

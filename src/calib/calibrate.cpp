@@ -41,6 +41,13 @@ CalibrationRun without_bearings(const CalibrationRun& run,
   return out;
 }
 
+// CalibrateOptions::noise_check_lower_max_joins: whether "less noise" may be applied to a
+// check over check.clusters tracks after `joins` pieces of lines were joined.
+bool lower_side_applies(const CalibrateOptions& co, std::size_t joins, const BatchNoiseCheck& check) {
+  return co.noise_check_lower_max_joins >= 0.0 &&
+         static_cast<double>(joins) <= co.noise_check_lower_max_joins * check.clusters;
+}
+
 CalibrationResult calibrate_once(const CalibrationRun& run,
                                  const Options& options,
                                  const CalibrateOptions& co) {
@@ -135,26 +142,19 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
       r.noise_verdict = r.filter_noise_verdict;
       // Applied when the check shows more noise, or less where the tracker kept its lines
       // (CalibrateOptions::noise_check).
+      auto apply = [&](const Eigen::Matrix3d& covariance) {
+        r.filter.covariance = covariance;
+        r.filter_noise_applied = r.noise_applied = true;
+        r.filter_noise_ratio = r.noise_ratio = ratio;
+      };
       if (r.filter_noise_verdict == NoiseVerdict::kMoreNoise) {
-        r.filter.covariance *= ratio;
-        r.filter_noise_applied = true;
-        r.filter_noise_ratio = ratio;
-        r.noise_applied = true;
-        r.noise_ratio = ratio;
+        apply(r.filter.covariance * ratio);
       } else if (r.filter_noise_verdict == NoiseVerdict::kLessNoise &&
-                 co.noise_check_lower_max_joins >= 0.0 &&
-                 static_cast<double>(r.filter.joins.size()) <=
-                     co.noise_check_lower_max_joins * r.filter_noise.clusters) {
+                 lower_side_applies(co, r.filter.joins.size(), r.filter_noise)) {
         const Eigen::Matrix3d shrunk =
             r.filter.covariance + r.filter_noise.covariance - r.filter_noise.model_covariance;
-        const Eigen::LLT<Eigen::Matrix3d> llt(shrunk);
-        if (llt.info() == Eigen::Success && shrunk.allFinite()) {
-          r.filter.covariance = 0.5 * (shrunk + shrunk.transpose());
-          r.filter_noise_applied = true;
-          r.filter_noise_ratio = ratio;
-          r.noise_applied = true;
-          r.noise_ratio = ratio;
-        }
+        if (shrunk.allFinite() && Eigen::LLT<Eigen::Matrix3d>(shrunk).info() == Eigen::Success)
+          apply(0.5 * (shrunk + shrunk.transpose()));
       }
     }
     if (r.refined && r.refinement.covariance_ok) {
@@ -167,9 +167,8 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
         r.noise = r.refinement.noise;
         r.noise_verdict = noise_check_verdict(r.noise, co.noise_check_level);
         if (r.noise_verdict == NoiseVerdict::kMoreNoise ||
-            (r.noise_verdict == NoiseVerdict::kLessNoise && co.noise_check_lower_max_joins >= 0.0 &&
-             static_cast<double>(r.refinement.merges.size()) <=
-                 co.noise_check_lower_max_joins * r.noise.clusters)) {
+            (r.noise_verdict == NoiseVerdict::kLessNoise &&
+             lower_side_applies(co, r.refinement.merges.size(), r.noise))) {
           r.noise_applied = true;
           r.noise_ratio = ratio;
           r.refinement.covariance = r.noise.covariance;
@@ -193,14 +192,19 @@ CalibrationResult calibrate(const CalibrationRun& run,
   return calibrate_once(run, options, co);
 }
 
+namespace {
+// A model sigma scaled as the noise check found the errors; NaN when not checked.
+double checked_sigma(const CalibrationResult& r, double sigma) {
+  return r.noise.ok ? sigma * std::sqrt(r.noise.scale) : std::numeric_limits<double>::quiet_NaN();
+}
+}  // namespace
+
 double effective_bearing_sigma(const CalibrationResult& r) {
-  return r.noise.ok ? r.bearing_sigma * std::sqrt(r.noise.scale)
-                    : std::numeric_limits<double>::quiet_NaN();
+  return checked_sigma(r, r.bearing_sigma);
 }
 
 double effective_track_bias_sigma(const CalibrationResult& r) {
-  return r.noise.ok ? r.track_bias_sigma * std::sqrt(r.noise.scale)
-                    : std::numeric_limits<double>::quiet_NaN();
+  return checked_sigma(r, r.track_bias_sigma);
 }
 
 std::string bearing_noise_text(double bearing_sigma, double track_bias_sigma) {

@@ -146,7 +146,8 @@ double Updater::second_order_variance(const FilterState& state, const BearingMea
   // first updates (small parallax, depth and yaw both uncertain) are overconfident.
   const FeatureSlot& s = state.slots()[z.slot];
   std::vector<int> idx;
-  for (int i = 0; i < s.size; ++i) idx.push_back(s.index + i);
+  // (Not a track's bias entry, FeatureSlot::bias: h is linear in it, its rows of Hxx are 0.)
+  for (int i = 0; i < feature_param_size(s.param); ++i) idx.push_back(s.index + i);
   for (int i = 0; i < 3; ++i) idx.push_back(state.extrinsics_index() + i);
   const int d = static_cast<int>(idx.size());
   const std::vector<BearingMeasurement> one = {z};

@@ -36,8 +36,8 @@ struct CalibrateOptions {
   // trajectory, refinement 3.25 -> 4.12, 25 runs), with it they are untouched (they join
   // 2.6-7.4 pieces per track, medians by row; our tracker's runs from pixels at most 0.6),
   // and the corridor's runs from pixels come closer to the NEES interval (200 seeds: 2.31 ->
-  // 2.48; docs/calib.md, "The noise check", session 14). Otherwise the verdict is reported and the covariances
-  // kept (noise_check_line names the sigma the data want).
+  // 2.48; docs/calib.md, "The noise check", session 14). Otherwise the verdict is reported
+  // and the covariances kept (noise_check_line names the sigma the data want).
   // false: no check, the model's covariances.
   bool noise_check = true;
   double noise_check_level = 0.01;  // of each side of noise_check_verdict
@@ -103,11 +103,11 @@ CalibrationResult calibrate(const CalibrationRun& run,
 
 // What a user should be told about a result (empty when nothing): the filter's gate refused
 // more than 20% of the bearings after its start-up window (it has probably diverged, or the
-// tracks mix lines), and,
-// when refined, the refinement lies outside the filter's 99.9% ellipsoid (squared Mahalanobis
-// distance under the filter's covariance above 16.27, chi-square with 3 degrees of freedom):
-// the filter is biased or overconfident on this run, and the refinement's answer is the one
-// to trust (seen where tracks slip onto a neighbouring line, docs/calib.md).
+// tracks mix lines), and, when refined, the refinement lies outside the filter's 99.9%
+// ellipsoid (squared Mahalanobis distance under the filter's covariance above 16.27,
+// chi-square with 3 degrees of freedom): the filter is biased or overconfident on this run,
+// and the refinement's answer is the one to trust (seen where tracks slip onto a
+// neighbouring line, docs/calib.md).
 // A warning, too, when the wheel check (WheelCheck, at the refinement or at the filter's
 // noise check) finds a systematic wheel error, with its size and what to correct.
 std::vector<std::string> result_warnings(const CalibrationResult& result);
