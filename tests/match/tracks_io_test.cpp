@@ -1,6 +1,8 @@
 #include "omnivert/match/tracks_io.hpp"
 #include "omnivert/match/tracks_plot.hpp"
 
+#include <unistd.h>
+
 #include <cstdlib>
 #include <fstream>
 #include <random>
@@ -16,14 +18,28 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path temp_dir() {
-  const fs::path d =
-      fs::temp_directory_path() /
-      ("omnivert_tracks_io_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-       "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-  fs::create_directories(d);
-  return d;
-}
+// A scratch directory of one test, removed when the test ends (pid: ctest runs tests in
+// parallel processes).
+class ScratchDir {
+ public:
+  ScratchDir()
+      : path_(fs::temp_directory_path() /
+              ("omnivert_tracks_io_" + std::to_string(::getpid()) + "_" +
+               ::testing::UnitTest::GetInstance()->current_test_info()->name())) {
+    fs::remove_all(path_);
+    fs::create_directories(path_);
+  }
+  ~ScratchDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
 
 void write_text(const fs::path& p, const std::string& s) {
   std::ofstream f(p);
@@ -57,7 +73,8 @@ TEST(TracksCsv, RoundTrip) {
   EXPECT_EQ(rows[1].matched_frame, -1);
   EXPECT_EQ(rows[2].matched_frame, 7);
 
-  const fs::path p = temp_dir() / "tracks.csv";
+  const ScratchDir scratch;
+  const fs::path p = scratch.path() / "tracks.csv";
   write_tracks_csv(p, rows);
   EXPECT_FALSE(fs::exists(fs::path(p.string() + ".partial")));
   std::ifstream f(p);
@@ -85,7 +102,8 @@ TEST(TracksCsv, RoundTrip) {
 }
 
 TEST(TracksCsv, MinimalColumnsInAnyOrder) {
-  const fs::path p = temp_dir() / "min.csv";
+  const ScratchDir scratch;
+  const fs::path p = scratch.path() / "min.csv";
   write_text(p, "track_id,bearing_rad,frame,timestamp_ns\n4,0.5,3,100\n\n4,0.6,4,200\n");
   const auto rows = read_tracks_csv(p);
   ASSERT_EQ(rows.size(), 2u);
@@ -95,7 +113,8 @@ TEST(TracksCsv, MinimalColumnsInAnyOrder) {
 }
 
 TEST(TracksCsv, BadInputNamesFileAndLine) {
-  const fs::path dir = temp_dir();
+  const ScratchDir scratch;
+  const fs::path& dir = scratch.path();
   auto expect_error = [&](const std::string& content, int line, const std::string& what) {
     const fs::path p = dir / "bad.csv";
     write_text(p, content);
@@ -185,7 +204,8 @@ TEST(TracksPlot, WritesPng) {
     }
   }
   const char* env = std::getenv("OMNIVERT_PLOT_DIR");
-  const fs::path p = (env ? fs::path(env) : temp_dir()) / "tracks.png";
+  const ScratchDir scratch;
+  const fs::path p = (env ? fs::path(env) : scratch.path()) / "tracks.png";
   write_tracks_png(p, rows);
   const cv::Mat back = cv::imread(p.string());
   ASSERT_FALSE(back.empty());
