@@ -51,6 +51,7 @@ struct CalibrateArgs {
   std::string out;
   bool refine = false;
   bool noise_check = true;
+  double noise_check_lower_level = calib::CalibrateOptions{}.noise_check_lower_level;
   bool force = false;
   std::string prior_file;
   std::string tracks_file;  // --tracks: an existing tracks.csv instead of tracking
@@ -220,7 +221,12 @@ void run_calibrate(const CalibrateArgs& a) {
   for (const auto& w : warnings) spdlog::warn("{}", w);
   if (Progress::enabled()) std::fprintf(stderr, "calibrate: filter%s...\n", a.refine ? " and refinement" : "");
   const calib::CalibrationResult result = calib::calibrate(
-      run.run, opt, {.refine = a.refine, .noise_check = a.noise_check, .batch = batch_options(a)});
+      run.run,
+      opt,
+      {.refine = a.refine,
+       .noise_check = a.noise_check,
+       .noise_check_lower_level = a.noise_check_lower_level,
+       .batch = batch_options(a)});
   const auto t2 = clock::now();
   if (!result.extrinsics.vec().allFinite() || !result.covariance.allFinite())
     throw std::runtime_error(
@@ -360,6 +366,13 @@ void add_calibrate_command(CLI::App& app) {
   cmd->add_flag("!--no-noise-check", a->noise_check,
                 "Report the model's covariances as they are, without the data's check of the "
                 "bearing noise (errors summed along each track; docs/calib.md, \"The noise check\")");
+  cmd->add_option("--noise-check-lower-level", a->noise_check_lower_level,
+                  "The noise check finds the bearings less noisy than the model assumes when "
+                  "errors this small have at most this probability under the model, and then "
+                  "shrinks the bearings' share of the covariance where the tracker kept its "
+                  "lines (docs/calib.md, \"The noise check\"); 0 turns this side off")
+      ->check(kTestLevel)
+      ->capture_default_str();
   cmd->add_option("--tracks", a->tracks_file,
                   "Calibrate from this tracks.csv (of `omnivert track` or an earlier calibrate "
                   "on the same dataset) instead of extracting and tracking the images")

@@ -30,6 +30,15 @@ inline CLI::Validator number_at_least(double low, bool strict) {
       "NUMBER " + what);
 }
 inline const CLI::Validator kNonNegative = number_at_least(0.0, false);
+// A test's level: 0 (the test off) up to, not including, 0.5.
+inline const CLI::Validator kTestLevel(
+    [](std::string& in) -> std::string {
+      double v = 0.0;
+      if (!CLI::detail::lexical_cast(in, v) || !(v >= 0.0 && v < 0.5))
+        return "must be a number >= 0 and < 0.5, got " + in;
+      return std::string();
+    },
+    "LEVEL in [0, 0.5)");
 inline const CLI::Validator kPositive = number_at_least(0.0, true);
 
 // Thrown by a command's callback to end with a given code after printing `what()`.

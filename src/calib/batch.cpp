@@ -984,9 +984,9 @@ bool noise_check_finds_less_noise(const BatchNoiseCheck& check, double level) {
   return judgeable(check, level) && check.scale < noise_check_lower_limit(check.clusters, level);
 }
 
-NoiseVerdict noise_check_verdict(const BatchNoiseCheck& check, double level) {
+NoiseVerdict noise_check_verdict(const BatchNoiseCheck& check, double level, double lower_level) {
   if (noise_check_rejects_model(check, level)) return NoiseVerdict::kMoreNoise;
-  if (noise_check_finds_less_noise(check, level)) return NoiseVerdict::kLessNoise;
+  if (noise_check_finds_less_noise(check, lower_level)) return NoiseVerdict::kLessNoise;
   return NoiseVerdict::kAgrees;
 }
 

@@ -199,21 +199,24 @@ std::string noise_check_line(const CalibrationResult& r) {
   char verdict[320] = "as the model allows: sigmas kept";
   if (r.noise_verdict == NoiseVerdict::kMoreNoise)
     std::snprintf(verdict, sizeof verdict,
-                  "more than the model allows (x%.2f or more has a 1%% chance under it): sigmas "
+                  "more than the model allows (x%.2f or more has a %g%% chance under it): sigmas "
                   "scaled by %.2f",
-                  noise_check_limit(r.noise.clusters), std::sqrt(r.noise_ratio));
+                  noise_check_limit(r.noise.clusters, r.noise_check_level),
+                  100.0 * r.noise_check_level, std::sqrt(r.noise_ratio));
   else if (r.noise_verdict == NoiseVerdict::kLessNoise && r.noise_applied)
     std::snprintf(verdict, sizeof verdict,
-                  "less than the model assumes (x%.2f or less has a 1%% chance under it): sigmas "
+                  "less than the model assumes (x%.2f or less has a %g%% chance under it): sigmas "
                   "scaled by %.2f; %s would weight the bearings so from the start",
-                  noise_check_lower_limit(r.noise.clusters), std::sqrt(r.noise_ratio),
+                  noise_check_lower_limit(r.noise.clusters, r.noise_check_lower_level),
+                  100.0 * r.noise_check_lower_level, std::sqrt(r.noise_ratio),
                   noise_check_flags(r).c_str());
   else if (r.noise_verdict == NoiseVerdict::kLessNoise)
     std::snprintf(verdict, sizeof verdict,
-                  "less than the model assumes (x%.2f or less has a 1%% chance under it): sigmas "
+                  "less than the model assumes (x%.2f or less has a %g%% chance under it): sigmas "
                   "kept, on the safe side, as %zu pieces of lines were joined (pieces left apart "
                   "hide noise from this check); %s would weight the bearings as the data say",
-                  noise_check_lower_limit(r.noise.clusters),
+                  noise_check_lower_limit(r.noise.clusters, r.noise_check_lower_level),
+                  100.0 * r.noise_check_lower_level,
                   r.refined && r.refinement.covariance_ok ? r.refinement.merges.size()
                                                           : r.filter.joins.size(),
                   noise_check_flags(r).c_str());
@@ -329,8 +332,11 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
     const BatchNoiseCheck& n = r.noise;
     json nc;
     nc["checked"] = r.noise_checked;
-    nc["applied"] = r.noise_applied;  // the check rejected the model: covariance replaced
+    nc["applied"] = r.noise_applied;  // the reported covariance is the checked one
     nc["verdict"] = verdict_name(r.noise_verdict);
+    // The levels of the verdict's sides (CalibrateOptions::noise_check_level, _lower_level).
+    nc["level_more_noise"] = r.noise_check_level;
+    nc["level_less_noise"] = r.noise_check_lower_level;
     nc["scale"] = num(n.ok ? n.scale : NAN);
     nc["tracks"] = n.clusters;
     nc["effective_bearing_sigma_deg"] = num(rad2deg(effective_bearing_sigma(r)));

@@ -600,6 +600,29 @@ TEST(WheelCheck, FindsAWrongWheelBaseAndNothingWhereTheModelIsRight) {
   EXPECT_LE(flagged, 1);
 }
 
+// Each side of the verdict at its own level: chi-square(10) / 10 has its 1% point at 0.256,
+// its 30% point at 0.727 and its 99% point at 2.321.
+TEST(NoiseCheck, VerdictSidesHaveTheirOwnLevels) {
+  EXPECT_NEAR(noise_check_lower_limit(10, 0.01), 0.2558, 1e-3);
+  EXPECT_NEAR(noise_check_lower_limit(10, 0.3), 0.7267, 1e-3);
+  EXPECT_NEAR(noise_check_limit(10, 0.01), 2.3209, 1e-3);
+  BatchNoiseCheck c;
+  c.ok = true;
+  c.clusters = 10;
+  c.scale = 0.5;
+  EXPECT_EQ(noise_check_verdict(c), NoiseVerdict::kAgrees);
+  EXPECT_EQ(noise_check_verdict(c, 0.01, 0.3), NoiseVerdict::kLessNoise);
+  EXPECT_EQ(noise_check_verdict(c, 0.01, 0.0), NoiseVerdict::kAgrees);  // 0: the side is off
+  EXPECT_EQ(noise_check_verdict(c, 0.01, 0.5), NoiseVerdict::kAgrees);  // not a test
+  c.scale = 0.2;
+  EXPECT_EQ(noise_check_verdict(c), NoiseVerdict::kLessNoise);
+  c.scale = 2.4;
+  EXPECT_EQ(noise_check_verdict(c, 0.01, 0.3), NoiseVerdict::kMoreNoise);
+  EXPECT_EQ(noise_check_verdict(c, 0.001, 0.3), NoiseVerdict::kAgrees);  // 99.9% point 2.959
+  c.clusters = 1;
+  EXPECT_EQ(noise_check_verdict(c, 0.01, 0.3), NoiseVerdict::kAgrees);
+}
+
 TEST(NoiseCheck, AgreesWithTheModelWhenTheModelIsRight) {
   const NoiseCheckStats s = noise_check_monte_carlo(0.05, 0.0, 20);
   ASSERT_EQ(s.runs, 20);
@@ -761,7 +784,7 @@ TEST(NoiseCheck, FindsBearingsLessNoisyThanAssumed) {
     scale += r.noise.scale;
     if (r.noise_verdict == NoiseVerdict::kLessNoise) {
       ++less;
-      EXPECT_LT(r.noise.scale, noise_check_lower_limit(r.noise.clusters));
+      EXPECT_LT(r.noise.scale, noise_check_lower_limit(r.noise.clusters, r.noise_check_lower_level));
       EXPECT_TRUE(r.noise_applied);
       EXPECT_NE(noise_check_line(r).find("less than the model assumes"), std::string::npos);
       EXPECT_NE(noise_check_line(r).find("sigmas scaled by"), std::string::npos);

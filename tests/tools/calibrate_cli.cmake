@@ -141,6 +141,18 @@ elseif(MODE STREQUAL "no_noise_check")
   if(NOT out MATCHES "no noise check")
     fail("stdout should say there was no noise check: ${out}")
   endif()
+  # The level of the check's "less noise" side: recorded in the summary; 0.5 is refused.
+  run_calibrate_ok(${PAPER} ${out_dir}-level --tracks ${out_dir}/tracks.csv
+                   --noise-check-lower-level 0.3)
+  string(JSON lv GET "${json}" noise_check level_less_noise)
+  string(JSON lm GET "${json}" noise_check level_more_noise)
+  if(NOT lv EQUAL 0.3 OR NOT lm EQUAL 0.01)
+    fail("summary.json noise_check levels: less ${lv}, more ${lm}")
+  endif()
+  run_calibrate(${PAPER} ${out_dir}-level2 --noise-check-lower-level 0.5)
+  if(NOT rc EQUAL 2 OR NOT err MATCHES "must be a number >= 0 and < 0.5")
+    fail("--noise-check-lower-level 0.5 must exit 2 with its range, exited ${rc}: ${err}")
+  endif()
 
 elseif(MODE STREQUAL "track_bias")
   # --track-bias-sigma: a constant bearing error per track in the models; the terminal, the

@@ -116,16 +116,18 @@ struct BatchNoiseCheck {
 // false when the check failed or has fewer than 2 tracks.
 bool noise_check_rejects_model(const BatchNoiseCheck& check, double level = 0.01);
 // Whether a check shows less noise than the model assumes: its scale below the `level`
-// quantile of chi-square(G) / G. calibrate() reports it and keeps the model's covariances:
-// the check cannot see errors that the estimate absorbs (a bias all tracks share goes into
-// the extrinsics), and shrunk by it, runs from pixels with broken tracks that were
-// overconfident already became more so (docs/calib.md, "The noise check"). false when the
-// check failed or has fewer than 2 tracks.
+// quantile of chi-square(G) / G. calibrate() shrinks the bearings' share of the covariance
+// by it only where the tracker kept its lines (CalibrateOptions::noise_check): pieces of one
+// line left apart look like independent tracks to the check, which then reads less noise
+// than there is (docs/calib.md, "The noise check"). false when the check failed, has fewer
+// than 2 tracks, or level is not in (0, 0.5).
 bool noise_check_finds_less_noise(const BatchNoiseCheck& check, double level = 0.01);
-// The two tests above together (each at `level`: under the model, "agrees" with
-// probability 1 - 2 level).
+// The two tests above together, "more noise" at `level`, "less noise" at `lower_level`
+// (under the model, "agrees" with probability 1 - level - lower_level).
 enum class NoiseVerdict { kAgrees, kMoreNoise, kLessNoise };
-NoiseVerdict noise_check_verdict(const BatchNoiseCheck& check, double level = 0.01);
+NoiseVerdict noise_check_verdict(const BatchNoiseCheck& check,
+                                 double level = 0.01,
+                                 double lower_level = 0.01);
 // Whether the wheel check shows a systematic wheel error: its chi-square(2) statistic above
 // the 1 - level quantile (0.999: 13.8). false when the check was not made.
 bool wheel_check_rejects_model(const WheelCheck& check, double level = 0.001);
