@@ -53,6 +53,7 @@ namespace {
 
 struct Stats {
   std::vector<double> pos_mm, yaw_deg, nees;
+  std::vector<double> yaw_err, yaw_z2;  // camera yaw phi + psi: error [rad], its e^2 / sigma^2
   std::vector<Eigen::Vector3d> err;
   int failures = 0;
   void add(const Extrinsics& est, const Eigen::Matrix3d& cov, const Extrinsics& truth) {
@@ -66,6 +67,9 @@ struct Stats {
     pos_mm.push_back(1e3 * (est.position() - truth.position()).norm());
     yaw_deg.push_back(std::abs(rad2deg(angle_diff(est.yaw(), truth.yaw()))));
     nees.push_back(e.dot(cov.ldlt().solve(e)));
+    const double ey = angle_diff(est.yaw(), truth.yaw());
+    yaw_err.push_back(ey);
+    yaw_z2.push_back(ey * ey / (cov(0, 0) + cov(2, 2) + 2.0 * cov(0, 2)));
   }
   Eigen::Vector3d rms() const {
     Eigen::Vector3d r = Eigen::Vector3d::Zero();
@@ -81,7 +85,7 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-void print(const char* name, const Stats& s, const Eigen::Vector3d& crlb) {
+void print(const char* name, const Stats& s, const Eigen::Vector3d& crlb, double crlb_yaw) {
   const int n = static_cast<int>(s.err.size());
   const Eigen::Vector3d rms = s.rms();
   double mean_nees = 0;
@@ -100,6 +104,15 @@ void print(const char* name, const Stats& s, const Eigen::Vector3d& crlb) {
       rms(1) / crlb(1),
       rad2deg(rms(2)),
       rms(2) / crlb(2));
+  double yaw_ms = 0.0, yaw_z2 = 0.0;
+  for (std::size_t i = 0; i < s.yaw_err.size(); ++i) {
+    yaw_ms += s.yaw_err[i] * s.yaw_err[i];
+    yaw_z2 += s.yaw_z2[i];
+  }
+  yaw_ms /= std::max(n, 1);
+  yaw_z2 /= std::max(n, 1);
+  std::printf("  camera yaw: RMS %.4f deg (%.2f x CRLB), mean e^2 / sigma^2 %.2f\n",
+              rad2deg(std::sqrt(yaw_ms)), std::sqrt(yaw_ms) / crlb_yaw, yaw_z2);
   std::printf("  mean NEES %.2f   95%% interval [%.2f, %.2f]  -> %s\n",
               mean_nees,
               lo,
@@ -355,8 +368,9 @@ int main(int argc, char** argv) {
       std::printf("refinement RMS / that bound: phi %.2f  rho %.2f  psi %.2f\n",
                   ref.rms()(0) / j(0), ref.rms()(1) / j(1), ref.rms()(2) / j(2));
   }
-  print("filter", filt, crlb);
-  if (refine) print("filter + refinement", ref, crlb);
+  const double crlb_yaw = std::sqrt(crlb_yaw_sq / runs);
+  print("filter", filt, crlb, crlb_yaw);
+  if (refine) print("filter + refinement", ref, crlb, crlb_yaw);
   if (refine && filter_joins > 0)
     std::printf("filter: %d new tracks joined to a feature, %d of them to another line\n",
                 filter_joins, filter_wrong);
@@ -371,8 +385,8 @@ int main(int argc, char** argv) {
                 "covariance changed in %d runs (filter's: %d)\n", ms / scales.size(),
                 scales[scales.size() / 4], median(scales), scales[3 * scales.size() / 4],
                 applied, filter_applied);
-    print("filter, checked", filt_checked, crlb);
-    print("refinement, checked", ref_checked, crlb);
+    print("filter, checked", filt_checked, crlb, crlb_yaw);
+    print("refinement, checked", ref_checked, crlb, crlb_yaw);
   }
   return 0;
 }
