@@ -220,13 +220,13 @@ void run_calibrate(const CalibrateArgs& a) {
   }
   for (const auto& w : warnings) spdlog::warn("{}", w);
   if (Progress::enabled()) std::fprintf(stderr, "calibrate: filter%s...\n", a.refine ? " and refinement" : "");
-  const calib::CalibrationResult result = calib::calibrate(
-      run.run,
-      opt,
-      {.refine = a.refine,
-       .noise_check = a.noise_check,
-       .noise_check_lower_level = a.noise_check_lower_level,
-       .batch = batch_options(a)});
+  const calib::CalibrationResult result =
+      calib::calibrate(run.run,
+                       opt,
+                       {.refine = a.refine,
+                        .noise_check = a.noise_check,
+                        .noise_check_lower_level = a.noise_check_lower_level,
+                        .batch = batch_options(a)});
   const auto t2 = clock::now();
   if (!result.extrinsics.vec().allFinite() || !result.covariance.allFinite())
     throw std::runtime_error(
@@ -366,7 +366,8 @@ void add_calibrate_command(CLI::App& app) {
   cmd->add_flag("!--no-noise-check", a->noise_check,
                 "Report the model's covariances as they are, without the data's check of the "
                 "bearing noise (errors summed along each track; docs/calib.md, \"The noise check\")");
-  cmd->add_option("--noise-check-lower-level", a->noise_check_lower_level,
+  cmd->add_option("--noise-check-lower-level",
+                  a->noise_check_lower_level,
                   "The noise check finds the bearings less noisy than the model assumes when "
                   "errors this small have at most this probability under the model, and then "
                   "shrinks the bearings' share of the covariance where the tracker kept its "

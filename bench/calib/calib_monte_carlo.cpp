@@ -112,7 +112,9 @@ void print(const char* name, const Stats& s, const Eigen::Vector3d& crlb, double
   yaw_ms /= std::max(n, 1);
   yaw_z2 /= std::max(n, 1);
   std::printf("  camera yaw: RMS %.4f deg (%.2f x CRLB), mean e^2 / sigma^2 %.2f\n",
-              rad2deg(std::sqrt(yaw_ms)), std::sqrt(yaw_ms) / crlb_yaw, yaw_z2);
+              rad2deg(std::sqrt(yaw_ms)),
+              std::sqrt(yaw_ms) / crlb_yaw,
+              yaw_z2);
   std::printf("  mean NEES %.2f   95%% interval [%.2f, %.2f]  -> %s\n",
               mean_nees,
               lo,
@@ -381,10 +383,15 @@ int main(int argc, char** argv) {
     double ms = 0;
     for (double v : scales) ms += v;
     std::sort(scales.begin(), scales.end());
-    std::printf("noise check (refinement's): scale mean %.3f, quartiles %.3f %.3f %.3f; "
-                "covariance changed in %d runs (filter's: %d)\n", ms / scales.size(),
-                scales[scales.size() / 4], median(scales), scales[3 * scales.size() / 4],
-                applied, filter_applied);
+    std::printf(
+        "noise check (refinement's): scale mean %.3f, quartiles %.3f %.3f %.3f; "
+        "covariance changed in %d runs (filter's: %d)\n",
+        ms / scales.size(),
+        scales[scales.size() / 4],
+        median(scales),
+        scales[3 * scales.size() / 4],
+        applied,
+        filter_applied);
     print("filter, checked", filt_checked, crlb, crlb_yaw);
     print("refinement, checked", ref_checked, crlb, crlb_yaw);
   }

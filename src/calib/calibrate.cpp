@@ -140,7 +140,8 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
     if (const double ratio = ratio_of(r.filter_noise); ratio > 0.0) {
       r.noise_checked = true;
       r.noise = r.filter_noise;
-      r.filter_noise_verdict = noise_check_verdict(r.filter_noise, co.noise_check_level, co.noise_check_lower_level);
+      r.filter_noise_verdict =
+          noise_check_verdict(r.filter_noise, co.noise_check_level, co.noise_check_lower_level);
       r.noise_verdict = r.filter_noise_verdict;
       // Applied when the check shows more noise, or less where the tracker kept its lines
       // (CalibrateOptions::noise_check).
@@ -167,7 +168,8 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
       if (const double ratio = ratio_of(r.refinement.noise); ratio > 0.0) {
         r.noise_checked = true;
         r.noise = r.refinement.noise;
-        r.noise_verdict = noise_check_verdict(r.noise, co.noise_check_level, co.noise_check_lower_level);
+        r.noise_verdict =
+            noise_check_verdict(r.noise, co.noise_check_level, co.noise_check_lower_level);
         if (r.noise_verdict == NoiseVerdict::kMoreNoise ||
             (r.noise_verdict == NoiseVerdict::kLessNoise &&
              lower_side_applies(co, r.refinement.merges.size(), r.noise))) {

@@ -198,20 +198,25 @@ std::string noise_check_line(const CalibrationResult& r) {
   if (!r.noise_checked) return {};
   char verdict[320] = "as the model allows: sigmas kept";
   if (r.noise_verdict == NoiseVerdict::kMoreNoise)
-    std::snprintf(verdict, sizeof verdict,
+    std::snprintf(verdict,
+                  sizeof verdict,
                   "more than the model allows (x%.2f or more has a %g%% chance under it): sigmas "
                   "scaled by %.2f",
                   noise_check_limit(r.noise.clusters, r.noise_check_level),
-                  100.0 * r.noise_check_level, std::sqrt(r.noise_ratio));
+                  100.0 * r.noise_check_level,
+                  std::sqrt(r.noise_ratio));
   else if (r.noise_verdict == NoiseVerdict::kLessNoise && r.noise_applied)
-    std::snprintf(verdict, sizeof verdict,
+    std::snprintf(verdict,
+                  sizeof verdict,
                   "less than the model assumes (x%.2f or less has a %g%% chance under it): sigmas "
                   "scaled by %.2f; %s would weight the bearings so from the start",
                   noise_check_lower_limit(r.noise.clusters, r.noise_check_lower_level),
-                  100.0 * r.noise_check_lower_level, std::sqrt(r.noise_ratio),
+                  100.0 * r.noise_check_lower_level,
+                  std::sqrt(r.noise_ratio),
                   noise_check_flags(r).c_str());
   else if (r.noise_verdict == NoiseVerdict::kLessNoise)
-    std::snprintf(verdict, sizeof verdict,
+    std::snprintf(verdict,
+                  sizeof verdict,
                   "less than the model assumes (x%.2f or less has a %g%% chance under it): sigmas "
                   "kept, on the safe side, as %zu pieces of lines were joined (pieces left apart "
                   "hide noise from this check); %s would weight the bearings as the data say",

@@ -784,7 +784,8 @@ TEST(NoiseCheck, FindsBearingsLessNoisyThanAssumed) {
     scale += r.noise.scale;
     if (r.noise_verdict == NoiseVerdict::kLessNoise) {
       ++less;
-      EXPECT_LT(r.noise.scale, noise_check_lower_limit(r.noise.clusters, r.noise_check_lower_level));
+      EXPECT_LT(r.noise.scale,
+                noise_check_lower_limit(r.noise.clusters, r.noise_check_lower_level));
       EXPECT_TRUE(r.noise_applied);
       EXPECT_NE(noise_check_line(r).find("less than the model assumes"), std::string::npos);
       EXPECT_NE(noise_check_line(r).find("sigmas scaled by"), std::string::npos);
