@@ -17,28 +17,29 @@ inline constexpr int kExitBadInput = 2;
 inline constexpr int kExitUndetermined = 3;
 
 // Number checks with plain messages ("--x: must be a number >= 0, got -1"); CLI11's own
-// NonNegativeNumber prints the largest double as the upper end of its range.
-inline CLI::Validator number_at_least(double low, bool strict) {
-  const std::string what = std::string(strict ? "> " : ">= ") + CLI::detail::to_string(low);
+// NonNegativeNumber prints the largest double as the upper end of its range. `what` names
+// the accepted values ("a number >= 0"), `ok` tests one.
+template <typename Ok>
+CLI::Validator number_check(const std::string& what, Ok ok, const std::string& shown) {
   return CLI::Validator(
-      [low, strict, what](std::string& in) -> std::string {
+      [what, ok](std::string& in) -> std::string {
         double v = 0.0;
-        if (!CLI::detail::lexical_cast(in, v) || !(strict ? v > low : v >= low))
-          return "must be a number " + what + ", got " + in;
+        if (!CLI::detail::lexical_cast(in, v) || !ok(v)) return "must be " + what + ", got " + in;
         return std::string();
       },
+      shown);
+}
+inline CLI::Validator number_at_least(double low, bool strict) {
+  const std::string what = std::string(strict ? "> " : ">= ") + CLI::detail::to_string(low);
+  return number_check(
+      "a number " + what,
+      [low, strict](double v) { return strict ? v > low : v >= low; },
       "NUMBER " + what);
 }
 inline const CLI::Validator kNonNegative = number_at_least(0.0, false);
 // A test's level: 0 (the test off) up to, not including, 0.5.
-inline const CLI::Validator kTestLevel(
-    [](std::string& in) -> std::string {
-      double v = 0.0;
-      if (!CLI::detail::lexical_cast(in, v) || !(v >= 0.0 && v < 0.5))
-        return "must be a number >= 0 and < 0.5, got " + in;
-      return std::string();
-    },
-    "LEVEL in [0, 0.5)");
+inline const CLI::Validator kTestLevel = number_check(
+    "a number >= 0 and < 0.5", [](double v) { return v >= 0.0 && v < 0.5; }, "LEVEL in [0, 0.5)");
 inline const CLI::Validator kPositive = number_at_least(0.0, true);
 
 // Thrown by a command's callback to end with a given code after printing `what()`.

@@ -233,6 +233,13 @@ std::string noise_check_flags(const CalibrationResult& r) {
   return out;
 }
 
+std::string noise_check_chance(double limit, const char* side, double level) {
+  char buf[96];
+  std::snprintf(
+      buf, sizeof buf, "x%.2f or %s has a %g%% chance under it", limit, side, 100.0 * level);
+  return buf;
+}
+
 std::vector<std::string> result_warnings(const CalibrationResult& r) {
   std::vector<std::string> out;
   char buf[1024];
@@ -268,11 +275,10 @@ std::vector<std::string> result_warnings(const CalibrationResult& r) {
     out.emplace_back(buf);
   }
   if (r.noise_checked && r.noise.clusters >= 2) {
-    // noise_check_rejects_model at its default level: under the model the check's scale is
-    // about chi-square(G) / G over G tracks.
+    // noise_check_rejects_model at the level the run used: under the model the check's scale
+    // is about chi-square(G) / G over G tracks.
     const int g = r.noise.clusters;
-    const double limit = noise_check_limit(g);
-    if (noise_check_rejects_model(r.noise)) {
+    if (noise_check_rejects_model(r.noise, r.noise_check_level)) {
       std::snprintf(buf, sizeof(buf), "To weight the bearings as the data say, run again with "
                     "%s", noise_check_flags(r).c_str());
       std::string remedy = buf;
@@ -280,14 +286,18 @@ std::vector<std::string> result_warnings(const CalibrationResult& r) {
         remedy += "; or add --refine, which splits tracks that slipped onto a neighbouring "
                   "line anywhere in the run (the filter splits them only in its start-up window "
                   "and then treats each as one feature, which the check sees)";
-      std::snprintf(buf, sizeof(buf),
-                    "the bearings' errors, summed along each track, are larger than the bearing "
-                    "sigma of %s allows (variance x%.2f over %d tracks; under the model "
-                    "x%.2f or more has a 1%% chance): the sigmas reported include it (noise "
-                    "check). %s",
-                    bearing_noise_text(r.bearing_sigma, r.track_bias_sigma).c_str(),
-                    r.noise.scale, g, limit,
-                    remedy.c_str());
+      std::snprintf(
+          buf,
+          sizeof(buf),
+          "the bearings' errors, summed along each track, are larger than the bearing "
+          "sigma of %s allows (variance x%.2f over %d tracks; %s): the sigmas "
+          "reported include it (noise check). %s",
+          bearing_noise_text(r.bearing_sigma, r.track_bias_sigma).c_str(),
+          r.noise.scale,
+          g,
+          noise_check_chance(noise_check_limit(g, r.noise_check_level), "more", r.noise_check_level)
+              .c_str(),
+          remedy.c_str());
       out.emplace_back(buf);
     }
   }

@@ -195,33 +195,38 @@ nlohmann::json joins_json(const std::vector<std::pair<int, int>>& joins) {
 }
 
 std::string noise_check_line(const CalibrationResult& r) {
+  const int g = r.noise.clusters;
   if (!r.noise_checked) return {};
   char verdict[320] = "as the model allows: sigmas kept";
   if (r.noise_verdict == NoiseVerdict::kMoreNoise)
-    std::snprintf(verdict,
-                  sizeof verdict,
-                  "more than the model allows (x%.2f or more has a %g%% chance under it): sigmas "
-                  "scaled by %.2f",
-                  noise_check_limit(r.noise.clusters, r.noise_check_level),
-                  100.0 * r.noise_check_level,
-                  std::sqrt(r.noise_ratio));
+    std::snprintf(
+        verdict,
+        sizeof verdict,
+        "more than the model allows (%s): sigmas scaled by %.2f",
+        noise_check_chance(noise_check_limit(g, r.noise_check_level), "more", r.noise_check_level)
+            .c_str(),
+        std::sqrt(r.noise_ratio));
   else if (r.noise_verdict == NoiseVerdict::kLessNoise && r.noise_applied)
     std::snprintf(verdict,
                   sizeof verdict,
-                  "less than the model assumes (x%.2f or less has a %g%% chance under it): sigmas "
-                  "scaled by %.2f; %s would weight the bearings so from the start",
-                  noise_check_lower_limit(r.noise.clusters, r.noise_check_lower_level),
-                  100.0 * r.noise_check_lower_level,
+                  "less than the model assumes (%s): sigmas scaled by %.2f; %s would weight the "
+                  "bearings so from the start",
+                  noise_check_chance(noise_check_lower_limit(g, r.noise_check_lower_level),
+                                     "less",
+                                     r.noise_check_lower_level)
+                      .c_str(),
                   std::sqrt(r.noise_ratio),
                   noise_check_flags(r).c_str());
   else if (r.noise_verdict == NoiseVerdict::kLessNoise)
     std::snprintf(verdict,
                   sizeof verdict,
-                  "less than the model assumes (x%.2f or less has a %g%% chance under it): sigmas "
-                  "kept, on the safe side, as %zu pieces of lines were joined (pieces left apart "
-                  "hide noise from this check); %s would weight the bearings as the data say",
-                  noise_check_lower_limit(r.noise.clusters, r.noise_check_lower_level),
-                  100.0 * r.noise_check_lower_level,
+                  "less than the model assumes (%s): sigmas kept, on the safe side, as %zu pieces "
+                  "of lines were joined (pieces left apart hide noise from this check); %s would "
+                  "weight the bearings as the data say",
+                  noise_check_chance(noise_check_lower_limit(g, r.noise_check_lower_level),
+                                     "less",
+                                     r.noise_check_lower_level)
+                      .c_str(),
                   r.refined && r.refinement.covariance_ok ? r.refinement.merges.size()
                                                           : r.filter.joins.size(),
                   noise_check_flags(r).c_str());

@@ -106,6 +106,9 @@ std::string bearing_noise_text(double bearing_sigma, double track_bias_sigma);
 // The flags that would weight the bearings as the noise check found them, e.g.
 // "--bearing-sigma 0.014" or "--bearing-sigma 0.014 --track-bias-sigma 0.012".
 std::string noise_check_flags(const CalibrationResult& result);
+// The chance of a noise check's side in words: "x0.71 or less has a 20% chance under it"
+// for the limit 0.71, side "less", level 0.2.
+std::string noise_check_chance(double limit, const char* side, double level);
 
 // Throws InputError on invalid options or input (non-finite values, repeated track ids).
 CalibrationResult calibrate(const CalibrationRun& run,
