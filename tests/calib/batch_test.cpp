@@ -448,6 +448,41 @@ TEST(PiecesOfOneLine, AreJoinedOnlyWithTheirOwnLine) {
 
 // (phi + pi, -rho, psi - pi) is the same camera pose as (phi, rho, psi): a refinement started
 // on that mirror stays there (every residual is the same), and must report rho >= 0.
+// calib::camera_yaw_from_flow: the camera yaw phi + psi from the direction the bearings flow
+// from while the robot drives (eq. 30), whatever the mounting; NaN without translation.
+TEST(WindowStarts, CameraYawFromTheBearingsFlow) {
+  for (const Trajectory trajectory : {Trajectory::kPaper, Trajectory::kZigzag}) {
+    for (const double yaw : {-2.8, -1.876, -0.6, 0.0, 1.4, 3.0}) {
+      SyntheticRunOptions o;
+      o.trajectory = trajectory;
+      o.bearing_sigma = 0.03 * kPi / 180.0;
+      o.num_features = 15;
+      o.truth = {0.7, 0.2, wrap_angle(yaw - 0.7)};
+      o.seed = 3;
+      const SyntheticRun s = make_synthetic_run(o);
+      const double flow = camera_yaw_from_flow(s.run, o.wheel_base);
+      ASSERT_TRUE(std::isfinite(flow)) << "yaw " << yaw;
+      // The bound: the window's starts are taken at the flow's yaw when it is more than 0.35
+      // rad from the prior's; off by 0.2 rad they converge (docs/calib.md, "Window starts").
+      EXPECT_LT(std::abs(wrap_angle(flow - yaw)), 0.2) << "yaw " << yaw << " flow " << flow;
+    }
+  }
+  // Turns in place only (the paper run's turn, its wheels' travel exactly opposite): the
+  // camera moves on a circle of radius rho but the robot does not drive, so the flow tells
+  // nothing.
+  SyntheticRunOptions o;
+  o.bearing_sigma = 0.03 * kPi / 180.0;
+  const SyntheticRun s = make_synthetic_run(o);
+  CalibrationRun turn;
+  for (const FrameInput& f : s.run.frames)
+    if (std::abs(f.d_right - f.d_left) > std::abs(f.d_right + f.d_left)) {
+      turn.frames.push_back(f);
+      turn.frames.back().d_left = -f.d_right;
+    }
+  ASSERT_GT(turn.frames.size(), 40u);
+  EXPECT_TRUE(std::isnan(camera_yaw_from_flow(turn, o.wheel_base)));
+}
+
 TEST(Refinement, MirroredExtrinsicsAreReportedWithPositiveRho) {
   SyntheticRunOptions so;
   so.bearing_sigma = deg2rad(0.05);

@@ -130,7 +130,9 @@ struct Options {
   int bootstrap_max_frames = 300;
   double bootstrap_depth_prior_scale = 100.0;  // window's inverse-depth prior sigma, x sigma_q
   // Starts of the window's solve (1-5): the prior, then phi moved by -0.5, +0.5, -1 and +1 rad
-  // (psi the other way), in that order; the lowest cost is kept (docs/calib.md).
+  // (psi the other way), in that order; the lowest cost is kept (docs/calib.md). Where the
+  // bearings' flow puts the camera yaw far from the prior's (camera_yaw_from_flow), the same
+  // starts are solved at the flow's camera yaw as well.
   int bootstrap_starts = 5;
   // Tracks that slipped onto a neighbouring line are split in the window's solve, with the
   // refinement's test (BatchOptions::split_chi2, which has the same default); 0: off.
