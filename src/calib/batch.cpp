@@ -1380,7 +1380,7 @@ double camera_yaw_from_flow(const CalibrationRun& run,
   // (Without 1/h, one sum over all tracks leaned by 0.27 rad on the synthetic paper run; with
   // 1/|d| instead of 1/h, by 0.25.)
   struct Pair {
-    double ds, dalpha, beta;
+    double ds, dalpha, sin_beta, cos_beta;  // beta: the pair's mid bearing
   };
   std::map<std::pair<int, int>, std::vector<Pair>> tracks;  // (track id, straight) -> pairs
   double total = 0.0;
@@ -1388,8 +1388,8 @@ double camera_yaw_from_flow(const CalibrationRun& run,
   int straight = 0;  // counts the frames that turn: a track's h is that of one straight
   std::map<int, double> previous;  // track id -> bearing in the previous frame
   for (const FrameInput& f : run.frames) {
-    const double ds = 0.5 * (f.d_right + f.d_left);
-    const double dtheta = (f.d_right - f.d_left) / wheel_base;
+    const Vec2 step = wheel_step(f.d_right, f.d_left, wheel_base);  // eq. (15)
+    const double ds = step(0), dtheta = step(1);
     if (std::abs(dtheta) * wheel_base > std::abs(ds)) ++straight;  // wheels turning, not driving
     std::map<int, double> now;
     for (const BearingObservation& o : f.observations) {
@@ -1399,7 +1399,8 @@ double camera_yaw_from_flow(const CalibrationRun& run,
       const double dbeta = wrap_angle(o.beta - it->second);
       const double dalpha = dbeta + dtheta;
       if (!std::isfinite(dalpha) || std::abs(dalpha) > 0.1) continue;  // a switch of lines
-      tracks[{o.track_id, straight}].push_back({ds, dalpha, it->second + 0.5 * dbeta});
+      const double mid = it->second + 0.5 * dbeta;
+      tracks[{o.track_id, straight}].push_back({ds, dalpha, std::sin(mid), std::cos(mid)});
       total += dalpha * dalpha;
       ++pairs;
     }
@@ -1408,11 +1409,12 @@ double camera_yaw_from_flow(const CalibrationRun& run,
   const double nan = std::numeric_limits<double>::quiet_NaN();
   if (pairs < min_pairs || !(total > 0.0)) return nan;
   auto explained = [&tracks](double yaw) {
+    const double sy = std::sin(yaw), cy = std::cos(yaw);
     double g = 0.0;
     for (const auto& [id, v] : tracks) {
       double sxy = 0.0, sxx = 0.0;
       for (const Pair& p : v) {
-        const double sx = std::sin(p.beta + yaw);
+        const double sx = p.sin_beta * cy + p.cos_beta * sy;  // sin(beta + yaw)
         const double x = p.ds * sx * std::abs(sx);
         sxy += p.dalpha * x;
         sxx += x * x;

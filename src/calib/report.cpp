@@ -195,8 +195,8 @@ nlohmann::json joins_json(const std::vector<std::pair<int, int>>& joins) {
 }
 
 std::string noise_check_line(const CalibrationResult& r) {
-  const int g = r.noise.clusters;
   if (!r.noise_checked) return {};
+  const int g = r.noise.clusters;
   char verdict[320] = "as the model allows: sigmas kept";
   if (r.noise_verdict == NoiseVerdict::kMoreNoise)
     std::snprintf(
