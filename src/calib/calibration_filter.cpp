@@ -52,10 +52,12 @@ void CalibrationFilter::process(const FrameInput& frame) {
                        " appears twice in one frame");
   }
 
-  // The bearings left out ahead (guard_before_starts), as guarded ones, after the window
-  // (whose batch problem guards the frames before a track's start itself, reject_crossings;
-  // left out there as well, corridor zigzag seed 90 at a drawn mount: a track that slipped onto
-  // a neighbouring line was no longer split, and the window ended 3 mm off, 0.04 mm sure).
+  // The bearings left out ahead (guard_before_starts), as guarded ones, after the window.
+  // In the window, only those before a track that starts after it (end_bootstrap): the
+  // window's batch problem guards the frames before the starts it sees itself
+  // (reject_crossings), and left out there as well, corridor zigzag seed 90 at a drawn mount,
+  // a track that slipped onto a neighbouring line was no longer split, and the window ended
+  // 3 mm off, 0.04 mm sure.
   if (!ahead_.empty() && !bootstrapping_) {
     FrameInput kept = frame;
     kept.observations.clear();
@@ -114,6 +116,28 @@ void CalibrationFilter::end_bootstrap(FrameEstimate rec) {
   {
     bootstrapping_ = false;
     window_frames_ = static_cast<int>(window_.frames.size());
+    // Bearings before a line whose track starts after the window (guard_before_starts): the
+    // window cannot see that line. (Drawn-mount office paper seed 36: a line's two last
+    // bearings in the window 0.09-0.12 degree off, pushed by a line 0.2-0.3 degree away whose
+    // track started two frames after the window; the filter's rho moved 1.7 mm when the
+    // first line's clean bearings came.)
+    if (!ahead_.empty()) {
+      const int first = frame_ - static_cast<int>(window_.frames.size()) + 1;
+      for (int k = 0; k < static_cast<int>(window_.frames.size()); ++k) {
+        auto& obs = window_.frames[static_cast<std::size_t>(k)].observations;
+        const auto gone = std::remove_if(obs.begin(), obs.end(), [&](const BearingObservation& o) {
+          const auto it = ahead_.find({o.track_id, first + k});
+          return it != ahead_.end() && it->second > frame_;
+        });
+        for (auto it = gone; it != obs.end(); ++it) {
+          guarded_.emplace_back(it->track_id, first + k);
+          ++ahead_count_[first + k];
+          const std::size_t h = static_cast<std::size_t>(first + k);  // history_ ends before rec
+          ++(h < history_.size() ? history_[h].num_guarded : rec.num_guarded);
+        }
+        obs.erase(gone, obs.end());
+      }
+    }
     std::string why;
     BootstrapDetails details;
     if (bootstrap_filter_state(window_, options_, &state_, &why, &details)) {
@@ -403,9 +427,9 @@ void CalibrationFilter::record_tracks() {
   }
 }
 
-std::set<std::pair<int, int>> guard_before_starts(const CalibrationRun& run,
-                                                  const Options& options) {
-  std::set<std::pair<int, int>> out;
+std::map<std::pair<int, int>, int> guard_before_starts(const CalibrationRun& run,
+                                                       const Options& options) {
+  std::map<std::pair<int, int>, int> out;
   const double guard = options.crossing_guard;
   if (!(guard > 0.0)) return out;
   std::map<int, std::map<int, double>> at;  // track id -> frame -> bearing
@@ -426,7 +450,10 @@ std::set<std::pair<int, int>> guard_before_starts(const CalibrationRun& run,
         if (const auto ai = of_a.find(it->first); ai != of_a.end())
           rate = (angle_diff(it->second, ai->second) - sep0) / (it->first - k0);
       for (auto it = of_a.lower_bound(k0 - options.max_missed_frames); it != a0; ++it)
-        if (std::abs(sep0 - rate * (k0 - it->first)) < guard) out.emplace(a, it->first);
+        if (std::abs(sep0 - rate * (k0 - it->first)) < guard) {
+          const auto [o, fresh] = out.emplace(std::make_pair(a, it->first), k0);
+          if (!fresh) o->second = std::min(o->second, k0);
+        }
     }
   }
   return out;

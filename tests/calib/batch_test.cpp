@@ -368,8 +368,8 @@ TEST(CrossingGuard, BeforeATrackStartsBesideAnother) {
   }
   Options o;
   ASSERT_NEAR(o.crossing_guard, deg2rad(0.75), 1e-12);
-  std::set<std::pair<int, int>> expected;
-  for (int k = 10; k <= 19; ++k) expected.emplace(1, k);
+  std::map<std::pair<int, int>, int> expected;  // (track, frame) -> where the other starts
+  for (int k = 10; k <= 19; ++k) expected[{1, k}] = 20;
   EXPECT_EQ(guard_before_starts(run, o), expected);
   o.crossing_guard = 0.0;  // the guard off: nothing
   EXPECT_TRUE(guard_before_starts(run, o).empty());

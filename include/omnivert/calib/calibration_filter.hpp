@@ -54,10 +54,10 @@ class CalibrationFilter {
   // One image frame. Throws InputError on non-finite wheel travel or bearings, or a track id
   // repeated within the frame.
   void process(const FrameInput& frame);
-  // Bearings (track id, frame) to leave out as guarded when their frames come: those where a
-  // line whose track starts later was beside them (guard_before_starts; a filter fed frame by
-  // frame does not know them, run_filter does).
-  void guard_ahead(std::set<std::pair<int, int>> keys) { ahead_ = std::move(keys); }
+  // Bearings (track id, frame) -> the frame where the track of the line beside them starts,
+  // to leave out as guarded (guard_before_starts; a filter fed frame by frame does not know
+  // them, run_filter does).
+  void guard_ahead(std::map<std::pair<int, int>, int> keys) { ahead_ = std::move(keys); }
   // End of the run: solves a pending bootstrap window (a run that never turned). Call once
   // after the last frame before reading the estimate.
   void finish();
@@ -121,7 +121,7 @@ class CalibrationFilter {
   CalibrationRun window_;
   double window_heading_ = 0.0;
   double window_max_turn_ = 0.0;
-  std::set<std::pair<int, int>> ahead_;  // guard_ahead
+  std::map<std::pair<int, int>, int> ahead_;  // guard_ahead
   std::map<int, int> ahead_count_;       // frame -> bearings left out ahead
 };
 
@@ -132,12 +132,13 @@ class CalibrationFilter {
 // widens each track's span by max_missed_frames). For each track b and each track a seen in
 // b's first frame k0 (and before it), the separation b - a is carried back from k0 at its
 // rate over b's first 3 frames both saw; a's bearings over the max_missed_frames frames
-// before k0 where it is within the guard are returned (track id, frame index in run).
+// before k0 where it is within the guard are returned: (track id, frame index in run) -> k0
+// (the earliest, where several lines start beside it).
 // (Drawn-mount office paper seed 14: a line 0.2-0.3 degree from another before its track
 // started pushed that one's bearings 0.12 degree off for two frames; the filter ended with
 // rho 2.2 mm off, 3 times its sigma, against the refinement's 1.1 mm.)
-std::set<std::pair<int, int>> guard_before_starts(const CalibrationRun& run,
-                                                  const Options& options);
+std::map<std::pair<int, int>, int> guard_before_starts(const CalibrationRun& run,
+                                                       const Options& options);
 
 // Runs the filter over a whole run.
 struct FilterResult {
