@@ -60,18 +60,23 @@ void CalibrationFilter::process(const FrameInput& frame) {
   // 3 mm off, 0.04 mm sure.
   if (!ahead_.empty() && !bootstrapping_) {
     FrameInput kept = frame;
-    kept.observations.clear();
-    for (const BearingObservation& o : frame.observations) {
-      if (ahead_.count({o.track_id, frame_})) {
-        guarded_.emplace_back(o.track_id, frame_);
-        ++ahead_count_[frame_];
-      } else {
-        kept.observations.push_back(o);
-      }
-    }
-    if (kept.observations.size() != frame.observations.size()) return admit(kept);
+    if (leave_out_ahead(&kept.observations, frame_, -1) > 0) return admit(kept);
   }
   admit(frame);
+}
+
+int CalibrationFilter::leave_out_ahead(std::vector<BearingObservation>* obs,
+                                       int frame,
+                                       int started_after) {
+  const auto gone = std::remove_if(obs->begin(), obs->end(), [&](const BearingObservation& o) {
+    const auto it = ahead_.find({o.track_id, frame});
+    return it != ahead_.end() && it->second > started_after;
+  });
+  const int n = static_cast<int>(obs->end() - gone);
+  for (auto it = gone; it != obs->end(); ++it) guarded_.emplace_back(it->track_id, frame);
+  obs->erase(gone, obs->end());
+  if (n > 0) ahead_count_[frame] += n;
+  return n;
 }
 
 int CalibrationFilter::guarded_ahead(int frame) const {
@@ -124,18 +129,10 @@ void CalibrationFilter::end_bootstrap(FrameEstimate rec) {
     if (!ahead_.empty()) {
       const int first = frame_ - static_cast<int>(window_.frames.size()) + 1;
       for (int k = 0; k < static_cast<int>(window_.frames.size()); ++k) {
-        auto& obs = window_.frames[static_cast<std::size_t>(k)].observations;
-        const auto gone = std::remove_if(obs.begin(), obs.end(), [&](const BearingObservation& o) {
-          const auto it = ahead_.find({o.track_id, first + k});
-          return it != ahead_.end() && it->second > frame_;
-        });
-        for (auto it = gone; it != obs.end(); ++it) {
-          guarded_.emplace_back(it->track_id, first + k);
-          ++ahead_count_[first + k];
-          const std::size_t h = static_cast<std::size_t>(first + k);  // history_ ends before rec
-          ++(h < history_.size() ? history_[h].num_guarded : rec.num_guarded);
-        }
-        obs.erase(gone, obs.end());
+        const int n = leave_out_ahead(
+            &window_.frames[static_cast<std::size_t>(k)].observations, first + k, frame_);
+        const std::size_t h = static_cast<std::size_t>(first + k);  // history_ ends before rec
+        (h < history_.size() ? history_[h].num_guarded : rec.num_guarded) += n;
       }
     }
     std::string why;

@@ -91,6 +91,10 @@ class CalibrationFilter {
  private:
   void admit(const FrameInput& frame);
   void step(const FrameInput& frame);
+  // Removes from obs (frame `frame`) the bearings guard_ahead marked before a track that
+  // starts after frame `started_after`, records them as guarded; returns how many.
+  int leave_out_ahead(std::vector<BearingObservation>* obs, int frame, int started_after);
+  // Bearings left out ahead in a frame.
   int guarded_ahead(int frame) const;
   void end_bootstrap(FrameEstimate rec);
   void record_tracks();
