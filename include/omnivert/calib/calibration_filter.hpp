@@ -11,7 +11,6 @@
 //   Extrinsics ex = filter.extrinsics();  Eigen::Matrix3d C = filter.covariance();
 
 #include <map>
-#include <set>
 #include <string>
 #include <utility>
 #include <vector>
