@@ -6,45 +6,24 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include <chrono>
-#include <cmath>
-#include <cstdlib>
 #include <cstdio>
-#include <filesystem>
 #include <memory>
 #include <optional>
-#include <set>
 #include <string>
 #include <vector>
 
-#include <spdlog/spdlog.h>
-
 #include "commands.hpp"
+#include "core/progress.hpp"
+#include "core/yaml_fields.hpp"
 #include "omnivert/calib/calibrate.hpp"
-#include "omnivert/calib/dataset_run.hpp"
-#include "omnivert/calib/report.hpp"
 #include "omnivert/core/angles.hpp"
-#include "omnivert/core/error.hpp"
-#include "omnivert/core/image_io.hpp"
-#include "omnivert/core/progress.hpp"
-#include "omnivert/core/yaml_fields.hpp"
-#include "omnivert/match/track_dataset.hpp"
-#include "omnivert/match/tracks_plot.hpp"
+#include "omnivert/pipeline/calibrate_dataset.hpp"
 #include "pipeline_options.hpp"
 #include "tracker_options.hpp"
 
 namespace omnivert::cli {
 
 namespace {
-
-// The bearing noise of our extractor on rendered images, as the calibration needs it for a
-// consistent estimate (docs/calib.md, "From pixels"): 0.025 degree once the bearings of lines
-// that cross are left out (before the crossing guard the pulled bearings needed 0.05); it is
-// the noisiest of our worlds' bearings (office), and the noise check enlarges the covariance
-// where a run's bearings are noisier. The paper's 0.3 degree is 12x looser.
-constexpr double kDefaultBearingSigmaDeg = 0.025;
-// A constant bearing error per track (calib::Options::track_bias_sigma), degrees; 0: none.
-constexpr double kDefaultTrackBiasSigmaDeg = 0.0;
 
 struct CalibrateArgs {
   std::string dataset;
@@ -86,40 +65,6 @@ void read_prior_file(const std::string& path, calib::Options* o) {
   if (auto v = yaml::optional_number(y, "odometry_inflation", path, true)) o->odometry_inflation = *v;
 }
 
-void remove_if_exists(const std::filesystem::path& p) {
-  std::error_code ec;
-  std::filesystem::remove(p, ec);
-}
-
-// --tracks: the rows of an earlier tracks.csv (`omnivert track` or `calibrate`), checked
-// against the dataset: every row's frame must be one of its images, with that image's
-// timestamp (a tracks.csv of another dataset, or of a re-recorded one, is refused by file and
-// line).
-TrackDatasetResult tracks_of_dataset(const std::string& file, const dataset::Dataset& data) {
-  TrackDatasetResult t;
-  t.rows = read_tracks_csv(file);
-  const auto& images = data.images();
-  std::set<std::int64_t> ids;
-  for (const TrackRow& r : t.rows) {
-    const int line = r.source_line;
-    if (r.frame >= static_cast<std::int64_t>(images.size()))
-      throw InputError(file, line,
-                       "frame " + std::to_string(r.frame) + " is not an image of " + data.root() +
-                           " (it has " + std::to_string(images.size()) + ")");
-    const auto& im = images[static_cast<std::size_t>(r.frame)];
-    if (r.timestamp_ns != im.timestamp_ns)
-      throw InputError(file, line,
-                       "frame " + std::to_string(r.frame) + " has timestamp " +
-                           std::to_string(r.timestamp_ns) + " but cam0/data.csv line " +
-                           std::to_string(im.line) + " has " + std::to_string(im.timestamp_ns) +
-                           ": these tracks are not of this dataset");
-    ids.insert(r.track_id);
-  }
-  t.frames = static_cast<std::int64_t>(images.size());
-  t.stats.new_tracks = static_cast<std::int64_t>(ids.size());
-  return t;
-}
-
 calib::BatchOptions batch_options(const CalibrateArgs& a) {
   calib::BatchOptions b;
   b.split_chi2 = a.split_chi2;
@@ -128,21 +73,10 @@ calib::BatchOptions batch_options(const CalibrateArgs& a) {
   return b;
 }
 
-void run_calibrate(const CalibrateArgs& a) {
-  namespace fs = std::filesystem;
-  using clock = std::chrono::steady_clock;
-  std::string why;
-  if (!a.pipeline.IsValid(&why)) throw InputError("invalid extraction options: " + why);
-
-  // Options: defaults (the paper's hand measurement, wide sigmas), then the dataset's wheel
-  // sensor, then the prior file, then the flags.
-  dataset::LoadOptions lo;
-  lo.require_wheel = true;
-  lo.allow_missing_images = true;
-  const auto data = dataset::Dataset::load(a.dataset, lo);
-  calib::Options opt = calib::options_from_dataset(data);
-  opt.bearing_sigma = deg2rad(kDefaultBearingSigmaDeg);
-  opt.track_bias_sigma = deg2rad(kDefaultTrackBiasSigmaDeg);
+// The calibration's options: the recommended preset, then the prior file, then the flags
+// (the wheel base and K come from wheel0/sensor.yaml in the pipeline).
+calib::Options calibration_options(const CalibrateArgs& a) {
+  calib::Options opt = calib::recommended_options();
   if (!a.prior_file.empty()) read_prior_file(a.prior_file, &opt);
   if (a.phi) opt.prior.phi = *a.phi;
   if (a.rho) opt.prior.rho = *a.rho;
@@ -157,179 +91,47 @@ void run_calibrate(const CalibrateArgs& a) {
   opt.join_pieces = !a.no_join;
   opt.lateral_sigma = a.lateral_sigma;
   opt.crossing_guard = deg2rad(a.crossing_guard_deg);
-  if (!opt.IsValid(&why)) throw InputError("invalid calibration options: " + why);
+  return opt;
+}
 
-  // Read before the output folder is cleared: --tracks may name DIR/tracks.csv itself.
-  std::optional<TrackDatasetResult> given_tracks;
-  if (!a.tracks_file.empty()) given_tracks = tracks_of_dataset(a.tracks_file, data);
-
-  std::error_code ec;
-  fs::create_directories(a.out, ec);
-  if (ec) throw InputError(a.out, 0, "cannot create the output folder: " + ec.message());
-  const fs::path out(a.out);
-  // A result of an earlier run must not pass for this run's.
-  for (const char* f : {"extrinsics.yaml", "summary.json", "report.html", "states.csv",
-                        "convergence.png", "tracks.csv", "tracks.png"})
-    remove_if_exists(out / f);
-
-  // 1. Tracking (Sec. 4, 9.1), or the tracks of an earlier run (--tracks).
-  const auto t0 = clock::now();
-  TrackDatasetResult tracked;
-  if (!given_tracks) {
-    TrackDatasetOptions to;
-    to.pipeline = a.pipeline;
-    to.tracker = a.tracker.options();
-    Progress bar("track", data.size());
-    tracked = track_dataset(data, to, [&](std::size_t done, std::size_t) { bar.update(done); });
-    bar.finish();
-  } else {
-    tracked = std::move(*given_tracks);
-  }
-  std::vector<std::string> warnings = tracked.warnings;
-  write_tracks_csv(out / "tracks.csv", tracked.rows);
-  write_tracks_png(out / "tracks.png", tracked.rows);
-  const auto t1 = clock::now();
-
-  // 2. The calibration's input, then the filter, observability and refinement (Sec. 8).
-  calib::DatasetRunOptions ro;
-  ro.max_wheel_gap_s = a.max_wheel_gap;
-  ro.crowded_sigma_scale = a.crowded_sigma;
-  const calib::DatasetRun run = calib::calibration_run_from_tracks(data, tracked.rows, ro);
-  warnings.insert(warnings.end(), run.warnings.begin(), run.warnings.end());
-  {
-    // Few lines: measured on the simulator's office (docs/calib.md, "Shorter lines"), about
-    // 10 tracks at the paper's 50% length gave a median camera yaw error of 0.14-0.17 degree
-    // over 50 runs; 25% lines with --refine gave 0.006 degree.
-    constexpr int kFewTracks = 15;
-    if (run.tracks < kFewTracks) {
-      std::string w = "only " + std::to_string(run.tracks) +
-                      " lines were tracked: the estimate rests on few features and may be off by "
-                      "more than its sigma";
-      if (a.pipeline.lines.threshold == LineThreshold::kFractionOfAnnulus &&
-          a.pipeline.lines.length_fraction > 0.3)
-        w += "; shorter lines help (--length-fraction 0.25 with --refine; docs/calib.md, "
-             "\"Shorter lines\")";
-      warnings.push_back(w);
-    }
-  }
-  if (given_tracks && !a.unused_with_tracks.empty()) {
+void run_calibrate(const CalibrateArgs& a) {
+  pipeline::CalibrateDatasetOptions o;
+  o.features = a.pipeline;
+  o.tracker = a.tracker.options();
+  o.calibration = calibration_options(a);
+  o.run = {.refine = a.refine,
+           .noise_check = a.noise_check,
+           .noise_check_lower_level = a.noise_check_lower_level,
+           .batch = batch_options(a)};
+  o.input.max_wheel_gap_s = a.max_wheel_gap;
+  o.input.crowded_sigma_scale = a.crowded_sigma;
+  o.tracks_file = a.tracks_file;
+  o.force = a.force;
+  o.command = command_line();
+  if (!a.tracks_file.empty() && !a.unused_with_tracks.empty()) {
     std::string list;
     for (const std::string& n : a.unused_with_tracks) list += (list.empty() ? "" : ", ") + n;
-    warnings.push_back("--tracks: the tracks are read from " + a.tracks_file + "; " + list +
-                       " (extraction and tracking options) did nothing");
+    o.notes.push_back("--tracks: the tracks are read from " + a.tracks_file + "; " + list +
+                      " (extraction and tracking options) did nothing");
   }
-  for (const auto& w : warnings) spdlog::warn("{}", w);
-  if (Progress::enabled()) std::fprintf(stderr, "calibrate: filter%s...\n", a.refine ? " and refinement" : "");
-  const calib::CalibrationResult result =
-      calib::calibrate(run.run,
-                       opt,
-                       {.refine = a.refine,
-                        .noise_check = a.noise_check,
-                        .noise_check_lower_level = a.noise_check_lower_level,
-                        .batch = batch_options(a)});
-  const auto t2 = clock::now();
-  if (!result.extrinsics.vec().allFinite() || !result.covariance.allFinite())
-    throw std::runtime_error(
-        "the calibration diverged (non-finite estimate); nothing written but tracks.csv. Check "
-        "the wheel base and K in wheel0/sensor.yaml and the tracks in tracks.png");
-  for (const std::string& w : calib::result_warnings(result)) {
-    spdlog::warn("{}", w);
-    warnings.push_back(w);
-  }
-
-  const bool observable = result.observable();
-  const bool write_extrinsics = observable || a.force;
-  const int exit_code = write_extrinsics ? 0 : kExitUndetermined;
-
-  std::optional<calib::Extrinsics> truth;
-  if (data.ground_truth() && data.ground_truth()->extrinsics) {
-    const auto& g = *data.ground_truth()->extrinsics;
-    truth = calib::Extrinsics{g.phi, g.rho, g.psi};
-  }
-
-  // 3. Outputs (each written to a temporary name and renamed: none is left partial).
-  calib::write_states_csv((out / "states.csv").string(), result.filter.history);
-  std::optional<calib::Extrinsics> refined;
-  if (result.refined && result.refinement.covariance_ok) refined = result.refinement.extrinsics;
-  write_image_atomic((out / "convergence.png").string(),
-                     calib::draw_convergence(result.filter.history, truth, refined));
-  calib::ReportInputs ri;
-  ri.dataset = a.dataset;
-  ri.command = command_line();
-  ri.frames = tracked.frames;
-  ri.frames_skipped = tracked.frames_skipped;
-  ri.detections = static_cast<std::int64_t>(tracked.rows.size());
-  ri.tracks_total = tracked.stats.new_tracks;
-  ri.run = &run;
-  ri.options = opt;
-  ri.options.bearing_sigma = result.bearing_sigma;
-  ri.truth = truth;
-  ri.force = a.force;
-  ri.exit_code = exit_code;
-  ri.seconds_tracking = std::chrono::duration<double>(t1 - t0).count();
-  ri.seconds_calibration = std::chrono::duration<double>(t2 - t1).count();
-  ri.warnings = warnings;
-  ri.wrote_extrinsics = write_extrinsics;
-  if (write_extrinsics) calib::write_extrinsics_yaml((out / "extrinsics.yaml").string(), result);
-  write_text_atomic((out / "summary.json").string(), calib::summary_json(result, ri));
-  write_text_atomic((out / "report.html").string(), calib::report_html(result, ri));
-
-  // 4. On stdout: the estimate, the verdict, the comparison with the truth when known.
-  const auto& e = result.extrinsics;
-  const auto& C = result.covariance;
-  const auto& o = result.observability;
-  std::printf("%lld frames (%lld skipped), %zu detections, %d tracks used, %d bearings; "
-              "%.2f m driven, %.0f deg turned\n",
-              static_cast<long long>(tracked.frames), static_cast<long long>(tracked.frames_skipped),
-              tracked.rows.size(), run.tracks, run.observations, run.path_length,
-              rad2deg(run.rotation));
-  std::printf("%s estimate:  phi %.3f +- %.3f deg   rho %.2f +- %.2f mm   psi %.3f +- %.3f deg\n",
-              refined ? "refined" : "filter", rad2deg(e.phi), rad2deg(std::sqrt(C(0, 0))),
-              e.rho * 1e3, std::sqrt(C(1, 1)) * 1e3, rad2deg(e.psi), rad2deg(std::sqrt(C(2, 2))));
-  const Eigen::Vector2d p = e.position();
-  std::printf("camera in the robot frame: x %.2f mm, y %.2f mm, yaw %.3f deg\n", p(0) * 1e3,
-              p(1) * 1e3, rad2deg(e.yaw()));
-  if (result.noise_checked)
-    std::printf("bearing sigma %s; %s\n",
-                calib::bearing_noise_text(result.bearing_sigma, result.track_bias_sigma).c_str(),
-                calib::noise_check_line(result).c_str());
-  else
-    std::printf("bearing sigma %s (no noise check%s)\n",
-                calib::bearing_noise_text(result.bearing_sigma, result.track_bias_sigma).c_str(),
-                a.noise_check ? ": the run does not determine the extrinsics" : "");
-  if (const std::string w = calib::wheel_check_line(result); !w.empty()) std::printf("%s\n", w.c_str());
-  if (result.refined && result.refinement.num_splits > 0)
-    std::printf("refinement: %d tracks split where they changed line (summary.json lists them)\n",
-                result.refinement.num_splits);
-  if (!result.filter.joins.empty())
-    std::printf("filter: %zu tracks joined to the line they continue after the tracker lost it\n",
-                result.filter.joins.size());
-  if (result.refined && !result.refinement.merges.empty())
-    std::printf("refinement: %zu tracks joined to the line they continue after the tracker lost "
-                "it (summary.json lists them)\n",
-                result.refinement.merges.size());
-  std::printf("Cramer-Rao bound of this run: phi %.3f deg, rho %.2f mm, psi %.3f deg\n",
-              rad2deg(o.phi.crlb), o.rho.crlb * 1e3, rad2deg(o.psi.crlb));
-  if (truth) {
-    auto show = [&](const char* name, const calib::Extrinsics& est, const Eigen::Matrix3d& cov) {
-      const auto er = calib::errors_vs_truth(est, cov, *truth);
-      std::printf("error vs ground truth (%s): phi %.3f deg, rho %.2f mm, psi %.3f deg, "
-                  "position %.2f mm, yaw %.3f deg, NEES %.2f\n",
-                  name, rad2deg(er.phi), er.rho * 1e3, rad2deg(er.psi), er.position * 1e3,
-                  rad2deg(er.yaw), er.nees);
-    };
-    show("filter", result.filter.extrinsics, result.filter.covariance);
-    if (refined) show("refinement", result.refinement.extrinsics, result.refinement.covariance);
-  }
-  std::printf("%s\n", o.message.c_str());
-  std::printf("results in %s: %sreport.html, summary.json, states.csv, convergence.png, "
-              "tracks.csv, tracks.png\n",
-              out.c_str(), write_extrinsics ? "extrinsics.yaml, " : "");
-  if (!write_extrinsics) {
+  std::optional<Progress> bar;
+  o.progress = [&](const std::string& stage, std::size_t done, std::size_t total) {
+    if (stage == "track") {
+      if (!bar) bar.emplace("track", total);
+      bar->update(done);
+      return;
+    }
+    if (bar) bar->finish();
+    if (Progress::enabled())
+      std::fprintf(stderr, "calibrate: filter%s...\n", a.refine ? " and refinement" : "");
+  };
+  const pipeline::CalibrateDatasetResult r = pipeline::calibrate_dataset(a.dataset, a.out, o);
+  std::printf("%s", r.BriefReport().c_str());
+  if (!r.wrote_extrinsics) {
     std::fprintf(stderr,
                  "omnivert: the extrinsics are not determined by this run (%s); extrinsics.yaml "
                  "not written. --force writes it anyway.\n",
-                 o.message.c_str());
+                 r.calibration.observability.message.c_str());
     throw CommandExit{kExitUndetermined};
   }
 }

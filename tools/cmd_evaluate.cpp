@@ -7,7 +7,7 @@
 
 #include "commands.hpp"
 #include "omnivert/core/error.hpp"
-#include "omnivert/core/image_io.hpp"
+#include "omnivert/image/image_io.hpp"
 #include "omnivert/dataset/dataset.hpp"
 #include "omnivert/eval/tracking_eval.hpp"
 

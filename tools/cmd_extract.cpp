@@ -10,9 +10,9 @@
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/camera_geometry.hpp"
 #include "omnivert/core/error.hpp"
-#include "omnivert/core/image_io.hpp"
+#include "omnivert/image/image_io.hpp"
 #include "omnivert/describe/feature_pipeline.hpp"
-#include "omnivert/describe/overlay.hpp"
+#include "omnivert/viz/overlay.hpp"
 #include "pipeline_options.hpp"
 
 namespace omnivert::cli {

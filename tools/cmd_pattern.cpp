@@ -9,7 +9,7 @@
 #include "commands.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
-#include "omnivert/core/image_io.hpp"
+#include "omnivert/image/image_io.hpp"
 #include "omnivert/sim/radial_pattern.hpp"
 
 namespace omnivert::cli {

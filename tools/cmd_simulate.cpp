@@ -3,7 +3,7 @@
 #include <cstdio>
 
 #include "commands.hpp"
-#include "omnivert/core/progress.hpp"
+#include "core/progress.hpp"
 #include "omnivert/sim/simulator.hpp"
 
 namespace omnivert::cli {

@@ -9,9 +9,9 @@
 #include "commands.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
-#include "omnivert/core/progress.hpp"
-#include "omnivert/match/track_dataset.hpp"
-#include "omnivert/match/tracks_plot.hpp"
+#include "core/progress.hpp"
+#include "omnivert/pipeline/track_dataset.hpp"
+#include "omnivert/viz/tracks_plot.hpp"
 #include "pipeline_options.hpp"
 #include "tracker_options.hpp"
 

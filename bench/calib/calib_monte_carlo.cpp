@@ -41,10 +41,10 @@
 #include "omnivert/calib/batch.hpp"
 #include "omnivert/calib/calibrate.hpp"
 #include "omnivert/calib/calibration_filter.hpp"
-#include "omnivert/calib/synthetic_run.hpp"
+#include "calib/synthetic_run.hpp"
 #include "omnivert/calib/updater.hpp"
 #include "omnivert/core/angles.hpp"
-#include "omnivert/core/progress.hpp"
+#include "core/progress.hpp"
 
 using namespace omnivert;
 using namespace omnivert::calib;

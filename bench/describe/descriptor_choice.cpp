@@ -1,4 +1,4 @@
-// The study behind the descriptor defaults (NOTES Sec. 3): both readings of the Gaussian
+// The study behind the descriptor defaults (docs/theory/descriptor.md): both readings of the Gaussian
 // window (vote weight / image blur) and both normalisation units (pair / half), measured by
 // nearest-neighbour matching of lines between an image and its rotated or re-lit copy.
 //
@@ -15,7 +15,7 @@
 
 #include "omnivert/core/angles.hpp"
 #include "omnivert/describe/feature_pipeline.hpp"
-#include "omnivert/describe/invariance.hpp"
+#include "omnivert/eval/invariance.hpp"
 #include "omnivert/sim/radial_pattern.hpp"
 
 using namespace omnivert;

@@ -99,7 +99,7 @@ BENCHMARK(BM_TrackerPerFrame)
 
 // The recommended rule sets with wheel data (straight driving, 3.8 cm a frame): mutual, gate,
 // same polarity and track continuity. variant 0: the link model at 1 degree with the paper's
-// F1 (the recommended set before issue 4's second round); 1: the track model at 0.8 degree
+// F1 (an earlier recommended set); 1: the track model at 0.8 degree
 // with F1 0.6 and look-back F1 0.5 (recommended now); 2: 1 + heads_only.
 void BM_TrackerRecommended(benchmark::State& state) {
   const auto seq = make_sequence(static_cast<int>(state.range(0)));

@@ -1,4 +1,4 @@
-// Rendering speed at 640x480 on one core (issue 3 target: >= 20 frames per second).
+// Rendering speed at 640x480 on one core (target: >= 20 frames per second).
 // Peers measured in the same run: the plain reference renderer (per-pixel ray casting
 // against every wall, 4 rays per pixel) and OpenCV's cv::remap of a 640x480 panorama, the
 // usual cost of unwarping one omnidirectional frame. items_per_second = frames per second.

@@ -31,7 +31,7 @@ int FeatureInitializer::initialize(int track_id,
   Eigen::Vector2d var_n;  // variances of (prior variable, beta)
   switch (options_.feature_init) {
     case FeatureInit::kNaive: {
-      // NOTES Sec. 5 "naive": far-feature approximation of eq. (27),
+      // docs/theory/filter.md "naive": far-feature approximation of eq. (27),
       // beta ~ pi - theta - phi - psi, and a fixed distance prior.
       slot.param = FeatureParam::kDistance;
       y = Eigen::Vector2d(options_.naive_distance, wrap_angle(kPi - beta - ex.phi - ex.psi));

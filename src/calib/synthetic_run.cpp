@@ -1,4 +1,4 @@
-#include "omnivert/calib/synthetic_run.hpp"
+#include "calib/synthetic_run.hpp"
 
 #include <cmath>
 #include <random>

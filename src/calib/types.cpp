@@ -75,4 +75,18 @@ bool Options::IsValid(std::string* why) const {
   return true;
 }
 
+Options recommended_options() {
+  Options o;
+  o.bearing_sigma = deg2rad(0.025);
+  o.track_bias_sigma = 0.0;
+  return o;
+}
+
+Options paper_options() {
+  Options o;
+  o.bearing_sigma = deg2rad(0.3);
+  o.odometry_inflation = 5.0;
+  return o;
+}
+
 }  // namespace omnivert::calib

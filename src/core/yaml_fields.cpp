@@ -1,4 +1,4 @@
-#include "omnivert/core/yaml_fields.hpp"
+#include "core/yaml_fields.hpp"
 
 #include <cmath>
 #include <filesystem>

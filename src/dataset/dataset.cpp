@@ -13,7 +13,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "omnivert/core/error.hpp"
-#include "omnivert/core/yaml_fields.hpp"
+#include "core/yaml_fields.hpp"
 
 namespace omnivert::dataset {
 

@@ -6,7 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "omnivert/core/angles.hpp"
-#include "omnivert/core/fast_math.hpp"
+#include "describe/fast_math.hpp"
 
 namespace omnivert {
 

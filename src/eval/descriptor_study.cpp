@@ -10,7 +10,7 @@
 #include <opencv2/line_descriptor.hpp>
 
 #include "omnivert/core/error.hpp"
-#include "omnivert/core/progress.hpp"
+#include "core/progress.hpp"
 #include "omnivert/eval/panorama.hpp"
 
 namespace omnivert {

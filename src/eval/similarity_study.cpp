@@ -73,7 +73,7 @@ SimilarityResult similarity_study(const cv::Mat& gray,
   SimilarityResult r;
   const int n = std::max(3, o.steps);
   for (int i = 0; i < n; ++i) r.bearings.push_back(wrap_angle(i * kTwoPi / n));
-  // Our descriptor at every bearing (image angle = sign * bearing, NOTES Sec. 1).
+  // Our descriptor at every bearing (image angle = sign * bearing, docs/theory/conventions.md).
   std::vector<double> angles;
   for (double b : r.bearings) angles.push_back(wrap_angle(o.bearing_sign * b));
   DescriptorExtractor ex(o.descriptor);

@@ -10,7 +10,7 @@
 #include <system_error>
 #include <unordered_map>
 
-#include "omnivert/core/image_io.hpp"
+#include "omnivert/core/file_io.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
 

@@ -7,7 +7,7 @@
 
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
-#include "omnivert/core/yaml_fields.hpp"
+#include "core/yaml_fields.hpp"
 
 namespace omnivert::sim {
 

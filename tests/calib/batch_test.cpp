@@ -13,10 +13,10 @@
 
 #include "omnivert/calib/batch.hpp"
 #include "omnivert/calib/calibrate.hpp"
-#include "omnivert/calib/report.hpp"
+#include "omnivert/pipeline/calibration_report.hpp"
 #include "omnivert/calib/calibration_filter.hpp"
 #include "omnivert/calib/model.hpp"
-#include "omnivert/calib/synthetic_run.hpp"
+#include "calib/synthetic_run.hpp"
 #include "omnivert/core/angles.hpp"
 #include "synthetic_support.hpp"
 

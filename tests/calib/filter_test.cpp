@@ -15,7 +15,7 @@
 #include "omnivert/calib/calibration_filter.hpp"
 #include "omnivert/calib/feature_initializer.hpp"
 #include "omnivert/calib/model.hpp"
-#include "omnivert/calib/synthetic_run.hpp"
+#include "calib/synthetic_run.hpp"
 #include "omnivert/calib/updater.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"

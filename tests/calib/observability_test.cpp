@@ -6,7 +6,7 @@
 
 #include "omnivert/calib/batch.hpp"
 #include "omnivert/calib/calibrate.hpp"
-#include "omnivert/calib/synthetic_run.hpp"
+#include "calib/synthetic_run.hpp"
 #include "omnivert/core/angles.hpp"
 #include "synthetic_support.hpp"
 

@@ -4,7 +4,7 @@
 #include <Eigen/Cholesky>
 
 #include "omnivert/calib/batch.hpp"
-#include "omnivert/calib/synthetic_run.hpp"
+#include "calib/synthetic_run.hpp"
 #include "omnivert/core/angles.hpp"
 
 namespace omnivert::calib::test_support {

@@ -11,7 +11,7 @@
 
 #include "omnivert/core/angles.hpp"
 #include "omnivert/describe/feature_pipeline.hpp"
-#include "omnivert/describe/invariance.hpp"
+#include "omnivert/eval/invariance.hpp"
 #include "omnivert/sim/radial_pattern.hpp"
 
 namespace omnivert {

@@ -15,7 +15,7 @@
 #include "omnivert/eval/descriptor_study.hpp"
 #include "omnivert/eval/panorama.hpp"
 #include "omnivert/eval/similarity_study.hpp"
-#include "omnivert/eval/study_plot.hpp"
+#include "omnivert/viz/plot.hpp"
 #include "omnivert/sim/radial_pattern.hpp"
 #include "omnivert/sim/simulator.hpp"
 

@@ -66,7 +66,7 @@ SyntheticRun make_run(unsigned seed, int lookalikes, float spread) {
     world.push_back(l);
   }
   // Trajectory: 10 m straight (263 frames of 3.8 cm), a 180 degree turn on the spot
-  // (60 frames), 10 m back. Paper extrinsics (Sec. 9.2 truth in NOTES Sec. 5).
+  // (60 frames), 10 m back. Paper extrinsics (Sec. 9.2 truth in docs/theory/filter.md).
   const double e = 0.5, phi = -0.34, rho = 0.23, psi = 0.33;
   double x = 0.0, y = 0.0, th = 0.0;
   std::vector<WheelIncrement> plan;

@@ -1,4 +1,4 @@
-// The edge stage allocates nothing per frame once warmed up (issue 2, deliverable 7): the
+// The edge stage allocates nothing per frame once warmed up (the steady state of a video): the
 // lookup table is built once per annulus and every buffer is reused.
 
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
 #include "omnivert/match/tracks_io.hpp"
-#include "omnivert/match/tracks_plot.hpp"
+#include "omnivert/viz/tracks_plot.hpp"
 
 #include <unistd.h>
 

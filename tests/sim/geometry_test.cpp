@@ -30,7 +30,7 @@ TEST(CameraModel, RadiusElevationRoundTripAndMonotonic) {
 }
 
 TEST(CameraModel, ProjectionFollowsTheBearingConvention) {
-  // NOTES Sec. 1: with bearing_sign +1 a point at bearing beta is drawn at
+  // docs/theory/conventions.md: with bearing_sign +1 a point at bearing beta is drawn at
   // (cx + r cos beta, cy + r sin beta); with -1 at (cx + r cos beta, cy - r sin beta).
   for (int sign : {1, -1}) {
     CatadioptricCamera cam;

@@ -1,7 +1,7 @@
-// Rendered geometry against an independent computation (issue 3 acceptance): a vertical
+// Rendered geometry against an independent computation: a vertical
 // edge at a known world position must appear at its predicted bearing within 0.05 degree.
 //
-// The prediction uses NOTES Sec. 1 directly (camera centre at rho (cos phi, sin phi) in the
+// The prediction uses docs/theory/conventions.md directly (camera centre at rho (cos phi, sin phi) in the
 // robot frame, beta = atan2(y_f - y_C, x_f - x_C) - (theta_R + phi + psi)). The measurement
 // does not use the renderer's code: it fits the edge's image angle to the rendered
 // intensities. For any anti-aliasing that integrates a footprint symmetric about the pixel
@@ -47,7 +47,7 @@ World edge_world(double edge_y) {
   return w;
 }
 
-// Predicted camera bearing of the world vertical line at (xf, yf) (NOTES Sec. 1).
+// Predicted camera bearing of the world vertical line at (xf, yf) (docs/theory/conventions.md).
 double predicted_bearing(
     double xr, double yr, double th, double phi, double rho, double psi, double xf, double yf) {
   const double xc = xr + rho * std::cos(th + phi);

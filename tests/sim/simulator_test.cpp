@@ -1,7 +1,7 @@
 // End to end: simulate, read back with the dataset reader, and check the ground truth is
 // self-consistent: the wheel travel integrated with eq. (14)-(15) reproduces
 // ground_truth/poses.csv, the lines' bearings follow from the edges, the poses and the
-// extrinsics (NOTES Sec. 1), runs are reproducible, and no partial dataset is left behind.
+// extrinsics (docs/theory/conventions.md), runs are reproducible, and no partial dataset is left behind.
 
 #include <unistd.h>
 
@@ -16,7 +16,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "omnivert/calib/batch.hpp"
-#include "omnivert/calib/dataset_run.hpp"
+#include "omnivert/pipeline/calibration_input.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
 #include "omnivert/dataset/dataset.hpp"

@@ -1,4 +1,4 @@
-# omnivert calibrate through the CLI (issue 5): the main job end to end on the paper's
+# omnivert calibrate through the CLI: the main job end to end on the paper's
 # simulated experiment, the observability verdict of a straight-only run (exit 3, --force),
 # and bad wheel data / too few lines (clear error or warning, never a NaN in any output).
 #   cmake -DOV=<omnivert> -DPAPER=<paper dataset> -DSTRAIGHT=<straight dataset>

@@ -1,4 +1,4 @@
-# omnivert track / evaluate through the CLI on a tiny simulated dataset (issue 4 acceptance:
+# omnivert track / evaluate through the CLI on a tiny simulated dataset (the acceptance:
 # a corrupt or missing image in the middle warns and tracking continues; a frame with no lines;
 # an empty dataset is a clear error). Usage:
 #   cmake -DOV=<omnivert> -DSRC=<12-frame dataset> -DWORK=<scratch dir> -DMODE=<mode> -P track_cli.cmake

@@ -1,5 +1,5 @@
 #pragma once
-// How a new track enters the state (the paper leaves it open; NOTES Sec. 5 shows it decides
+// How a new track enters the state (the paper leaves it open; docs/theory/filter.md shows it decides
 // the outcome). Both methods are a stochastic augmentation y = g(x_ext, beta, prior): the
 // new block gets P_yy = G_x P_xx G_x^T + G_n N G_n^T and P_yx = G_x P_x., so it is correlated
 // with the extrinsics it was computed from.

@@ -81,7 +81,7 @@ double predict_bearing_inverse(double q,
                                Row5* J_beta_x = nullptr);
 
 // The same bearing from plain geometry: the robot at pose (x_R, y_R, theta_R), a feature at
-// world point f: beta = atan2(y_f - y_C, x_f - x_C) - (theta_R + phi + psi) (NOTES Sec. 1).
+// world point f: beta = atan2(y_f - y_C, x_f - x_C) - (theta_R + phi + psi) (docs/theory/conventions.md).
 double bearing_from_geometry(const Eigen::Vector3d& robot_pose,
                              const Vec2& feature,
                              const Extrinsics& ex);

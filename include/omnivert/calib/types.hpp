@@ -1,7 +1,7 @@
 #pragma once
 // Inputs and options of the camera-to-odometry self-calibration (paper Sec. 7-8).
 //
-// Conventions (NOTES Sec. 1): robot frame x forward, y left, z up; the camera centre is at
+// Conventions (docs/theory/conventions.md): robot frame x forward, y left, z up; the camera centre is at
 // rho (cos phi, sin phi) in the robot frame and the camera x-axis is rotated by phi + psi
 // from the robot x-axis, so T_base_cam = [Rz(phi + psi) | (rho cos phi, rho sin phi, 0)].
 // A bearing beta is counter-clockwise from the camera x-axis, in radians.
@@ -63,7 +63,7 @@ struct CalibrationRun {
 
 // How a new feature enters the filter state.
 enum class FeatureInit {
-  // The "naive" initialisation of NOTES Sec. 5: D from a fixed prior (D0 +- sigma_D0),
+  // The "naive" initialisation of docs/theory/filter.md: D from a fixed prior (D0 +- sigma_D0),
   // theta from the far-feature approximation beta ~ pi - theta - phi - psi (eq. 25).
   kNaive,
   // Undelayed inverse-distance initialisation (Civera, Davison, Montiel 2008, adapted to the
@@ -168,5 +168,12 @@ struct Options {
   // True when usable; otherwise false with the reason in *why (may be null).
   bool IsValid(std::string* why) const;
 };
+
+// Presets. recommended_options(): the defaults of `omnivert calibrate` and of
+// pipeline::calibrate_dataset: Options{} with the bearing sigma our extractor has on rendered
+// images (0.025 degree; docs/theory/filter.md). paper_options(): Sec. 8.2 as published, bearing
+// sigma 0.3 degree and the Chong-Kleeman K inflated five-fold.
+Options recommended_options();
+Options paper_options();
 
 }  // namespace omnivert::calib

@@ -1,6 +1,6 @@
 #pragma once
 // Angle helpers. Every difference of two angles in omnivert (innovations, matching gates,
-// bearing errors) goes through wrap_angle (NOTES Sec. 1): bearings are circular.
+// bearing errors) goes through wrap_angle (docs/theory/conventions.md): bearings are circular.
 
 #include <cmath>
 #include <numbers>

@@ -1,9 +1,9 @@
 #pragma once
 // The image-side geometry of a catadioptric camera with a vertical mirror axis, as read from
 // cam0/sensor.yaml: image size, mirror centre, valid annulus R_min..R_max (Sec. 2) and the
-// sign that turns an image angle into a camera bearing (NOTES Sec. 1).
+// sign that turns an image angle into a camera bearing (docs/theory/conventions.md).
 //
-// Conventions (NOTES Sec. 1): pixel (u right, v down); image angle a = atan2(v - cy, u - cx);
+// Conventions (docs/theory/conventions.md): pixel (u right, v down); image angle a = atan2(v - cy, u - cx);
 // camera bearing beta = bearing_sign * a, wrapped to (-pi, pi].
 
 #include <optional>
@@ -24,7 +24,7 @@ struct CameraGeometry {
   // +1: beta = a; -1: beta = -a (mirror-flipped image).
   int bearing_sign = 1;
 
-  // Camera bearing of an image angle (NOTES Sec. 1).
+  // Camera bearing of an image angle (docs/theory/conventions.md).
   double bearing_of_image_angle(double a) const;
   // Image angle of a camera bearing (inverse of the above).
   double image_angle_of_bearing(double beta) const;

@@ -2,7 +2,7 @@
 // The rotation-invariant descriptor of a radial line (Sec. 3).
 //
 // Three circular areas of radius r_a = (R_max - R_min)/6 sit on the line at radii
-// R_min + r_a, R_min + 3 r_a, R_min + 5 r_a (they touch and cover the annulus; NOTES Sec. 3).
+// R_min + r_a, R_min + 3 r_a, R_min + 5 r_a (they touch and cover the annulus; docs/theory/descriptor.md).
 // In each area the gradient orientation of every pixel is taken relative to the line's image
 // angle theta (Sec. 3.1: rotation invariance), and the pixel votes, with its gradient
 // magnitude, into the orientation histogram of its side of the line (Sec. 3.2: left/right
@@ -13,7 +13,7 @@
 // Illumination (Sec. 3.3): each histogram unit is scaled to unit length, every bin clipped
 // at 0.1, and the unit renormalised.
 //
-// Two readings of the paper are options (NOTES Sec. 3):
+// Two readings of the paper are options (docs/theory/descriptor.md):
 // - smoothing: "smooth each area with a Gaussian window, sigma_G = r_a/3" as a Gaussian
 //   weight on each vote by its distance from the area centre (kGaussianWeight) or as a
 //   Gaussian blur of the image before the gradients (kGaussianBlur);
@@ -29,8 +29,8 @@
 #include <opencv2/core.hpp>
 
 #include "omnivert/describe/frame_features.hpp"
-#include "omnivert/extract/mirror_circle.hpp"
-#include "omnivert/extract/vertical_line.hpp"
+#include "omnivert/core/mirror_circle.hpp"
+#include "omnivert/core/vertical_line.hpp"
 
 namespace omnivert {
 

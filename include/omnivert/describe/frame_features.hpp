@@ -7,8 +7,8 @@
 
 #include <Eigen/Core>
 
-#include "omnivert/extract/mirror_circle.hpp"
-#include "omnivert/extract/vertical_line.hpp"
+#include "omnivert/core/mirror_circle.hpp"
+#include "omnivert/core/vertical_line.hpp"
 
 namespace omnivert {
 

@@ -2,7 +2,7 @@
 // The cylindrical panorama of a catadioptric image (the paper's Fig. 10) and the rectangular
 // patterns that SSD and ZNCC compare in Sec. 5.
 //
-// Geometry (NOTES Sec. 1): column c holds camera bearing beta = 2 pi c / width (c = 0 is
+// Geometry (docs/theory/conventions.md): column c holds camera bearing beta = 2 pi c / width (c = 0 is
 // bearing 0, bearings grow with c); the image angle is a = bearing_sign * beta. Row i holds
 // radius r = r_max - i (r_max - r_min) / (rows - 1): the rim (highest elevation for the usual
 // mirror) on top, the camera's reflection at the bottom. Each panorama pixel is the bilinear
@@ -10,7 +10,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "omnivert/extract/mirror_circle.hpp"
+#include "omnivert/core/mirror_circle.hpp"
 
 namespace omnivert {
 

@@ -3,7 +3,7 @@
 //
 // Step 2: Sobel gradients, eq. (1). A pixel is an edge pixel of a radial line if its
 //   gradient magnitude passes a threshold and its gradient is within +-5 degrees of the
-//   tangential direction (NOTES Sec. 2: the paper's "looks towards the centre" read
+//   tangential direction (docs/theory/extraction.md: the paper's "looks towards the centre" read
 //   literally is wrong for radial edges; it is the edge direction that points at the centre).
 //   The test is a dot product against the radial unit vector: no atan2 per pixel.
 // Step 3: edge thinning by non-maximum suppression along the gradient, with a sub-pixel
@@ -28,8 +28,8 @@
 
 #include <opencv2/core.hpp>
 
-#include "omnivert/extract/mirror_circle.hpp"
-#include "omnivert/extract/vertical_line.hpp"
+#include "omnivert/core/mirror_circle.hpp"
+#include "omnivert/core/vertical_line.hpp"
 
 namespace omnivert {
 

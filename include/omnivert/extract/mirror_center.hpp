@@ -19,7 +19,7 @@
 #include <opencv2/core.hpp>
 
 #include "omnivert/core/camera_geometry.hpp"
-#include "omnivert/extract/mirror_circle.hpp"
+#include "omnivert/core/mirror_circle.hpp"
 
 namespace omnivert {
 

@@ -2,7 +2,7 @@
 // A gate on the bearing change of a static world vertical line between two frames, from the
 // wheel travel alone: no extrinsics needed (docs/tracking.md, "Odometry gate").
 //
-// Bearing model, eqs. (16)-(17) (NOTES Sec. 1):
+// Bearing model, eqs. (16)-(17) (docs/theory/conventions.md):
 //   beta = atan2(y_f - y_C, x_f - x_C) - (theta_R + phi + psi).
 // Between two frames the camera yaw theta_R + phi + psi changes by exactly the robot rotation
 // d_theta (the camera is rigid on the robot), whatever phi and psi are. The world direction

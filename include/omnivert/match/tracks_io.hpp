@@ -6,7 +6,7 @@
 //   frame          0-based image index in the dataset (cam0/data.csv order)
 //   timestamp_ns   image timestamp
 //   track_id       stable integer id, 0, 1, 2, ... in order of creation
-//   bearing_rad    camera bearing beta in (-pi, pi] (NOTES Sec. 1)
+//   bearing_rad    camera bearing beta in (-pi, pi] (docs/theory/conventions.md)
 //   image_angle_rad, edge_pixels, r_inner, r_outer   the detection (extract/vertical_line.hpp)
 //   matched_frame  frame of the observation this one was matched to; -1 starts a new track
 //   distance       descriptor distance of that match (eq. 6); 0 for a new track

@@ -8,7 +8,7 @@
 // at radius
 //     r(el) = gamma * cos(el) / (xi - sin(el))
 // from the mirror centre (cx, cy), at image angle a = bearing_sign * beta:
-//     (u, v) = (cx + r cos a, cy + r sin a)            (NOTES Sec. 1)
+//     (u, v) = (cx + r cos a, cy + r sin a)            (docs/theory/conventions.md)
 // This is the unified model with its optical axis pointing down along the mirror axis
 // (z_m = -z), unit-sphere point (cos el cos beta, cos el sin beta, -sin el), projected with
 // m = (x_s, y_s) / (z_s + xi) and u = gamma * m + c. The self-reflection of the camera is at
@@ -37,7 +37,7 @@ struct CatadioptricCamera {
   double gamma = 130.0;  // generalised focal length [px]
   double r_min = 60.0;   // valid annulus [px]
   double r_max = 215.0;
-  int bearing_sign = 1;  // +1: a = beta; -1: a = -beta (NOTES Sec. 1)
+  int bearing_sign = 1;  // +1: a = beta; -1: a = -beta (docs/theory/conventions.md)
 
   // Radius [px] of the elevation el [rad]; el must lie in the valid domain.
   double radius_of_elevation(double el) const;

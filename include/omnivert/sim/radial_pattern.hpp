@@ -13,7 +13,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "omnivert/extract/mirror_circle.hpp"
+#include "omnivert/core/mirror_circle.hpp"
 
 namespace omnivert::sim {
 

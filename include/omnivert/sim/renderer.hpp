@@ -25,7 +25,7 @@
 namespace omnivert::sim {
 
 // The camera's pose in the world: centre (x, y) [m], height above the floor [m], and the
-// heading of the camera x-axis [rad] (theta_R + phi + psi, NOTES Sec. 1).
+// heading of the camera x-axis [rad] (theta_R + phi + psi, docs/theory/conventions.md).
 struct CameraPose {
   double x = 0, y = 0, yaw = 0;
   double height = 0.9;

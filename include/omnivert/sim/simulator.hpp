@@ -22,7 +22,7 @@
 
 namespace omnivert::sim {
 
-// Camera-to-odometry extrinsics (NOTES Sec. 1, Fig. 19): camera centre at
+// Camera-to-odometry extrinsics (docs/theory/conventions.md, Fig. 19): camera centre at
 // rho (cos phi, sin phi) in the robot frame, camera x-axis at phi + psi from the robot x-axis.
 // Defaults: the paper's estimates (Sec. 9.2).
 struct Extrinsics {
@@ -45,7 +45,7 @@ struct SimConfig {
   double min_line_px = 2.0;    // ground-truth lines shorter than this (radially) are left out
 };
 
-// The camera pose for a robot pose (NOTES Sec. 1).
+// The camera pose for a robot pose (docs/theory/conventions.md).
 CameraPose camera_pose(const Pose2& robot, const Extrinsics& x, double camera_height);
 
 // Empty if the robot centre keeps `clearance` from every wall over [0, t_end] (sampled every

@@ -1,4 +1,4 @@
-#include "omnivert/describe/overlay.hpp"
+#include "omnivert/viz/overlay.hpp"
 
 #include <cmath>
 #include <string>

@@ -1,4 +1,4 @@
-#include "omnivert/describe/invariance.hpp"
+#include "omnivert/eval/invariance.hpp"
 
 #include <cmath>
 #include <limits>

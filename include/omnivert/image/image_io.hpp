@@ -5,6 +5,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "omnivert/core/file_io.hpp"  // write_text_atomic
+
 namespace omnivert {
 
 // Reads an image file as it is stored (any depth, any channels). Throws InputError naming the
@@ -15,8 +17,5 @@ cv::Mat read_image(const std::string& path);
 // interrupted write never leaves a partial file under the final name. Throws InputError for
 // an unsupported extension or a folder that cannot be written.
 void write_image_atomic(const std::string& path, const cv::Mat& image);
-
-// Writes a text file atomically, as above.
-void write_text_atomic(const std::string& path, const std::string& text);
 
 }  // namespace omnivert

@@ -1,4 +1,4 @@
-#include "omnivert/match/tracks_plot.hpp"
+#include "omnivert/viz/tracks_plot.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "omnivert/core/image_io.hpp"
+#include "omnivert/image/image_io.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
 

@@ -1,4 +1,4 @@
-#include "omnivert/calib/dataset_run.hpp"
+#include "omnivert/pipeline/calibration_input.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,7 @@
-#include "omnivert/match/track_dataset.hpp"
+#include "omnivert/pipeline/track_dataset.hpp"
+
+#include <set>
+#include <string>
 
 #include "omnivert/core/error.hpp"
 
@@ -66,6 +69,31 @@ TrackDatasetResult track_dataset(const dataset::Dataset& data,
   }
   out.stats = tracker.stats();
   return out;
+}
+
+TrackDatasetResult read_tracks_for_dataset(const std::string& file, const dataset::Dataset& data) {
+  TrackDatasetResult t;
+  t.rows = read_tracks_csv(file);
+  const auto& images = data.images();
+  std::set<std::int64_t> ids;
+  for (const TrackRow& r : t.rows) {
+    const int line = r.source_line;
+    if (r.frame >= static_cast<std::int64_t>(images.size()))
+      throw InputError(file, line,
+                       "frame " + std::to_string(r.frame) + " is not an image of " + data.root() +
+                           " (it has " + std::to_string(images.size()) + ")");
+    const auto& im = images[static_cast<std::size_t>(r.frame)];
+    if (r.timestamp_ns != im.timestamp_ns)
+      throw InputError(file, line,
+                       "frame " + std::to_string(r.frame) + " has timestamp " +
+                           std::to_string(r.timestamp_ns) + " but cam0/data.csv line " +
+                           std::to_string(im.line) + " has " + std::to_string(im.timestamp_ns) +
+                           ": these tracks are not of this dataset");
+    ids.insert(r.track_id);
+  }
+  t.frames = static_cast<std::int64_t>(images.size());
+  t.stats.new_tracks = static_cast<std::int64_t>(ids.size());
+  return t;
 }
 
 }  // namespace omnivert

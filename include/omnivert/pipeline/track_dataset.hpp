@@ -43,4 +43,10 @@ TrackDatasetResult track_dataset(const dataset::Dataset& data,
                                  const std::function<void(std::size_t, std::size_t)>& progress = {},
                                  bool keep_features = false);
 
+// The rows of an earlier tracks.csv (`omnivert track` or `calibrate`), checked against the
+// dataset: every row's frame must be one of its images, with that image's timestamp. A
+// tracks.csv of another dataset, or of a re-recorded one, is an InputError naming the file
+// and line.
+TrackDatasetResult read_tracks_for_dataset(const std::string& file, const dataset::Dataset& data);
+
 }  // namespace omnivert

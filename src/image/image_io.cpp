@@ -1,4 +1,4 @@
-#include "omnivert/core/image_io.hpp"
+#include "omnivert/image/image_io.hpp"
 
 #include <filesystem>
 #include <fstream>
@@ -64,23 +64,5 @@ void write_image_atomic(const std::string& path, const cv::Mat& image) {
   }
 }
 
-void write_text_atomic(const std::string& path, const std::string& text) {
-  const fs::path p(path);
-  const fs::path tmp = temp_sibling(p);
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw InputError(path, 0, "cannot write (does the folder exist and is it writable?)");
-    out << text;
-    out.flush();
-    if (!out) {
-      std::error_code ec;
-      fs::remove(tmp, ec);
-      throw InputError(path, 0, "write failed (disk full?)");
-    }
-  }
-  std::error_code ec;
-  fs::rename(tmp, p, ec);
-  if (ec) throw InputError(path, 0, "cannot write: " + ec.message());
-}
 
 }  // namespace omnivert

@@ -6,9 +6,9 @@ namespace omnivert {
 
 struct VerticalLine {
   // Image angle of the radial line, a = atan2(v - cy, u - cx), refined below the 0.5 degree
-  // sector (NOTES Sec. 2), in (-pi, pi].
+  // sector (docs/theory/extraction.md), in (-pi, pi].
   double image_angle = 0.0;
-  // Camera bearing, beta = bearing_sign * a (NOTES Sec. 1), in (-pi, pi].
+  // Camera bearing, beta = bearing_sign * a (docs/theory/conventions.md), in (-pi, pi].
   double bearing = 0.0;
   // Length of the line in pixels: the radial extent covered by its edge pixels (short gaps
   // bridged); the paper thresholds it at 50% of R_max - R_min (Sec. 2).

@@ -3,7 +3,7 @@
 // differential-drive robot drives a trajectory, the wheel encoders report the travel with
 // Chong-Kleeman noise (eq. 31), and the camera reports bearings of vertical lines (point
 // features in the plane) with Gaussian noise. Poses follow eq. (14) exactly, bearings
-// follow beta = atan2(y_f - y_C, x_f - x_C) - (theta_R + phi + psi) (NOTES Sec. 1).
+// follow beta = atan2(y_f - y_C, x_f - x_C) - (theta_R + phi + psi) (docs/theory/conventions.md).
 // (Images are the simulator's business, src/sim; this works on bearings only.)
 
 #include <cstdint>

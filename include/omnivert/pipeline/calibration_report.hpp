@@ -12,10 +12,9 @@
 #include <string>
 #include <vector>
 
-#include <opencv2/core.hpp>
 
 #include "omnivert/calib/calibrate.hpp"
-#include "omnivert/calib/dataset_run.hpp"
+#include "omnivert/pipeline/calibration_input.hpp"
 
 namespace omnivert::calib {
 
@@ -30,13 +29,6 @@ struct ErrorsVsTruth {
 ErrorsVsTruth errors_vs_truth(const Extrinsics& estimate,
                               const Eigen::Matrix3d& covariance,
                               const Extrinsics& truth);
-
-// Fig. 25: two rows of three plots (phi [deg], rho [mm], psi [deg]; their sigmas), against
-// the frame number, with +-3 sigma dashed around the estimate, the truth and the refined
-// value (when given) as horizontal lines.
-cv::Mat draw_convergence(const std::vector<FrameEstimate>& history,
-                         const std::optional<Extrinsics>& truth = std::nullopt,
-                         const std::optional<Extrinsics>& refined = std::nullopt);
 
 // Everything the report shows, gathered by the caller.
 struct ReportInputs {

@@ -1,4 +1,4 @@
-#include "omnivert/eval/study_plot.hpp"
+#include "omnivert/viz/plot.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,0 +1,75 @@
+#pragma once
+// The main job as one library call: a dataset folder in, the camera-to-odometry extrinsics
+// and every output file out. `omnivert calibrate` is a thin layer over it.
+//
+//   1. the lines of every image tracked (paper Sec. 2-4, 9.1), or an earlier tracks.csv read;
+//   2. the calibration's input: bearings per track and frame, wheel increments (eq. 14-15);
+//   3. the filter (Sec. 8.2), observability (Sec. 8.1), the optional refinement and the checks
+//      (calib::calibrate);
+//   4. the outputs, each written atomically into `out_dir`: tracks.csv, tracks.png, states.csv,
+//      convergence.png (Fig. 25), summary.json, report.html, and extrinsics.yaml when the run
+//      determines the extrinsics (or `force`). docs/outputs.md describes every field.
+//
+// Bad input (a missing or malformed dataset, tracks of another dataset, invalid options)
+// throws InputError naming the file, line and problem; nothing of an earlier run is left in
+// `out_dir` to pass for this run's.
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "omnivert/calib/calibrate.hpp"
+#include "omnivert/describe/feature_pipeline.hpp"
+#include "omnivert/match/tracker.hpp"
+#include "omnivert/pipeline/calibration_input.hpp"
+#include "omnivert/pipeline/track_dataset.hpp"
+
+namespace omnivert::pipeline {
+
+struct CalibrateDatasetOptions {
+  FeaturePipelineOptions features;  // extraction and descriptor (Sec. 2-3)
+  // The tracker; its odometry gate takes the wheel base of wheel0/sensor.yaml.
+  TrackerOptions tracker = recommended_tracker_options(0.0);
+  // Prior and models. The wheel base and Chong-Kleeman K come from wheel0/sensor.yaml
+  // (calib::options_from_dataset); everything else from here.
+  calib::Options calibration = calib::recommended_options();
+  calib::CalibrateOptions run;          // refinement, noise check, batch options
+  calib::DatasetRunOptions input;       // wheel gaps, crowded lines
+  std::string tracks_file;              // non-empty: calibrate from this earlier tracks.csv
+  bool force = false;                   // write extrinsics.yaml even when undetermined
+  std::string command;                  // the command line, recorded in the report
+  std::vector<std::string> notes;       // extra warnings of the caller, reported with the rest
+  // Called while tracking (stage "track", frames done, frames in all) and once before the
+  // calibration (stage "calibrate", 0, 0).
+  std::function<void(const std::string& stage, std::size_t done, std::size_t total)> progress;
+};
+
+struct CalibrateDatasetResult {
+  calib::CalibrationResult calibration;
+  calib::DatasetRun input;                  // what the estimator was given
+  std::int64_t frames = 0, frames_skipped = 0, detections = 0;
+  std::optional<calib::Extrinsics> truth;   // ground_truth/extrinsics.yaml, when present
+  std::vector<std::string> warnings;        // tracking's, the input's and the estimate's
+  bool wrote_extrinsics = false;            // determined, or forced
+  std::string out_dir;
+  bool noise_check_requested = true;        // CalibrateOptions::noise_check of the run
+
+  // The answer: the refinement's estimate when it ran and its covariance is usable, else the
+  // filter's (the same as calibration.extrinsics / calibration.covariance).
+  const calib::Extrinsics& extrinsics() const { return calibration.extrinsics; }
+  // A few lines for a terminal: counts, the estimate with sigmas, the camera pose, the noise
+  // and wheel checks, splits and joins, the Cramer-Rao bound, errors against the truth when
+  // known, the observability verdict and where the files are.
+  std::string BriefReport() const;
+};
+
+// Runs the main job on the dataset folder `dataset_dir`, writing into `out_dir` (created when
+// missing). Throws InputError for bad input and std::runtime_error when the estimate is not
+// finite (only tracks.csv and tracks.png are then written).
+CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir, const std::string& out_dir,
+                                         const CalibrateDatasetOptions& options = {});
+
+}  // namespace omnivert::pipeline

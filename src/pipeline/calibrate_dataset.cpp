@@ -1,0 +1,223 @@
+#include "omnivert/pipeline/calibrate_dataset.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
+#include <utility>
+
+#include <spdlog/spdlog.h>
+
+#include "omnivert/calib/calibrate.hpp"
+#include "omnivert/core/angles.hpp"
+#include "omnivert/core/error.hpp"
+#include "omnivert/core/file_io.hpp"
+#include "omnivert/image/image_io.hpp"
+#include "omnivert/pipeline/calibration_report.hpp"
+#include "omnivert/viz/convergence_plot.hpp"
+#include "omnivert/viz/tracks_plot.hpp"
+
+namespace omnivert::pipeline {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+// Fewer tracks than this: the estimate rests on few features. Measured on the simulator's
+// office (docs/theory/association.md): about 10 tracks at the paper's 50% length gave a median
+// camera yaw error of 0.14-0.17 degree over 50 runs; 25% lines with the refinement 0.006.
+constexpr int kFewTracks = 15;
+
+// The output files of a run; those of an earlier run are removed first, so that none of them
+// passes for this run's.
+constexpr const char* kOutputs[] = {"extrinsics.yaml", "summary.json", "report.html",
+                                    "states.csv",      "convergence.png", "tracks.csv",
+                                    "tracks.png"};
+
+std::string few_tracks_warning(int tracks, const FeaturePipelineOptions& features) {
+  std::string w = "only " + std::to_string(tracks) +
+                  " lines were tracked: the estimate rests on few features and may be off by "
+                  "more than its sigma";
+  if (features.lines.threshold == LineThreshold::kFractionOfAnnulus &&
+      features.lines.length_fraction > 0.3)
+    w += "; shorter lines help (--length-fraction 0.25 with --refine; docs/calib.md, "
+         "\"Shorter lines\")";
+  return w;
+}
+
+// Step 1: the tracks, of the images or of an earlier tracks.csv.
+TrackDatasetResult tracks_of(const dataset::Dataset& data, const CalibrateDatasetOptions& o,
+                             std::optional<TrackDatasetResult> given) {
+  if (given) return std::move(*given);
+  TrackDatasetOptions to;
+  to.pipeline = o.features;
+  to.tracker = o.tracker;
+  return track_dataset(data, to, [&](std::size_t done, std::size_t total) {
+    if (o.progress) o.progress("track", done, total);
+  });
+}
+
+void prepare_out_dir(const std::string& out_dir) {
+  std::error_code ec;
+  fs::create_directories(out_dir, ec);
+  if (ec) throw InputError(out_dir, 0, "cannot create the output folder: " + ec.message());
+  for (const char* f : kOutputs) fs::remove(fs::path(out_dir) / f, ec);
+}
+
+}  // namespace
+
+CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir, const std::string& out_dir,
+                                         const CalibrateDatasetOptions& o) {
+  std::string why;
+  if (!o.features.IsValid(&why)) throw InputError("invalid extraction options: " + why);
+  dataset::LoadOptions lo;
+  lo.require_wheel = true;
+  lo.allow_missing_images = true;
+  const auto data = dataset::Dataset::load(dataset_dir, lo);
+  const calib::Options opt = calib::options_from_dataset(data, o.calibration);
+  if (!opt.IsValid(&why)) throw InputError("invalid calibration options: " + why);
+
+  // Read before the output folder is cleared: the tracks file may be out_dir/tracks.csv.
+  std::optional<TrackDatasetResult> given;
+  if (!o.tracks_file.empty()) given = read_tracks_for_dataset(o.tracks_file, data);
+  prepare_out_dir(out_dir);
+  const fs::path out(out_dir);
+
+  CalibrateDatasetResult r;
+  r.out_dir = out_dir;
+  r.noise_check_requested = o.run.noise_check;
+  const auto t0 = Clock::now();
+  const TrackDatasetResult tracked = tracks_of(data, o, std::move(given));
+  r.warnings = tracked.warnings;
+  write_tracks_csv(out / "tracks.csv", tracked.rows);
+  write_tracks_png(out / "tracks.png", tracked.rows);
+  const auto t1 = Clock::now();
+  r.frames = tracked.frames;
+  r.frames_skipped = tracked.frames_skipped;
+  r.detections = static_cast<std::int64_t>(tracked.rows.size());
+
+  // Step 2: the calibration's input; step 3: filter, observability, refinement (Sec. 8).
+  r.input = calib::calibration_run_from_tracks(data, tracked.rows, o.input);
+  r.warnings.insert(r.warnings.end(), r.input.warnings.begin(), r.input.warnings.end());
+  if (r.input.tracks < kFewTracks) r.warnings.push_back(few_tracks_warning(r.input.tracks, o.features));
+  r.warnings.insert(r.warnings.end(), o.notes.begin(), o.notes.end());
+  for (const auto& w : r.warnings) spdlog::warn("{}", w);
+  if (o.progress) o.progress("calibrate", 0, 0);
+  r.calibration = calib::calibrate(r.input.run, opt, o.run);
+  const auto t2 = Clock::now();
+  const calib::CalibrationResult& result = r.calibration;
+  if (!result.extrinsics.vec().allFinite() || !result.covariance.allFinite())
+    throw std::runtime_error(
+        "the calibration diverged (non-finite estimate); nothing written but tracks.csv. Check "
+        "the wheel base and K in wheel0/sensor.yaml and the tracks in tracks.png");
+  for (const std::string& w : calib::result_warnings(result)) {
+    spdlog::warn("{}", w);
+    r.warnings.push_back(w);
+  }
+  r.wrote_extrinsics = result.observable() || o.force;
+  if (data.ground_truth() && data.ground_truth()->extrinsics) {
+    const auto& g = *data.ground_truth()->extrinsics;
+    r.truth = calib::Extrinsics{g.phi, g.rho, g.psi};
+  }
+
+  // Step 4: the outputs, each written to a temporary name and renamed.
+  calib::write_states_csv((out / "states.csv").string(), result.filter.history);
+  std::optional<calib::Extrinsics> refined;
+  if (result.refined && result.refinement.covariance_ok) refined = result.refinement.extrinsics;
+  write_image_atomic((out / "convergence.png").string(),
+                     calib::draw_convergence(result.filter.history, r.truth, refined));
+  calib::ReportInputs ri;
+  ri.dataset = dataset_dir;
+  ri.command = o.command;
+  ri.frames = tracked.frames;
+  ri.frames_skipped = tracked.frames_skipped;
+  ri.detections = r.detections;
+  ri.tracks_total = tracked.stats.new_tracks;
+  ri.run = &r.input;
+  ri.options = opt;
+  ri.options.bearing_sigma = result.bearing_sigma;
+  ri.truth = r.truth;
+  ri.force = o.force;
+  ri.exit_code = r.wrote_extrinsics ? 0 : 3;
+  ri.seconds_tracking = std::chrono::duration<double>(t1 - t0).count();
+  ri.seconds_calibration = std::chrono::duration<double>(t2 - t1).count();
+  ri.warnings = r.warnings;
+  ri.wrote_extrinsics = r.wrote_extrinsics;
+  if (r.wrote_extrinsics) calib::write_extrinsics_yaml((out / "extrinsics.yaml").string(), result);
+  write_text_atomic((out / "summary.json").string(), calib::summary_json(result, ri));
+  write_text_atomic((out / "report.html").string(), calib::report_html(result, ri));
+  return r;
+}
+
+namespace {
+
+std::string format(const char* fmt, auto... args) {
+  char buf[512];
+  std::snprintf(buf, sizeof buf, fmt, args...);
+  return buf;
+}
+
+std::string truth_lines(const CalibrateDatasetResult& r, bool refined) {
+  std::string s;
+  auto show = [&](const char* name, const calib::Extrinsics& est, const Eigen::Matrix3d& cov) {
+    const auto er = calib::errors_vs_truth(est, cov, *r.truth);
+    s += format("error vs ground truth (%s): phi %.3f deg, rho %.2f mm, psi %.3f deg, "
+                "position %.2f mm, yaw %.3f deg, NEES %.2f\n",
+                name, rad2deg(er.phi), er.rho * 1e3, rad2deg(er.psi), er.position * 1e3,
+                rad2deg(er.yaw), er.nees);
+  };
+  const auto& c = r.calibration;
+  show("filter", c.filter.extrinsics, c.filter.covariance);
+  if (refined) show("refinement", c.refinement.extrinsics, c.refinement.covariance);
+  return s;
+}
+
+}  // namespace
+
+std::string CalibrateDatasetResult::BriefReport() const {
+  const calib::CalibrationResult& c = calibration;
+  const bool refined = c.refined && c.refinement.covariance_ok;
+  const auto& e = c.extrinsics;
+  const auto& C = c.covariance;
+  const auto& o = c.observability;
+  std::string s = format(
+      "%lld frames (%lld skipped), %lld detections, %d tracks used, %d bearings; "
+      "%.2f m driven, %.0f deg turned\n",
+      static_cast<long long>(frames), static_cast<long long>(frames_skipped),
+      static_cast<long long>(detections), input.tracks, input.observations, input.path_length,
+      rad2deg(input.rotation));
+  s += format("%s estimate:  phi %.3f +- %.3f deg   rho %.2f +- %.2f mm   psi %.3f +- %.3f deg\n",
+              refined ? "refined" : "filter", rad2deg(e.phi), rad2deg(std::sqrt(C(0, 0))),
+              e.rho * 1e3, std::sqrt(C(1, 1)) * 1e3, rad2deg(e.psi), rad2deg(std::sqrt(C(2, 2))));
+  const Eigen::Vector2d p = e.position();
+  s += format("camera in the robot frame: x %.2f mm, y %.2f mm, yaw %.3f deg\n", p(0) * 1e3,
+              p(1) * 1e3, rad2deg(e.yaw()));
+  const std::string noise = calib::bearing_noise_text(c.bearing_sigma, c.track_bias_sigma);
+  if (c.noise_checked)
+    s += "bearing sigma " + noise + "; " + calib::noise_check_line(c) + "\n";
+  else
+    s += "bearing sigma " + noise + " (no noise check" +
+         (noise_check_requested ? ": the run does not determine the extrinsics" : "") + ")\n";
+  if (const std::string w = calib::wheel_check_line(c); !w.empty()) s += w + "\n";
+  if (c.refined && c.refinement.num_splits > 0)
+    s += format("refinement: %d tracks split where they changed line (summary.json lists them)\n",
+                c.refinement.num_splits);
+  if (!c.filter.joins.empty())
+    s += format("filter: %zu tracks joined to the line they continue after the tracker lost it\n",
+                c.filter.joins.size());
+  if (c.refined && !c.refinement.merges.empty())
+    s += format("refinement: %zu tracks joined to the line they continue after the tracker lost "
+                "it (summary.json lists them)\n",
+                c.refinement.merges.size());
+  s += format("Cramer-Rao bound of this run: phi %.3f deg, rho %.2f mm, psi %.3f deg\n",
+              rad2deg(o.phi.crlb), o.rho.crlb * 1e3, rad2deg(o.psi.crlb));
+  if (truth) s += truth_lines(*this, refined);
+  s += o.message + "\n";
+  s += "results in " + out_dir + ": " + (wrote_extrinsics ? "extrinsics.yaml, " : "") +
+       "report.html, summary.json, states.csv, convergence.png, tracks.csv, tracks.png\n";
+  return s;
+}
+
+}  // namespace omnivert::pipeline
