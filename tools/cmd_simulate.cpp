@@ -1,6 +1,9 @@
 // omnivert simulate: renders a catadioptric dataset with ground truth (docs/simulator.md).
 
 #include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
 
 #include "commands.hpp"
 #include "core/progress.hpp"
@@ -8,40 +11,43 @@
 
 namespace omnivert::cli {
 
-void add_simulate_command(CLI::App& app) {
-  auto* cmd = app.add_subcommand(
-      "simulate",
-      "Render a dataset (images, wheel odometry, ground truth) of a robot driving through a world");
-  struct Options {
-    std::string world = "corridor";
-    std::string trajectory = "paper";
-    std::string out;
-    bool force = false;
-    sim::SimConfig cfg;
-    std::string wheel_unit = "meters";
-    std::vector<double> center;
-    std::vector<double> ticks_per_meter;
-  };
-  auto opt = std::make_shared<Options>();
-  sim::SimConfig& c = opt->cfg;
-  cmd->add_option("--world", opt->world, "World: corridor, office, hall, or a YAML file")
+namespace {
+
+struct SimulateArgs {
+  std::string world = "corridor";
+  std::string trajectory = "paper";
+  std::string out;
+  bool force = false;
+  sim::SimConfig cfg;
+  std::string wheel_unit = "meters";
+  std::vector<double> center;
+  std::vector<double> ticks_per_meter;
+};
+
+// World, trajectory, output and frames.
+void add_run_options(CLI::App* cmd, SimulateArgs& a) {
+  sim::SimConfig& c = a.cfg;
+  cmd->add_option("--world", a.world, "World: corridor, office, hall, or a YAML file")
       ->capture_default_str();
-  cmd->add_option("--trajectory",
-                  opt->trajectory,
-                  "Trajectory: paper, zigzag, straight, tour, or a YAML file")
+  cmd->add_option(
+         "--trajectory", a.trajectory, "Trajectory: paper, zigzag, straight, tour, or a YAML file")
       ->capture_default_str();
-  cmd->add_option("--out", opt->out, "Output dataset directory (must not exist)")->required();
-  cmd->add_flag("--force", opt->force, "Replace the output directory if it exists");
+  cmd->add_option("--out", a.out, "Output dataset directory (must not exist)")->required();
+  cmd->add_flag("--force", a.force, "Replace the output directory if it exists");
   cmd->add_option("--seed", c.seed, "Seed of every random draw (noise)")->capture_default_str();
   cmd->add_option("--frames", c.max_frames, "At most this many frames (0: whole trajectory)")
       ->check(kNonNegative);
   cmd->add_option("--rate", c.frame_rate, "Frame rate [Hz]")
       ->capture_default_str()
       ->check(kPositive);
-  // Camera and mounting.
+}
+
+// Camera and mounting.
+void add_camera_options(CLI::App* cmd, SimulateArgs& a) {
+  sim::SimConfig& c = a.cfg;
   cmd->add_option("--width", c.camera.width, "Image width [px]")->capture_default_str();
   cmd->add_option("--height", c.camera.height, "Image height [px]")->capture_default_str();
-  cmd->add_option("--center", opt->center, "Mirror centre cx cy [px] (default 321.37 238.81)")
+  cmd->add_option("--center", a.center, "Mirror centre cx cy [px] (default 321.37 238.81)")
       ->expected(2);
   cmd->add_option("--xi", c.camera.xi, "Unified model mirror parameter xi")->capture_default_str();
   cmd->add_option("--gamma", c.camera.gamma, "Unified model focal length gamma [px]")
@@ -59,7 +65,11 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_option("--phi", c.extrinsics.phi, "Extrinsics phi [rad]")->capture_default_str();
   cmd->add_option("--rho", c.extrinsics.rho, "Extrinsics rho [m]")->capture_default_str();
   cmd->add_option("--psi", c.extrinsics.psi, "Extrinsics psi [rad]")->capture_default_str();
-  // Wheels.
+}
+
+// Wheels.
+void add_wheel_options(CLI::App* cmd, SimulateArgs& a) {
+  sim::SimConfig& c = a.cfg;
   cmd->add_option("--wheel-rate", c.wheel.rate_hz, "Wheel data rate [Hz]")
       ->capture_default_str()
       ->check(kPositive);
@@ -77,16 +87,20 @@ void add_simulate_command(CLI::App& app) {
                   "Systematic scale error of the right wheel");
   cmd->add_option(
       "--wheel-base-error", c.wheel.wheel_base_error, "True wheel base = nominal * (1 + this)");
-  cmd->add_option("--wheel-unit", opt->wheel_unit, "meters or ticks")
+  cmd->add_option("--wheel-unit", a.wheel_unit, "meters or ticks")
       ->check(CLI::IsMember({"meters", "ticks"}))
       ->capture_default_str();
   cmd->add_option(
-         "--ticks-per-meter", opt->ticks_per_meter, "Ticks per meter, left [right] (default 20000)")
+         "--ticks-per-meter", a.ticks_per_meter, "Ticks per meter, left [right] (default 20000)")
       ->expected(1, 2)
       ->check(kPositive);
   cmd->add_option("--counter-bits", c.wheel.counter_bits, "Tick counters wrap at 2^bits (0: never)")
       ->check(CLI::Range(0, 62));
-  // Image sensor.
+}
+
+// Image sensor.
+void add_image_sensor_options(CLI::App* cmd, SimulateArgs& a) {
+  sim::SimConfig& c = a.cfg;
   cmd->add_option("--noise", c.image.noise_sigma, "Image noise sigma [grey levels]")
       ->capture_default_str()
       ->check(kNonNegative);
@@ -99,38 +113,52 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_option("--blur", c.image.blur_sigma, "Gaussian blur sigma [px]")
       ->capture_default_str()
       ->check(kNonNegative);
+}
 
-  cmd->callback([opt]() {
-    sim::SimConfig& cfg = opt->cfg;
-    cfg.wheel.ticks = opt->wheel_unit == "ticks";
-    if (opt->center.size() == 2) {
-      cfg.camera.cx = opt->center[0];
-      cfg.camera.cy = opt->center[1];
-    }
-    if (!opt->ticks_per_meter.empty()) {
-      cfg.wheel.ticks_per_meter_left = opt->ticks_per_meter.front();
-      cfg.wheel.ticks_per_meter_right = opt->ticks_per_meter.back();
-    }
-    const sim::World world = sim::load_world(opt->world);
-    const sim::Trajectory trajectory = sim::load_trajectory(opt->trajectory);
-    std::unique_ptr<Progress> progress;
-    const sim::SimSummary s = sim::simulate(
-        world, trajectory, opt->cfg, opt->out, opt->force, [&progress](int done, int total) {
-          if (!progress)
-            progress = std::make_unique<Progress>("simulate", static_cast<std::size_t>(total));
-          progress->update(static_cast<std::size_t>(done));
-        });
-    if (progress) progress->finish();
-    std::printf(
-        "wrote %s: %d frames, %d wheel samples, %.2f m driven, %.1f ground-truth lines per "
-        "frame, %.1f s\n",
-        opt->out.c_str(),
-        s.frames,
-        s.wheel_samples,
-        s.distance,
-        s.mean_lines,
-        s.seconds);
-  });
+void run_simulate(SimulateArgs& a) {
+  sim::SimConfig& cfg = a.cfg;
+  cfg.wheel.ticks = a.wheel_unit == "ticks";
+  if (a.center.size() == 2) {
+    cfg.camera.cx = a.center[0];
+    cfg.camera.cy = a.center[1];
+  }
+  if (!a.ticks_per_meter.empty()) {
+    cfg.wheel.ticks_per_meter_left = a.ticks_per_meter.front();
+    cfg.wheel.ticks_per_meter_right = a.ticks_per_meter.back();
+  }
+  const sim::World world = sim::load_world(a.world);
+  const sim::Trajectory trajectory = sim::load_trajectory(a.trajectory);
+  std::unique_ptr<Progress> progress;
+  const sim::SimSummary s =
+      sim::simulate(world, trajectory, a.cfg, a.out, a.force, [&progress](int done, int total) {
+        if (!progress)
+          progress = std::make_unique<Progress>("simulate", static_cast<std::size_t>(total));
+        progress->update(static_cast<std::size_t>(done));
+      });
+  if (progress) progress->finish();
+  std::printf(
+      "wrote %s: %d frames, %d wheel samples, %.2f m driven, %.1f ground-truth lines per "
+      "frame, %.1f s\n",
+      a.out.c_str(),
+      s.frames,
+      s.wheel_samples,
+      s.distance,
+      s.mean_lines,
+      s.seconds);
+}
+
+}  // namespace
+
+void add_simulate_command(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "simulate",
+      "Render a dataset (images, wheel odometry, ground truth) of a robot driving through a world");
+  auto args = std::make_shared<SimulateArgs>();
+  add_run_options(cmd, *args);
+  add_camera_options(cmd, *args);
+  add_wheel_options(cmd, *args);
+  add_image_sensor_options(cmd, *args);
+  cmd->callback([args]() { run_simulate(*args); });
 }
 
 }  // namespace omnivert::cli

@@ -1,7 +1,8 @@
 // omnivert study: the paper's descriptor study (Sec. 5-6) and baselines, as CSV and PNG
 // files in --out DIR (docs/study.md).
 //   study similarity IMAGE   similarity matrices, ours / SSD / ZNCC (Figs. 9-12)
-//   study sensitivity DATA   % correct NN vs clip, noise, bins/areas; rule PDFs (Figs. 13-18)
+//   study sensitivity DATA   % correct NN vs clip, noise, bins/areas; rule PDFs (Figs. 13-18;
+//                            eval/sensitivity_study.hpp)
 //   study baselines DATA     precision/recall of ours, ZNCC and LBD on the same frames
 
 #include <cmath>
@@ -21,6 +22,7 @@
 #include "core/progress.hpp"
 #include "omnivert/dataset/dataset.hpp"
 #include "omnivert/eval/descriptor_study.hpp"
+#include "omnivert/eval/sensitivity_study.hpp"
 #include "omnivert/eval/similarity_study.hpp"
 #include "omnivert/viz/plot.hpp"
 #include "omnivert/match/matcher.hpp"
@@ -203,223 +205,15 @@ void write_plot(const std::string& path, const std::vector<PlotSeries>& s, const
   write_image_atomic(path, draw_plot(s, o));
 }
 
-// Histogram densities of values (correct / incorrect) over [0, hi].
-void pdf(const std::vector<double>& v,
-         double hi,
-         int bins,
-         std::vector<double>& x,
-         std::vector<double>& y) {
-  x.assign(bins, 0), y.assign(bins, 0);
-  const double w = hi / bins;
-  for (int i = 0; i < bins; ++i) x[i] = (i + 0.5) * w;
-  if (v.empty()) return;
-  for (double t : v) {
-    const int b = std::clamp(static_cast<int>(t / w), 0, bins - 1);
-    y[b] += 1.0;
-  }
-  for (double& t : y) t /= (v.size() * w);
-}
-
 void run_sensitivity(const DatasetArgs& a) {
   dataset::Dataset data;
   const StudySet set = load_set(a, data);  // validates the input before any output exists
   ensure_dir(a.out);
-  const DescriptorOptions base = a.pipeline.descriptor;
-  // Three scores per setting: the database NN of the paper, the frame-pair NN, and the
-  // frame-pair NN over baselines of 1-2 m.
-  struct Scores {
-    NearestNeighbourScore db, pair, far;
-    double ap = 0;
-  };
-  auto score = [&](const DescriptorOptions& d, double noise) {
-    const auto m = describe_ours(set, d, noise, a.seed);
-    const auto rec = match_frame_pairs(set, m);
-    Scores s;
-    s.db = nearest_neighbour_score(set, m);
-    s.pair = pair_nearest_score(set, rec);
-    s.far = pair_nearest_score(set, rec, 1.0, a.max_baseline);
-    s.ap = average_precision(precision_recall(rec, 0));
-    return s;
-  };
-  auto head = [](std::ostringstream& o) {
-    o << "queries_db,correct_db,percent_db,queries_pair,percent_pair,queries_pair_1m,percent_pair_"
-         "1m,"
-         "ratio_test_average_precision\n";
-  };
-  auto row = [](std::ostringstream& o, const Scores& s) {
-    o << s.db.queries << ',' << s.db.correct << ',' << f6(s.db.percent()) << ',' << s.pair.queries
-      << ',' << f6(s.pair.percent()) << ',' << s.far.queries << ',' << f6(s.far.percent()) << ','
-      << f6(s.ap) << '\n';
-  };
-  auto three = [](const std::string& suffix) {
-    return std::vector<PlotSeries>{{"database NN" + suffix, {}, {}, plot_color(0)},
-                                   {"frame-pair NN" + suffix, {}, {}, plot_color(1)},
-                                   {"frame-pair NN, 1-2 m" + suffix, {}, {}, plot_color(2)}};
-  };
-  auto add = [](std::vector<PlotSeries>& v, std::size_t at, double x, const Scores& s) {
-    v[at].x.push_back(x), v[at].y.push_back(s.db.percent());
-    v[at + 1].x.push_back(x), v[at + 1].y.push_back(s.pair.percent());
-    v[at + 2].x.push_back(x), v[at + 2].y.push_back(s.far.percent());
-  };
-  std::printf(
-      "%% correct nearest neighbour: database (all frames within the baseline) / frame pairs / "
-      "frame "
-      "pairs 1-2 m apart; AP: average precision of the ratio test on frame pairs\n");
-
-  // Fig. 13: clipping threshold.
-  const std::vector<double> clips = {0.025, 0.05, 0.075, 0.1, 0.125, 0.15, 0.2, 0.3, 0.5, 1.0};
-  std::ostringstream cs;
-  cs << "#clip,";
-  head(cs);
-  auto sc = three("");
-  std::printf("Fig. 13, clipping threshold (1.0 = no clipping)\n");
-  for (double c : clips) {
-    DescriptorOptions d = base;
-    d.clip = c;
-    const auto s = score(d, 0.0);
-    cs << f6(c) << ',';
-    row(cs, s);
-    add(sc, 0, c, s);
-    std::printf("  clip %-6g %6.2f%% %6.2f%% %6.2f%%  AP %.4f\n",
-                c,
-                s.db.percent(),
-                s.pair.percent(),
-                s.far.percent(),
-                s.ap);
-  }
-  write_text_atomic(out_path(a.out, "sensitivity_clip.csv"), cs.str());
-  PlotOptions pc{
-      "Fig. 13: influence of clipping", "clipping threshold", "% correct nearest neighbour"};
-  pc.vertical_lines = {base.clip};
-  pc.vertical_labels = {"default"};
-  pc.legend_bottom = true;
-  write_plot(out_path(a.out, "sensitivity_clip.png"), sc, pc);
-
-  // Fig. 14: Gaussian image noise, sigma = p% of 255.
-  std::ostringstream ns;
-  ns << "#noise_percent,sigma_grey,";
-  head(ns);
-  auto sn = three("");
-  std::printf("Fig. 14, Gaussian image noise (sigma in %% of 255)\n");
-  for (double p : {0.0, 1.0, 2.0, 4.0, 6.0, 8.0, 10.0}) {
-    const auto s = score(base, p / 100.0 * 255.0);
-    ns << f6(p) << ',' << f6(p * 2.55) << ',';
-    row(ns, s);
-    add(sn, 0, p, s);
-    std::printf("  noise %4.1f%% %6.2f%% %6.2f%% %6.2f%%  AP %.4f\n",
-                p,
-                s.db.percent(),
-                s.pair.percent(),
-                s.far.percent(),
-                s.ap);
-  }
-  write_text_atomic(out_path(a.out, "sensitivity_noise.csv"), ns.str());
-  PlotOptions pn{
-      "Fig. 14: influence of image noise", "noise sigma [% of 255]", "% correct nearest neighbour"};
-  pn.legend_bottom = true;
-  write_plot(out_path(a.out, "sensitivity_noise.png"), sn, pn);
-
-  // Fig. 15: bins and areas; with the separation of the rule-3 ratio (average precision).
-  std::ostringstream bs;
-  bs << "#bins,areas,size,";
-  head(bs);
-  std::vector<PlotSeries> sb;
-  std::printf("Fig. 15, orientation bins x areas\n");
-  for (int areas : {3, 5}) {
-    auto s3 = three(areas == 3 ? ", 3 areas" : ", 5 areas");
-    for (auto& s : s3) s.dashed = areas == 5;
-    for (int bins : {8, 16, 32}) {
-      DescriptorOptions d = base;
-      d.bins = bins, d.areas = areas;
-      const auto s = score(d, 0.0);
-      bs << bins << ',' << areas << ',' << d.size() << ',';
-      row(bs, s);
-      add(s3, 0, bins, s);
-      std::printf("  %2d bins, %d areas (%3d-D): %6.2f%% %6.2f%% %6.2f%%  AP %.4f\n",
-                  bins,
-                  areas,
-                  d.size(),
-                  s.db.percent(),
-                  s.pair.percent(),
-                  s.far.percent(),
-                  s.ap);
-    }
-    sb.insert(sb.end(), s3.begin(), s3.end());
-  }
-  write_text_atomic(out_path(a.out, "sensitivity_bins.csv"), bs.str());
-  PlotOptions pb{
-      "Fig. 15: orientation bins and areas", "orientation bins", "% correct nearest neighbour"};
-  pb.legend_bottom = true;
-  pb.x_lo = 4, pb.x_hi = 52;  // room on the right for the legend
-  write_plot(out_path(a.out, "sensitivity_bins.png"), sb, pb);
-
-  // Figs. 16-18: PDFs of correct / incorrect nearest matches for the three rules (frame pairs).
-  const auto records = match_frame_pairs(set, describe_ours(set, base, 0.0, a.seed));
-  const MatchOptions F;
-  const double thr[3] = {F.f1, F.f2, F.f3};
-  const char* names[3] = {
-      "nearest distance", "nearest / mean distance", "nearest / second-nearest distance"};
-  const char* fig[3] = {"Fig. 16: rule 1", "Fig. 17: rule 2", "Fig. 18: rule 3"};
-  std::ostringstream rs;
-  rs << "#rule,threshold,correct,incorrect,false_removed,correct_lost\n";
-  std::int64_t n_correct = 0;
-  for (const auto& r : records) n_correct += r.correct();
-  std::printf("Figs. 16-18, %zu frame-pair queries, %.1f%% nearest correct\n",
-              records.size(),
-              records.empty() ? 0.0 : 100.0 * n_correct / records.size());
-  for (int rule = 1; rule <= 3; ++rule) {
-    std::vector<double> cv, iv;
-    double hi = 0;
-    for (const auto& r : records) {
-      const double v = rule_value(r, rule);
-      (r.correct() ? cv : iv).push_back(v);
-      hi = std::max(hi, v);
-    }
-    hi = rule == 1 ? std::max(1.5, hi * 1.02) : 1.0;
-    std::vector<double> x, yc, yi;
-    pdf(cv, hi, 50, x, yc);
-    pdf(iv, hi, 50, x, yi);
-    std::ostringstream ps;
-    ps << "#value,pdf_correct,pdf_incorrect\n";
-    for (std::size_t i = 0; i < x.size(); ++i)
-      ps << f6(x[i]) << ',' << f6(yc[i]) << ',' << f6(yi[i]) << '\n';
-    write_text_atomic(out_path(a.out, "rule" + std::to_string(rule) + "_pdf.csv"), ps.str());
-    const auto sh = rule_shares(records, rule, thr[rule - 1]);
-    rs << rule << ',' << f6(sh.threshold) << ',' << sh.correct << ',' << sh.incorrect << ','
-       << f6(sh.false_removed) << ',' << f6(sh.correct_lost) << '\n';
-    char t[160];
-    std::snprintf(t,
-                  sizeof t,
-                  "%s: removes %.0f%% of false, loses %.0f%% of correct",
-                  fig[rule - 1],
-                  100 * sh.false_removed,
-                  100 * sh.correct_lost);
-    PlotOptions po{t, names[rule - 1], "probability density"};
-    po.x_lo = 0, po.x_hi = hi;
-    po.y_lo = 0;
-    for (std::size_t i = 0; i < x.size(); ++i)
-      po.y_hi = std::max({po.y_hi, 1.08 * yc[i], 1.08 * yi[i]});
-    if (!(po.y_hi > 0)) po.y_hi = 1;
-    po.vertical_lines = {thr[rule - 1]};
-    po.vertical_labels = {"F" + std::to_string(rule) + " = " + f6(thr[rule - 1])};
-    write_plot(out_path(a.out, "rule" + std::to_string(rule) + "_pdf.png"),
-               {{"correct matches", x, yc, plot_color(2), false},
-                {"incorrect matches", x, yi, plot_color(3), false}},
-               po);
-    std::printf(
-        "  rule %d (F = %.2f): removes %5.1f%% of false matches, loses %5.1f%% of correct ones\n",
-        rule,
-        thr[rule - 1],
-        100 * sh.false_removed,
-        100 * sh.correct_lost);
-  }
-  const auto all = rules_operating_point(records, F.f1, F.f2, F.f3);
-  rs << "all,,,," << f6(all.precision) << ',' << f6(all.recall)
-     << "  # precision, recall of the three rules together\n";
-  std::printf("  all three rules: precision %.1f%%, recall %.1f%%\n",
-              100 * all.precision,
-              100 * all.recall);
-  write_text_atomic(out_path(a.out, "rules.csv"), rs.str());
+  SensitivityStudyOptions o;
+  o.descriptor = a.pipeline.descriptor;
+  o.max_baseline = a.max_baseline;
+  o.seed = a.seed;
+  run_sensitivity_study(set, o, a.out, stdout);
   std::printf(
       "wrote %s/sensitivity_{clip,noise,bins}.{csv,png}, rule{1,2,3}_pdf.{csv,png}, rules.csv\n",
       a.out.c_str());

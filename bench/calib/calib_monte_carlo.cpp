@@ -1,4 +1,4 @@
-// Monte-Carlo study of the self-calibration (issue 5): many synthetic runs of the paper's
+// Monte-Carlo study of the self-calibration: many synthetic runs of the paper's
 // trajectory from the paper's rough prior; errors against truth, RMS against the
 // Cramer-Rao bound, NEES against the chi-square interval. Filter alone and with the batch
 // refinement; with --refine also both with the covariances after the noise check
@@ -12,7 +12,7 @@
 // --init anchored (default): anchored inverse depth + camera-pose extrinsics, with the batch
 //   window up to the first turn (--bootstrap, rad of rotation; 0: no window);
 // --init inverse: the paper's state eq. (28) with undelayed inverse-distance features;
-// --init naive: NOTES Sec. 5's naive initialisation.
+// --init naive: the naive initialisation of docs/theory/filter.md.
 // --correlation A: AR(1) coefficient of each track's bearing errors from frame to frame.
 // --lateral M: sideways slip per step allowed by the batch problems (window, refinement).
 // --break P: each track gets a new id with probability P per frame (a tracker that loses
@@ -122,21 +122,23 @@ void print(const char* name, const Stats& s, const Eigen::Vector3d& crlb, double
               (mean_nees >= lo && mean_nees <= hi) ? "consistent" : "INCONSISTENT");
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+struct Args {
   int runs = 50, iterations = 3;
   bool refine = false;
   double bootstrap = Options{}.bootstrap_rotation;
   bool merge = true;
-  Eigen::Vector3d crlb_joined_sq = Eigen::Vector3d::Zero();
-  int all_merges = 0, wrong_merges = 0, filter_joins = 0, filter_wrong = 0;
-  double sigma_deg = 0.3, model_sigma_deg = -1.0, inflation = 1.0, correlation = 0.0, break_probability = 0.0;
+  double sigma_deg = 0.3, model_sigma_deg = -1.0, inflation = 1.0, correlation = 0.0,
+         break_probability = 0.0;
   double lateral = Options{}.lateral_sigma;
   double bias_deg = 0.0, model_bias_deg = -1.0;
   double lower_level = CalibrateOptions{}.noise_check_lower_level;
   std::string init = "anchored", trajectory = "paper";
   std::uint64_t seed = 1;
+};
+
+// The command line; exits with 2 on a bad argument.
+Args parse_args(int argc, char** argv) {
+  Args a;
   for (int i = 1; i < argc; ++i) {
     auto next = [&]() -> const char* {
       if (i + 1 >= argc) {
@@ -146,61 +148,72 @@ int main(int argc, char** argv) {
       return argv[++i];
     };
     if (!std::strcmp(argv[i], "--runs"))
-      runs = std::atoi(next());
+      a.runs = std::atoi(next());
     else if (!std::strcmp(argv[i], "--sigma-deg"))
-      sigma_deg = std::atof(next());
-    else if (!std::strcmp(argv[i], "--model-sigma-deg"))  // what the filter assumes (default: the truth)
-      model_sigma_deg = std::atof(next());
+      a.sigma_deg = std::atof(next());
+    else if (!std::strcmp(argv[i],
+                          "--model-sigma-deg"))  // what the filter assumes (default: the truth)
+      a.model_sigma_deg = std::atof(next());
     else if (!std::strcmp(argv[i], "--bias-deg"))
-      bias_deg = std::atof(next());
+      a.bias_deg = std::atof(next());
     else if (!std::strcmp(argv[i], "--model-bias-deg"))
-      model_bias_deg = std::atof(next());
+      a.model_bias_deg = std::atof(next());
     else if (!std::strcmp(argv[i], "--lower-level"))
-      lower_level = std::atof(next());
+      a.lower_level = std::atof(next());
     else if (!std::strcmp(argv[i], "--correlation"))
-      correlation = std::atof(next());
+      a.correlation = std::atof(next());
     else if (!std::strcmp(argv[i], "--break"))
-      break_probability = std::atof(next());
+      a.break_probability = std::atof(next());
     else if (!std::strcmp(argv[i], "--init"))
-      init = next();
+      a.init = next();
     else if (!std::strcmp(argv[i], "--inflation"))
-      inflation = std::atof(next());
+      a.inflation = std::atof(next());
     else if (!std::strcmp(argv[i], "--iterations"))
-      iterations = std::atoi(next());
+      a.iterations = std::atoi(next());
     else if (!std::strcmp(argv[i], "--trajectory"))
-      trajectory = next();
+      a.trajectory = next();
     else if (!std::strcmp(argv[i], "--refine"))
-      refine = true;
+      a.refine = true;
     else if (!std::strcmp(argv[i], "--bootstrap"))
-      bootstrap = std::atof(next());
+      a.bootstrap = std::atof(next());
     else if (!std::strcmp(argv[i], "--lateral"))
-      lateral = std::atof(next());
+      a.lateral = std::atof(next());
     else if (!std::strcmp(argv[i], "--no-merge"))
-      merge = false;
+      a.merge = false;
     else if (!std::strcmp(argv[i], "--seed"))
-      seed = std::strtoull(next(), nullptr, 10);
+      a.seed = std::strtoull(next(), nullptr, 10);
     else {
       std::fprintf(stderr, "unknown argument %s\n", argv[i]);
-      return 2;
+      std::exit(2);
     }
   }
+  return a;
+}
+
+// The simulated runs.
+SyntheticRunOptions synthetic_options(const Args& a) {
   SyntheticRunOptions so;
-  so.bearing_sigma = deg2rad(sigma_deg);
-  so.bearing_correlation = correlation;
-  so.track_bias_sigma = deg2rad(bias_deg);
-  so.break_probability = break_probability;
-  so.trajectory = trajectory == "zigzag" ? Trajectory::kZigzag : Trajectory::kPaper;
+  so.bearing_sigma = deg2rad(a.sigma_deg);
+  so.bearing_correlation = a.correlation;
+  so.track_bias_sigma = deg2rad(a.bias_deg);
+  so.break_probability = a.break_probability;
+  so.trajectory = a.trajectory == "zigzag" ? Trajectory::kZigzag : Trajectory::kPaper;
+  return so;
+}
+
+// The estimators' options, with the diagnostics from the environment.
+Options filter_options(const Args& a, const SyntheticRunOptions& so) {
   Options fo;
   fo.wheel_base = so.wheel_base;
   fo.odometry_K = so.odometry_K;
-  fo.odometry_inflation = inflation;
-  fo.bearing_sigma = model_sigma_deg > 0 ? deg2rad(model_sigma_deg) : so.bearing_sigma;
-  fo.track_bias_sigma = model_bias_deg >= 0 ? deg2rad(model_bias_deg) : so.track_bias_sigma;
-  fo.update_iterations = iterations;
-  fo.lateral_sigma = lateral;
-  fo.feature_init = init == "naive"     ? FeatureInit::kNaive
-                    : init == "inverse" ? FeatureInit::kInverseDistance
-                                        : FeatureInit::kAnchoredInverseDepth;
+  fo.odometry_inflation = a.inflation;
+  fo.bearing_sigma = a.model_sigma_deg > 0 ? deg2rad(a.model_sigma_deg) : so.bearing_sigma;
+  fo.track_bias_sigma = a.model_bias_deg >= 0 ? deg2rad(a.model_bias_deg) : so.track_bias_sigma;
+  fo.update_iterations = a.iterations;
+  fo.lateral_sigma = a.lateral;
+  fo.feature_init = a.init == "naive"     ? FeatureInit::kNaive
+                    : a.init == "inverse" ? FeatureInit::kInverseDistance
+                                          : FeatureInit::kAnchoredInverseDepth;
 
   if (const char* c = std::getenv("PRIOR_AT_TRUTH")) {  // diagnostics: prior centred on truth
     fo.prior = so.truth;
@@ -213,173 +226,224 @@ int main(int argc, char** argv) {
   if (const char* c = std::getenv("CONVERT")) fo.convert_ratio = std::atof(c);
   if (std::getenv("NO_SECOND_ORDER")) fo.second_order_noise = false;
   if (std::getenv("NO_FILTER_JOIN")) fo.join_pieces = false;
-  fo.bootstrap_rotation = bootstrap;
+  fo.bootstrap_rotation = a.bootstrap;
+  return fo;
+}
+
+// What the runs add up.
+struct Totals {
   Stats filt, ref, ref_checked, filt_checked;
   std::vector<double> scales;
   int applied = 0, filter_applied = 0;
   Eigen::Vector3d crlb_sq = Eigen::Vector3d::Zero();
+  Eigen::Vector3d crlb_joined_sq = Eigen::Vector3d::Zero();
   double crlb_yaw_sq = 0, crlb_pos_sq = 0;
-  Progress progress("monte carlo", runs);
-  for (int r = 0; r < runs; ++r) {
-    so.seed = seed + r;
-    const SyntheticRun run = make_synthetic_run(so);
-    // With --refine, the tool's pipeline (calib::calibrate): the filter, the refinement, and
-    // the noise checks of the filter (its tracks as its window split them) and of the refinement; the model's
-    // covariances are kept aside. The filter is run once either way.
-    CalibrationResult cr;
-    if (refine) {
-      CalibrateOptions co{.refine = true};
-      co.batch.lateral_sigma = lateral;
-      co.batch.merge_pieces = merge;
-      co.noise_check_lower_level = lower_level;
-      cr = calibrate(run.run, fo, co);
+  int all_merges = 0, wrong_merges = 0, filter_joins = 0, filter_wrong = 0;
+};
+
+// Diagnostics (MISSING): tracks of at least 3 bearings that the filter does not hold.
+void print_missing_tracks(const SyntheticRun& run, const FilterResult& fr) {
+  std::map<int, std::pair<int, int>> span;
+  std::map<int, int> n;
+  for (int k = 0; k < static_cast<int>(run.run.frames.size()); ++k)
+    for (const auto& o : run.run.frames[k].observations) {
+      if (!n[o.track_id]++) span[o.track_id].first = k;
+      span[o.track_id].second = k;
     }
-    const FilterResult fr = refine ? cr.filter : run_filter(run.run, fo);
-    filt.add(fr.extrinsics, refine ? cr.filter_model_covariance : fr.covariance, run.truth);
-    if (std::getenv("MISSING")) {
-      std::map<int, std::pair<int, int>> span;
-      std::map<int, int> n;
-      for (int k = 0; k < static_cast<int>(run.run.frames.size()); ++k)
-        for (const auto& o : run.run.frames[k].observations) {
-          if (!n[o.track_id]++) span[o.track_id].first = k;
-          span[o.track_id].second = k;
-        }
-      for (const auto& [id, c] : n)
-        if (c >= 3 && !fr.tracks.count(id))
-          std::printf("missing track %d: %d bearings, frames %d-%d (window %d)\n", id, c,
-                      span[id].first, span[id].second, fr.window_frames);
-    }
-    if (std::getenv("WINDOW_NEES") && fr.window_frames > 0) {
-      const FrameEstimate& w = fr.history[static_cast<std::size_t>(fr.window_frames - 1)];
-      const Eigen::Vector3d e(angle_diff(w.extrinsics.phi, run.truth.phi), w.extrinsics.rho - run.truth.rho,
-                              angle_diff(w.extrinsics.psi, run.truth.psi));
-      std::printf("window %d frames of %zu: nees %.2f; end %.2f; joins %zu\n", fr.window_frames,
-                  run.run.frames.size(), e.dot(w.covariance.ldlt().solve(e)), filt.nees.back(),
-                  fr.joins.size());
-    }
-    if (std::getenv("VERBOSE") && !filt.nees.empty())
-      std::printf("run %d: nees %.1f  phi %.4f rho %.4f psi %.4f\n",
-                  r,
-                  filt.nees.back(),
-                  fr.extrinsics.phi,
-                  fr.extrinsics.rho,
-                  fr.extrinsics.psi);
-    // Cramer-Rao bound of this run: Fisher information at the truth.
-    BatchPoint truth;
-    truth.poses = run.true_poses;
-    truth.extrinsics = run.truth;
-    for (const auto& [id, j] : run.track_feature) truth.features[id] = run.features[j];
-    const ObservabilityReport obs = analyse_observability(run.run, fo, truth);
-    crlb_sq += Eigen::Vector3d(obs.phi.crlb, obs.rho.crlb, obs.psi.crlb).cwiseAbs2();
-    crlb_yaw_sq += obs.yaw.crlb * obs.yaw.crlb;
-    crlb_pos_sq += obs.x.crlb * obs.x.crlb + obs.y.crlb * obs.y.crlb;
-    if (break_probability > 0.0) {
-      // The bound with each line's pieces under one id: what joining them can reach.
-      CalibrationRun joined = run.run;
-      BatchPoint at = truth;
-      at.features.clear();
-      for (FrameInput& f : joined.frames)
-        for (BearingObservation& o : f.observations) {
-          o.track_id = run.track_feature.at(o.track_id);
-          at.features[o.track_id] = run.features[static_cast<std::size_t>(o.track_id)];
-        }
-      const ObservabilityReport j = analyse_observability(joined, fo, at);
-      crlb_joined_sq += Eigen::Vector3d(j.phi.crlb, j.rho.crlb, j.psi.crlb).cwiseAbs2();
-    }
-    if (refine) {
-      if (cr.refinement.covariance_ok) {
-        ref.add(cr.refinement.extrinsics, cr.refinement_model_covariance, run.truth);
-        if (cr.noise_checked) {
-          scales.push_back(cr.noise.scale);
-          applied += cr.noise_applied ? 1 : 0;
-          filter_applied += cr.filter_noise_applied ? 1 : 0;
-          ref_checked.add(cr.refinement.extrinsics, cr.refinement.covariance, run.truth);
-          filt_checked.add(cr.filter.extrinsics, cr.filter.covariance, run.truth);
-        }
-      } else {
-        ++ref.failures;
+  for (const auto& [id, c] : n)
+    if (c >= 3 && !fr.tracks.count(id))
+      std::printf("missing track %d: %d bearings, frames %d-%d (window %d)\n",
+                  id,
+                  c,
+                  span[id].first,
+                  span[id].second,
+                  fr.window_frames);
+}
+
+// Diagnostics (WINDOW_NEES): the NEES at the end of the batch window.
+void print_window_nees(const SyntheticRun& run, const FilterResult& fr, const Stats& filt) {
+  const FrameEstimate& w = fr.history[static_cast<std::size_t>(fr.window_frames - 1)];
+  const Eigen::Vector3d e(angle_diff(w.extrinsics.phi, run.truth.phi),
+                          w.extrinsics.rho - run.truth.rho,
+                          angle_diff(w.extrinsics.psi, run.truth.psi));
+  std::printf("window %d frames of %zu: nees %.2f; end %.2f; joins %zu\n",
+              fr.window_frames,
+              run.run.frames.size(),
+              e.dot(w.covariance.ldlt().solve(e)),
+              filt.nees.back(),
+              fr.joins.size());
+}
+
+// The Cramer-Rao bound of this run (Fisher information at the truth), and with --break the
+// bound with each line's pieces under one id (what joining them can reach).
+void add_crlb(const SyntheticRun& run, const Options& fo, const Args& a, Totals& t) {
+  BatchPoint truth;
+  truth.poses = run.true_poses;
+  truth.extrinsics = run.truth;
+  for (const auto& [id, j] : run.track_feature) truth.features[id] = run.features[j];
+  const ObservabilityReport obs = analyse_observability(run.run, fo, truth);
+  t.crlb_sq += Eigen::Vector3d(obs.phi.crlb, obs.rho.crlb, obs.psi.crlb).cwiseAbs2();
+  t.crlb_yaw_sq += obs.yaw.crlb * obs.yaw.crlb;
+  t.crlb_pos_sq += obs.x.crlb * obs.x.crlb + obs.y.crlb * obs.y.crlb;
+  if (a.break_probability > 0.0) {
+    CalibrationRun joined = run.run;
+    BatchPoint at = truth;
+    at.features.clear();
+    for (FrameInput& f : joined.frames)
+      for (BearingObservation& o : f.observations) {
+        o.track_id = run.track_feature.at(o.track_id);
+        at.features[o.track_id] = run.features[static_cast<std::size_t>(o.track_id)];
       }
-      // Joins of two different lines (pieces whose true features differ).
-      auto of_two_lines = [&run](const std::vector<std::pair<int, int>>& joins) {
-        int n = 0;
-        for (const auto& [a, c] : joins) {
-          const auto ia = run.track_feature.find(a), ic = run.track_feature.find(c);
-          n += ia != run.track_feature.end() && ic != run.track_feature.end() &&
-               ia->second != ic->second;
-        }
-        return n;
-      };
-      const int wrong = of_two_lines(cr.refinement.merges);
-      wrong_merges += wrong;
-      all_merges += static_cast<int>(cr.refinement.merges.size());
-      filter_joins += static_cast<int>(cr.filter.joins.size());
-      filter_wrong += of_two_lines(cr.filter.joins);
-      if (std::getenv("VERBOSE"))
-        std::printf("run %d: refinement %s nees %.1f  phi %.4f rho %.4f psi %.4f  merges %zu "
-                    "(%d of two lines) splits %d\n",
-                    r,
-                    cr.refinement.covariance_ok ? "" : "(no covariance)",
-                    cr.refinement.covariance_ok ? ref.nees.back() : 0.0,
-                    cr.refinement.extrinsics.phi,
-                    cr.refinement.extrinsics.rho,
-                    cr.refinement.extrinsics.psi,
-                    cr.refinement.merges.size(),
-                    wrong,
-                    cr.refinement.num_splits);
-      if (std::getenv("VERBOSE"))
-        std::printf("   cost %.1f -> %.1f, %d iterations, %d bearings, %d rejected, %zu guarded, %d "
-                    "features, filter joins %zu, filter tracks %zu\n",
-                    cr.refinement.initial_cost, cr.refinement.final_cost, cr.refinement.iterations,
-                    cr.refinement.num_bearings, cr.refinement.num_rejected,
-                    cr.refinement.guarded.size(), cr.refinement.num_features, cr.filter.joins.size(),
-                    cr.filter.tracks.size());
-    }
-    progress.update(r + 1);
+    const ObservabilityReport j = analyse_observability(joined, fo, at);
+    t.crlb_joined_sq += Eigen::Vector3d(j.phi.crlb, j.rho.crlb, j.psi.crlb).cwiseAbs2();
   }
-  progress.finish();
+}
+
+// With --refine: the refinement's errors, the noise check, and the joins of pieces.
+void add_refinement(int r, const SyntheticRun& run, const CalibrationResult& cr, Totals& t) {
+  if (cr.refinement.covariance_ok) {
+    t.ref.add(cr.refinement.extrinsics, cr.refinement_model_covariance, run.truth);
+    if (cr.noise_checked) {
+      t.scales.push_back(cr.noise.scale);
+      t.applied += cr.noise_applied ? 1 : 0;
+      t.filter_applied += cr.filter_noise_applied ? 1 : 0;
+      t.ref_checked.add(cr.refinement.extrinsics, cr.refinement.covariance, run.truth);
+      t.filt_checked.add(cr.filter.extrinsics, cr.filter.covariance, run.truth);
+    }
+  } else {
+    ++t.ref.failures;
+  }
+  // Joins of two different lines (pieces whose true features differ).
+  auto of_two_lines = [&run](const std::vector<std::pair<int, int>>& joins) {
+    int n = 0;
+    for (const auto& [a, c] : joins) {
+      const auto ia = run.track_feature.find(a), ic = run.track_feature.find(c);
+      n += ia != run.track_feature.end() && ic != run.track_feature.end() &&
+           ia->second != ic->second;
+    }
+    return n;
+  };
+  const int wrong = of_two_lines(cr.refinement.merges);
+  t.wrong_merges += wrong;
+  t.all_merges += static_cast<int>(cr.refinement.merges.size());
+  t.filter_joins += static_cast<int>(cr.filter.joins.size());
+  t.filter_wrong += of_two_lines(cr.filter.joins);
+  if (std::getenv("VERBOSE"))
+    std::printf(
+        "run %d: refinement %s nees %.1f  phi %.4f rho %.4f psi %.4f  merges %zu "
+        "(%d of two lines) splits %d\n",
+        r,
+        cr.refinement.covariance_ok ? "" : "(no covariance)",
+        cr.refinement.covariance_ok ? t.ref.nees.back() : 0.0,
+        cr.refinement.extrinsics.phi,
+        cr.refinement.extrinsics.rho,
+        cr.refinement.extrinsics.psi,
+        cr.refinement.merges.size(),
+        wrong,
+        cr.refinement.num_splits);
+  if (std::getenv("VERBOSE"))
+    std::printf(
+        "   cost %.1f -> %.1f, %d iterations, %d bearings, %d rejected, %zu guarded, %d "
+        "features, filter joins %zu, filter tracks %zu\n",
+        cr.refinement.initial_cost,
+        cr.refinement.final_cost,
+        cr.refinement.iterations,
+        cr.refinement.num_bearings,
+        cr.refinement.num_rejected,
+        cr.refinement.guarded.size(),
+        cr.refinement.num_features,
+        cr.filter.joins.size(),
+        cr.filter.tracks.size());
+}
+
+// Run r: the filter (with --refine, the tool's pipeline calib::calibrate: the filter, the
+// refinement, and the noise checks of the filter (its tracks as its window split them) and of
+// the refinement; the model's covariances are kept aside; the filter is run once either way).
+void run_once(int r, const Args& a, SyntheticRunOptions& so, const Options& fo, Totals& t) {
+  so.seed = a.seed + r;
+  const SyntheticRun run = make_synthetic_run(so);
+  CalibrationResult cr;
+  if (a.refine) {
+    CalibrateOptions co{.refine = true};
+    co.batch.lateral_sigma = a.lateral;
+    co.batch.merge_pieces = a.merge;
+    co.noise_check_lower_level = a.lower_level;
+    cr = calibrate(run.run, fo, co);
+  }
+  const FilterResult fr = a.refine ? cr.filter : run_filter(run.run, fo);
+  t.filt.add(fr.extrinsics, a.refine ? cr.filter_model_covariance : fr.covariance, run.truth);
+  if (std::getenv("MISSING")) print_missing_tracks(run, fr);
+  if (std::getenv("WINDOW_NEES") && fr.window_frames > 0) print_window_nees(run, fr, t.filt);
+  if (std::getenv("VERBOSE") && !t.filt.nees.empty())
+    std::printf("run %d: nees %.1f  phi %.4f rho %.4f psi %.4f\n",
+                r,
+                t.filt.nees.back(),
+                fr.extrinsics.phi,
+                fr.extrinsics.rho,
+                fr.extrinsics.psi);
+  add_crlb(run, fo, a, t);
+  if (a.refine) add_refinement(r, run, cr, t);
+}
+
+// The settings and the Cramer-Rao bounds (RMS over runs).
+void print_settings_and_bounds(const Args& a, const Options& fo, const Totals& t) {
+  const int runs = a.runs;
   std::printf(
       "trajectory %s, bearing noise %.4f deg + per line %.4f (model %.4f + %.4f), init %s, "
       "bootstrap %.2f rad, K inflation %.1f, iterations %d, track break probability %.2f, runs "
       "%d from seed %llu\n",
-      trajectory.c_str(),
-      sigma_deg,
-      bias_deg,
+      a.trajectory.c_str(),
+      a.sigma_deg,
+      a.bias_deg,
       rad2deg(fo.bearing_sigma),
       rad2deg(fo.track_bias_sigma),
-      init.c_str(),
-      bootstrap,
-      inflation,
-      iterations,
-      break_probability,
+      a.init.c_str(),
+      a.bootstrap,
+      a.inflation,
+      a.iterations,
+      a.break_probability,
       runs,
-      static_cast<unsigned long long>(seed));
-  const Eigen::Vector3d crlb = (crlb_sq / runs).cwiseSqrt();
+      static_cast<unsigned long long>(a.seed));
+  const Eigen::Vector3d crlb = (t.crlb_sq / runs).cwiseSqrt();
   std::printf(
       "CRLB (RMS over runs): phi %.3f deg  rho %.2f mm  psi %.3f deg  yaw %.4f deg  "
       "position %.2f mm\n",
       rad2deg(crlb(0)),
       1e3 * crlb(1),
       rad2deg(crlb(2)),
-      rad2deg(std::sqrt(crlb_yaw_sq / runs)),
-      1e3 * std::sqrt(crlb_pos_sq / runs));
-  if (break_probability > 0.0) {
-    const Eigen::Vector3d j = (crlb_joined_sq / runs).cwiseSqrt();
+      rad2deg(std::sqrt(t.crlb_yaw_sq / runs)),
+      1e3 * std::sqrt(t.crlb_pos_sq / runs));
+  if (a.break_probability > 0.0) {
+    const Eigen::Vector3d j = (t.crlb_joined_sq / runs).cwiseSqrt();
     std::printf("CRLB with each line's pieces joined: phi %.3f deg  rho %.2f mm  psi %.3f deg\n",
-                rad2deg(j(0)), 1e3 * j(1), rad2deg(j(2)));
-    if (refine && !ref.nees.empty())
+                rad2deg(j(0)),
+                1e3 * j(1),
+                rad2deg(j(2)));
+    if (a.refine && !t.ref.nees.empty())
       std::printf("refinement RMS / that bound: phi %.2f  rho %.2f  psi %.2f\n",
-                  ref.rms()(0) / j(0), ref.rms()(1) / j(1), ref.rms()(2) / j(2));
+                  t.ref.rms()(0) / j(0),
+                  t.ref.rms()(1) / j(1),
+                  t.ref.rms()(2) / j(2));
   }
-  const double crlb_yaw = std::sqrt(crlb_yaw_sq / runs);
-  print("filter", filt, crlb, crlb_yaw);
-  if (refine) print("filter + refinement", ref, crlb, crlb_yaw);
-  if (refine && filter_joins > 0)
+}
+
+// The tables: filter, refinement, joins, and the estimates after the noise check.
+void print_tables(const Args& a, const Totals& t) {
+  const int runs = a.runs;
+  const Eigen::Vector3d crlb = (t.crlb_sq / runs).cwiseSqrt();
+  const double crlb_yaw = std::sqrt(t.crlb_yaw_sq / runs);
+  print("filter", t.filt, crlb, crlb_yaw);
+  if (a.refine) print("filter + refinement", t.ref, crlb, crlb_yaw);
+  if (a.refine && t.filter_joins > 0)
     std::printf("filter: %d new tracks joined to a feature, %d of them to another line\n",
-                filter_joins, filter_wrong);
-  if (refine && all_merges > 0)
-    std::printf("refinement: %d pieces of tracks joined, %d of them to another line\n", all_merges,
-                wrong_merges);
-  if (refine && !scales.empty()) {
+                t.filter_joins,
+                t.filter_wrong);
+  if (a.refine && t.all_merges > 0)
+    std::printf("refinement: %d pieces of tracks joined, %d of them to another line\n",
+                t.all_merges,
+                t.wrong_merges);
+  if (a.refine && !t.scales.empty()) {
+    std::vector<double> scales = t.scales;
     double ms = 0;
     for (double v : scales) ms += v;
     std::sort(scales.begin(), scales.end());
@@ -390,10 +454,27 @@ int main(int argc, char** argv) {
         scales[scales.size() / 4],
         median(scales),
         scales[3 * scales.size() / 4],
-        applied,
-        filter_applied);
-    print("filter, checked", filt_checked, crlb, crlb_yaw);
-    print("refinement, checked", ref_checked, crlb, crlb_yaw);
+        t.applied,
+        t.filter_applied);
+    print("filter, checked", t.filt_checked, crlb, crlb_yaw);
+    print("refinement, checked", t.ref_checked, crlb, crlb_yaw);
   }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Args a = parse_args(argc, argv);
+  SyntheticRunOptions so = synthetic_options(a);
+  const Options fo = filter_options(a, so);
+  Totals t;
+  Progress progress("monte carlo", a.runs);
+  for (int r = 0; r < a.runs; ++r) {
+    run_once(r, a, so, fo, t);
+    progress.update(r + 1);
+  }
+  progress.finish();
+  print_settings_and_bounds(a, fo, t);
+  print_tables(a, t);
   return 0;
 }

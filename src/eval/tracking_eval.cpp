@@ -45,52 +45,65 @@ void add(TrackingCounts* into, const TrackingCounts& c) {
 
 }  // namespace
 
-TrackingEvaluation evaluate_tracking(const std::vector<TrackRow>& tracks,
-                                     const std::vector<GroundTruthLine>& ground_truth,
-                                     const TrackingEvalOptions& options) {
-  std::string error;
-  if (!options.IsValid(&error)) throw InputError("evaluation options: " + error);
-  TrackingEvaluation ev;
+namespace {
 
+// The number of frames of the dataset: given, or the largest frame index seen plus one.
+std::int64_t count_frames(const std::vector<TrackRow>& tracks,
+                          const std::vector<GroundTruthLine>& ground_truth,
+                          const TrackingEvalOptions& options) {
   std::int64_t num_frames = options.num_frames;
   if (num_frames <= 0) {
     for (const TrackRow& r : tracks) num_frames = std::max(num_frames, r.frame + 1);
     for (const GroundTruthLine& g : ground_truth) num_frames = std::max(num_frames, g.frame + 1);
   }
+  return num_frames;
+}
 
+// Rule 1: each detection's world line (the nearest true bearing within the tolerance).
+struct Association {
+  std::vector<std::int64_t> line;  // per detection, -1 when unassociated
+  // Every world line within the tolerance (sorted ids): more than one when true lines are
+  // closer than the tolerance (crossings, lines far ahead), where the nearest is noise.
+  std::vector<std::vector<std::int64_t>> within;
+  std::vector<char> gt_detected;  // per ground-truth row
+};
+
+// Rule 1 and rule 7 (bearing RMS).
+Association associate_detections(const std::vector<TrackRow>& tracks,
+                                 const std::vector<GroundTruthLine>& ground_truth,
+                                 const TrackingEvalOptions& options,
+                                 TrackingEvaluation& ev) {
   // Ground truth by frame.
   std::unordered_map<std::int64_t, std::vector<std::size_t>> gt_by_frame;
   for (std::size_t k = 0; k < ground_truth.size(); ++k) {
     gt_by_frame[ground_truth[k].frame].push_back(k);
   }
-
-  // Rule 1: associate each detection to the nearest true bearing within the tolerance.
   const std::size_t n = tracks.size();
-  std::vector<std::int64_t> assoc(n, -1);
-  // Every world line within the tolerance (sorted ids): more than one when true lines are
-  // closer than the tolerance (crossings, lines far ahead), where the nearest is noise.
-  std::vector<std::vector<std::int64_t>> within(n);
-  std::vector<char> gt_detected(ground_truth.size(), 0);
+  Association a;
+  a.line.assign(n, -1);
+  a.within.resize(n);
+  a.gt_detected.assign(ground_truth.size(), 0);
   double sq_sum = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
     const auto it = gt_by_frame.find(tracks[i].frame);
     if (it == gt_by_frame.end()) continue;
     double best = options.association_tolerance;
     std::size_t best_k = ground_truth.size();
+    std::vector<std::int64_t>& within = a.within[i];
     for (std::size_t k : it->second) {
       const double d = std::abs(angle_diff(tracks[i].bearing, ground_truth[k].bearing));
-      if (d <= options.association_tolerance) within[i].push_back(ground_truth[k].line_id);
+      if (d <= options.association_tolerance) within.push_back(ground_truth[k].line_id);
       if (d <= best) {
         best = d;
         best_k = k;
       }
     }
-    std::sort(within[i].begin(), within[i].end());
-    within[i].erase(std::unique(within[i].begin(), within[i].end()), within[i].end());
-    if (within[i].size() > 1) ++ev.ambiguous_detections;
+    std::sort(within.begin(), within.end());
+    within.erase(std::unique(within.begin(), within.end()), within.end());
+    if (within.size() > 1) ++ev.ambiguous_detections;
     if (best_k == ground_truth.size()) continue;
-    assoc[i] = ground_truth[best_k].line_id;
-    gt_detected[best_k] = 1;
+    a.line[i] = ground_truth[best_k].line_id;
+    a.gt_detected[best_k] = 1;
     ++ev.associated_detections;
     const double e = angle_diff(tracks[i].bearing, ground_truth[best_k].bearing);
     sq_sum += e * e;
@@ -98,8 +111,14 @@ TrackingEvaluation evaluate_tracking(const std::vector<TrackRow>& tracks,
   ev.detections = static_cast<std::int64_t>(n);
   ev.bearing_rms =
       ev.associated_detections > 0 ? std::sqrt(sq_sum / ev.associated_detections) : 0.0;
+  return a;
+}
 
-  // Rule 6: recall of long lines.
+// Rule 6: recall of long lines.
+void count_long_lines(const std::vector<GroundTruthLine>& ground_truth,
+                      const std::vector<char>& gt_detected,
+                      const TrackingEvalOptions& options,
+                      TrackingEvaluation& ev) {
   const double long_min =
       options.long_line_fraction * (options.annulus_r_max - options.annulus_r_min);
   for (std::size_t k = 0; k < ground_truth.size(); ++k) {
@@ -108,23 +127,30 @@ TrackingEvaluation evaluate_tracking(const std::vector<TrackRow>& tracks,
       ev.long_lines_detected += gt_detected[k];
     }
   }
+}
 
-  // World lines detected per frame (sorted), for rule 4.
-  std::unordered_map<std::int64_t, std::vector<std::int64_t>> detected_by_frame;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (assoc[i] >= 0) detected_by_frame[tracks[i].frame].push_back(assoc[i]);
+// World lines detected per frame (sorted), for rule 4.
+class DetectedLines {
+ public:
+  DetectedLines(const std::vector<TrackRow>& tracks, const std::vector<std::int64_t>& assoc) {
+    for (std::size_t i = 0; i < tracks.size(); ++i) {
+      if (assoc[i] >= 0) by_frame_[tracks[i].frame].push_back(assoc[i]);
+    }
+    for (auto& [f, v] : by_frame_) std::sort(v.begin(), v.end());
   }
-  for (auto& [f, v] : detected_by_frame) std::sort(v.begin(), v.end());
-  auto detected_in = [&](std::int64_t frame, std::int64_t line) {
-    const auto it = detected_by_frame.find(frame);
-    return it != detected_by_frame.end() &&
-           std::binary_search(it->second.begin(), it->second.end(), line);
-  };
+  bool contains(std::int64_t frame, std::int64_t line) const {
+    const auto it = by_frame_.find(frame);
+    return it != by_frame_.end() && std::binary_search(it->second.begin(), it->second.end(), line);
+  }
 
-  // Tracks: detections by id, in frame order.
-  std::map<std::int64_t, std::vector<std::size_t>> by_track;
-  for (std::size_t i = 0; i < n; ++i) by_track[tracks[i].track_id].push_back(i);
+ private:
+  std::unordered_map<std::int64_t, std::vector<std::int64_t>> by_frame_;
+};
 
+// Rule 5: the rows of the table, intervals of `interval` frames.
+void make_intervals(std::int64_t num_frames,
+                    const TrackingEvalOptions& options,
+                    TrackingEvaluation& ev) {
   const std::int64_t num_intervals =
       std::max<std::int64_t>(1, (num_frames + options.interval - 1) / options.interval);
   ev.intervals.resize(static_cast<std::size_t>(num_intervals));
@@ -134,102 +160,129 @@ TrackingEvaluation evaluate_tracking(const std::vector<TrackRow>& tracks,
     c.end_frame =
         std::min<std::int64_t>((k + 1) * options.interval, std::max<std::int64_t>(num_frames, 1));
   }
-  auto bucket = [&](std::int64_t frame) -> TrackingCounts& {
-    const std::int64_t k = std::clamp<std::int64_t>(frame / options.interval, 0, num_intervals - 1);
-    return ev.intervals[static_cast<std::size_t>(k)];
-  };
+}
 
-  // Rule 3: identity sets propagated along the links of each track.
-  std::vector<std::vector<std::int64_t>> identity(n);
+TrackingCounts& interval_of(TrackingEvaluation& ev,
+                            const TrackingEvalOptions& options,
+                            std::int64_t frame) {
+  const auto num_intervals = static_cast<std::int64_t>(ev.intervals.size());
+  const std::int64_t k = std::clamp<std::int64_t>(frame / options.interval, 0, num_intervals - 1);
+  return ev.intervals[static_cast<std::size_t>(k)];
+}
+
+// Rule 2: the predecessor of detection dets[k] of a track (dets in frame order): its
+// detection at matched_frame when known, else at the latest earlier frame.
+std::size_t find_predecessor(const std::vector<TrackRow>& tracks,
+                             const std::vector<std::size_t>& dets,
+                             std::size_t k) {
+  const std::size_t n = tracks.size();
+  const TrackRow& d = tracks[dets[k]];
+  std::int64_t pred_frame = -1;
+  if (d.matched_frame >= 0) {
+    for (std::size_t m = 0; m < k; ++m) {
+      if (tracks[dets[m]].frame == d.matched_frame) pred_frame = d.matched_frame;
+    }
+  }
+  if (pred_frame < 0) {
+    for (std::size_t m = k; m-- > 0;) {
+      if (tracks[dets[m]].frame < d.frame) {
+        pred_frame = tracks[dets[m]].frame;
+        break;
+      }
+    }
+  }
+  // The exact predecessor when the file names the matched line (matched_line); else, if
+  // the track holds several lines in pred_frame (a double claim), the nearest bearing. That
+  // guess goes wrong when the scene turns faster than the two lines are apart, so files
+  // written by omnivert carry matched_line.
+  std::size_t pred = n;
+  if (d.matched_line >= 0 && pred_frame == d.matched_frame) {
+    for (std::size_t m = 0; m < k; ++m) {
+      const std::size_t j = dets[m];
+      if (tracks[j].frame == pred_frame && tracks[j].line == d.matched_line) pred = j;
+    }
+  }
+  double pred_d = 10.0;
+  const bool exact = pred < n;
+  for (std::size_t m = 0; m < k && !exact; ++m) {
+    const std::size_t j = dets[m];
+    if (tracks[j].frame != pred_frame) continue;
+    const double dd = std::abs(angle_diff(tracks[j].bearing, d.bearing));
+    if (dd < pred_d) {
+      pred_d = dd;
+      pred = j;
+    }
+  }
+  assert(pred < n);
+  return pred;
+}
+
+// Rules 2-4 along the links of one track (dets: its detections, sorted here in frame
+// order): new entries and false new entries, and each link correct, false or unverified by
+// the identity sets carried along the track.
+void evaluate_track(const std::vector<TrackRow>& tracks,
+                    std::vector<std::size_t>& dets,
+                    const Association& assoc,
+                    const DetectedLines& detected,
+                    const TrackingEvalOptions& options,
+                    std::vector<std::vector<std::int64_t>>& identity,
+                    TrackingEvaluation& ev) {
+  std::stable_sort(dets.begin(), dets.end(), [&](std::size_t a, std::size_t b) {
+    return tracks[a].frame < tracks[b].frame;
+  });
+  const std::int64_t start_frame = tracks[dets.front()].frame;
   std::vector<std::int64_t> common;
-  for (auto& [id, dets] : by_track) {
-    std::stable_sort(dets.begin(), dets.end(), [&](std::size_t a, std::size_t b) {
-      return tracks[a].frame < tracks[b].frame;
-    });
-    const std::int64_t start_frame = tracks[dets.front()].frame;
-    for (std::size_t k = 0; k < dets.size(); ++k) {
-      const std::size_t i = dets[k];
-      const TrackRow& d = tracks[i];
-      if (k > 0 && tracks[dets[k - 1]].frame == d.frame) ++ev.duplicate_ids;
-      if (d.frame == start_frame) {
-        identity[i] = within[i];
-        // Rule 2: the first detection(s) of a track id are new entries. Rule 4.
-        TrackingCounts& c = bucket(d.frame);
-        ++c.new_entries;
-        if (assoc[i] >= 0) {
-          for (int b = 1; b <= options.look_back; ++b) {
-            if (detected_in(d.frame - b, assoc[i])) {
-              ++c.false_new_entries;
-              break;
-            }
-          }
-        }
-        continue;
-      }
-      // Rule 2: the predecessor, at matched_frame when known, else the latest earlier frame.
-      std::int64_t pred_frame = -1;
-      if (d.matched_frame >= 0) {
-        for (std::size_t m = 0; m < k; ++m) {
-          if (tracks[dets[m]].frame == d.matched_frame) pred_frame = d.matched_frame;
-        }
-      }
-      if (pred_frame < 0) {
-        for (std::size_t m = k; m-- > 0;) {
-          if (tracks[dets[m]].frame < d.frame) {
-            pred_frame = tracks[dets[m]].frame;
+  for (std::size_t k = 0; k < dets.size(); ++k) {
+    const std::size_t i = dets[k];
+    const TrackRow& d = tracks[i];
+    const std::vector<std::int64_t>& within = assoc.within[i];
+    if (k > 0 && tracks[dets[k - 1]].frame == d.frame) ++ev.duplicate_ids;
+    if (d.frame == start_frame) {
+      identity[i] = within;
+      // Rule 2: the first detection(s) of a track id are new entries. Rule 4.
+      TrackingCounts& c = interval_of(ev, options, d.frame);
+      ++c.new_entries;
+      if (assoc.line[i] >= 0) {
+        for (int b = 1; b <= options.look_back; ++b) {
+          if (detected.contains(d.frame - b, assoc.line[i])) {
+            ++c.false_new_entries;
             break;
           }
         }
       }
-      // The exact predecessor when the file names the matched line (matched_line); else, if
-      // the track holds several lines in pred_frame (a double claim), the nearest bearing. That
-      // guess goes wrong when the scene turns faster than the two lines are apart, so files
-      // written by omnivert carry matched_line.
-      std::size_t pred = n;
-      if (d.matched_line >= 0 && pred_frame == d.matched_frame) {
-        for (std::size_t m = 0; m < k; ++m) {
-          const std::size_t j = dets[m];
-          if (tracks[j].frame == pred_frame && tracks[j].line == d.matched_line) pred = j;
-        }
-      }
-      double pred_d = 10.0;
-      const bool exact = pred < n;
-      for (std::size_t m = 0; m < k && !exact; ++m) {
-        const std::size_t j = dets[m];
-        if (tracks[j].frame != pred_frame) continue;
-        const double dd = std::abs(angle_diff(tracks[j].bearing, d.bearing));
-        if (dd < pred_d) {
-          pred_d = dd;
-          pred = j;
-        }
-      }
-      assert(pred < n);
-      // Rule 3.
-      TrackingCounts& c = bucket(d.frame);
-      ++c.matches;
-      if (within[i].empty() || identity[pred].empty()) {
-        ++c.unverified;
-        identity[i] = within[i];
-        continue;
-      }
-      common.clear();
-      std::set_intersection(identity[pred].begin(),
-                            identity[pred].end(),
-                            within[i].begin(),
-                            within[i].end(),
-                            std::back_inserter(common));
-      if (!common.empty()) {
-        ++c.correct;
-        identity[i] = common;
-      } else {
-        ++c.false_matches;
-        identity[i] = within[i];
-      }
+      continue;
+    }
+    const std::size_t pred = find_predecessor(tracks, dets, k);
+    // Rule 3.
+    TrackingCounts& c = interval_of(ev, options, d.frame);
+    ++c.matches;
+    if (within.empty() || identity[pred].empty()) {
+      ++c.unverified;
+      identity[i] = within;
+      continue;
+    }
+    common.clear();
+    std::set_intersection(identity[pred].begin(),
+                          identity[pred].end(),
+                          within.begin(),
+                          within.end(),
+                          std::back_inserter(common));
+    if (!common.empty()) {
+      ++c.correct;
+      identity[i] = common;
+    } else {
+      ++c.false_matches;
+      identity[i] = within;
     }
   }
-  // Rule 8: track purity. Per track, the world line most of its associated detections belong
-  // to; the associated detections on any other line follow a wrong line (a slip between two
-  // close lines counts one false match, but every detection after it here).
+}
+
+// Rule 8: track purity. Per track, the world line most of its associated detections belong
+// to; the associated detections on any other line follow a wrong line (a slip between two
+// close lines counts one false match, but every detection after it here).
+std::int64_t count_off_majority(const std::map<std::int64_t, std::vector<std::size_t>>& by_track,
+                                const std::vector<std::int64_t>& assoc) {
+  std::int64_t off = 0;
   for (const auto& [id, dets] : by_track) {
     std::map<std::int64_t, std::int64_t> count;
     std::int64_t associated = 0, majority = 0;
@@ -238,8 +291,34 @@ TrackingEvaluation evaluate_tracking(const std::vector<TrackRow>& tracks,
         ++associated;
         majority = std::max(majority, ++count[assoc[i]]);
       }
-    ev.off_majority_detections += associated - majority;
+    off += associated - majority;
   }
+  return off;
+}
+
+}  // namespace
+
+TrackingEvaluation evaluate_tracking(const std::vector<TrackRow>& tracks,
+                                     const std::vector<GroundTruthLine>& ground_truth,
+                                     const TrackingEvalOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw InputError("evaluation options: " + error);
+  TrackingEvaluation ev;
+  const std::int64_t num_frames = count_frames(tracks, ground_truth, options);
+  const Association assoc = associate_detections(tracks, ground_truth, options, ev);
+  count_long_lines(ground_truth, assoc.gt_detected, options, ev);
+  const DetectedLines detected(tracks, assoc.line);
+
+  // Tracks: detections by id, in frame order.
+  std::map<std::int64_t, std::vector<std::size_t>> by_track;
+  for (std::size_t i = 0; i < tracks.size(); ++i) by_track[tracks[i].track_id].push_back(i);
+  make_intervals(num_frames, options, ev);
+  // Rule 3: identity sets propagated along the links of each track.
+  std::vector<std::vector<std::int64_t>> identity(tracks.size());
+  for (auto& [id, dets] : by_track) {
+    evaluate_track(tracks, dets, assoc, detected, options, identity, ev);
+  }
+  ev.off_majority_detections += count_off_majority(by_track, assoc.line);
   ev.total.first_frame = 0;
   ev.total.end_frame = std::max<std::int64_t>(num_frames, 1);
   for (const auto& c : ev.intervals) add(&ev.total, c);

@@ -24,7 +24,8 @@ bool LineExtractorOptions::IsValid(std::string* why) const {
   if (!(isolation_px >= 0 && isolation_px <= 50)) return fail("isolation_px must be in [0, 50]");
   if (peak_window < 0 || peak_window > 10) return fail("peak_window must be in [0, 10] sectors");
   if (nms_radius < 1 || nms_radius > 10) return fail("nms_radius must be in [1, 10] sectors");
-  if (!(length_fraction > 0 && length_fraction <= 1)) return fail("length_fraction must be in (0, 1]");
+  if (!(length_fraction > 0 && length_fraction <= 1))
+    return fail("length_fraction must be in (0, 1]");
   if (!(adaptive_k >= 0)) return fail("adaptive_k must not be negative");
   if (top_k < 1) return fail("top_k must be at least 1");
   if (!(min_fraction >= 0 && min_fraction <= 1)) return fail("min_fraction must be in [0, 1]");
@@ -68,8 +69,8 @@ double principal_angle(double sxx, double sxy, double syy, double near_a) {
 }  // namespace
 
 template <typename F>
-void LineExtractor::visit_pixels(int k, int pol, int span, double a, double cx, double cy,
-                                 F&& f) const {
+void LineExtractor::visit_pixels(
+    int k, int pol, int span, double a, double cx, double cy, F&& f) const {
   const int N = options_.sectors;
   const double ca = std::cos(a), sa = std::sin(a);
   for (int j = -span; j <= span; ++j) {
@@ -181,17 +182,26 @@ void LineExtractor::extract(const cv::Mat& gray,
   edges_.clear();
   if (!(circle.r_max > circle.r_min)) return;
   if (circle.r_min != lut_r_min_ || circle.r_max != lut_r_max_) build_lut(circle);
-  const int W = gray.cols, H = gray.rows;
-  if (mag_.rows != H || mag_.cols != W) mag_ = cv::Mat::zeros(H, W, CV_32F);
-  float* mag = mag_.ptr<float>();
-  const uchar* img = gray.ptr<uchar>();
-
+  if (mag_.rows != gray.rows || mag_.cols != gray.cols) {
+    mag_ = cv::Mat::zeros(gray.rows, gray.cols, CV_32F);
+  }
   const int cxi = static_cast<int>(std::lround(circle.center.x()));
   const int cyi = static_cast<int>(std::lround(circle.center.y()));
   const float fx = static_cast<float>(circle.center.x() - cxi);
   const float fy = static_cast<float>(circle.center.y() - cyi);
+  edge_pass(gray, cxi, cyi);
+  vote_sectors(cxi, cyi, fx, fy);
+  bucket_edges();
+  suppress_non_maxima(circle);
+  refit_crowded_lines(circle);
+  threshold_lines(circle, out);
+}
 
+void LineExtractor::edge_pass(const cv::Mat& gray, int cxi, int cyi) {
   // Step 2: one pass over the annulus: Sobel (eq. 1), magnitude threshold, orientation test.
+  const int W = gray.cols, H = gray.rows;
+  float* mag = mag_.ptr<float>();
+  const uchar* img = gray.ptr<uchar>();
   const float t2 = static_cast<float>(options_.gradient_threshold * options_.gradient_threshold);
   const float s = static_cast<float>(std::sin(deg2rad(options_.orientation_tolerance_deg)));
   const float s2 = s * s;
@@ -213,12 +223,16 @@ void LineExtractor::extract(const cv::Mat& gray,
     mag[idx] = m;
     cands.push_back({i, idx, static_cast<int16_t>(gx), static_cast<int16_t>(gy), m});
   }
+}
 
+void LineExtractor::vote_sectors(int cxi, int cyi, float fx, float fy) {
   // Step 3: thinning along the gradient, sub-pixel position, soft sector votes.
+  const int W = mag_.cols;
+  float* mag = mag_.ptr<float>();
   const int N = options_.sectors;
   const float to_sector = static_cast<float>(N / kTwoPi);
   for (auto& h : hist_) h.assign(N, 0.0f);
-  for (const Candidate& c : cands) {
+  for (const Candidate& c : cands_) {
     const int ax = std::abs(c.gx), ay = std::abs(c.gy);
     int off;
     float sx, sy;
@@ -261,33 +275,36 @@ void LineExtractor::extract(const cv::Mat& gray,
                       static_cast<int16_t>(sec_i),
                       pol});
   }
-  for (const Candidate& c : cands) mag[c.px] = 0.0f;  // leave the buffer clean
+  for (const Candidate& c : cands_) mag[c.px] = 0.0f;  // leave the buffer clean
+}
 
-  // Buckets of edge points by (sector, polarity), for gathering a line's support.
+void LineExtractor::bucket_edges() {
+  const int N = options_.sectors;
   bucket_start_.assign(2 * N + 1, 0);
   for (const EdgePoint& p : edges_) ++bucket_start_[2 * p.sector + (p.polarity > 0) + 1];
   std::partial_sum(bucket_start_.begin(), bucket_start_.end(), bucket_start_.begin());
   bucket_items_.resize(edges_.size());
-  {
-    std::vector<int32_t>& fill = bucket_fill_;
-    fill.assign(bucket_start_.begin(), bucket_start_.end() - 1);
-    for (int32_t i = 0; i < static_cast<int32_t>(edges_.size()); ++i) {
-      const EdgePoint& p = edges_[i];
-      bucket_items_[fill[2 * p.sector + (p.polarity > 0)]++] = i;
-    }
+  std::vector<int32_t>& fill = bucket_fill_;
+  fill.assign(bucket_start_.begin(), bucket_start_.end() - 1);
+  for (int32_t i = 0; i < static_cast<int32_t>(edges_.size()); ++i) {
+    const EdgePoint& p = edges_[i];
+    bucket_items_[fill[2 * p.sector + (p.polarity > 0)]++] = i;
   }
+}
 
+void LineExtractor::suppress_non_maxima(const MirrorCircle& circle) {
   // Step 4: circular non-maximum suppression of the (3-sector) vote score.
+  const int N = options_.sectors;
   const double L = circle.r_max - circle.r_min;
   double floor_fraction = options_.length_fraction;
-  if (options_.threshold != LineThreshold::kFractionOfAnnulus) floor_fraction = options_.min_fraction;
+  if (options_.threshold != LineThreshold::kFractionOfAnnulus) {
+    floor_fraction = options_.min_fraction;
+  }
   const float peak_min = static_cast<float>(0.4 * floor_fraction * L);
   const double cx = circle.center.x(), cy = circle.center.y();
   const double max_gap = std::max(1.0, options_.max_gap_px);
-  std::vector<LineCandidate>& found = found_;
-  std::vector<float>& radii = radii_;
   std::vector<float>& score = score_;
-  found.clear();
+  found_.clear();
   score.resize(N);
   for (int pol = 0; pol < 2; ++pol) {
     const auto& h = hist_[pol];
@@ -305,33 +322,41 @@ void LineExtractor::extract(const cv::Mat& gray,
         if (score[(k + j) % N] > sc || score[(k + N - j) % N] >= sc) is_max = false;
       }
       if (!is_max) continue;
-
-      // Step 5: gather support around the peak and refine the angle (fit through the centre).
-      double fit_rms = 0;
-      const double a =
-          fit_angle(k, pol, (k + 0.5) / N * kTwoPi, cx, cy, nullptr, 0.0, &fit_rms, &radii);
-      if (radii.size() < 2) continue;
-      std::sort(radii.begin(), radii.end());
-      double covered = 1.0;
-      for (std::size_t q = 1; q < radii.size(); ++q) {
-        const double gap = radii[q] - radii[q - 1];
-        covered += gap <= max_gap ? gap : 1.0;
-      }
       LineCandidate lc;
-      lc.peak = k;
-      lc.line.image_angle = wrap_angle(a);
-      lc.line.bearing = lc.line.image_angle;
-      lc.line.edge_pixels = static_cast<int>(std::lround(covered));
-      lc.line.r_inner = radii.front();
-      lc.line.r_outer = radii.back();
-      lc.line.fit_rms_px = fit_rms;
-      lc.line.polarity = pol ? 1 : -1;
-      lc.polarity = pol;
-      lc.length = covered;
-      found.push_back(lc);
+      if (fit_peak(k, pol, cx, cy, max_gap, &lc)) found_.push_back(lc);
     }
   }
+}
 
+bool LineExtractor::fit_peak(
+    int k, int pol, double cx, double cy, double max_gap, LineCandidate* lc) {
+  // Step 5: gather support around the peak and refine the angle (fit through the centre).
+  const int N = options_.sectors;
+  std::vector<float>& radii = radii_;
+  double fit_rms = 0;
+  const double a =
+      fit_angle(k, pol, (k + 0.5) / N * kTwoPi, cx, cy, nullptr, 0.0, &fit_rms, &radii);
+  if (radii.size() < 2) return false;
+  std::sort(radii.begin(), radii.end());
+  double covered = 1.0;
+  for (std::size_t q = 1; q < radii.size(); ++q) {
+    const double gap = radii[q] - radii[q - 1];
+    covered += gap <= max_gap ? gap : 1.0;
+  }
+  lc->peak = k;
+  lc->line.image_angle = wrap_angle(a);
+  lc->line.bearing = lc->line.image_angle;
+  lc->line.edge_pixels = static_cast<int>(std::lround(covered));
+  lc->line.r_inner = radii.front();
+  lc->line.r_outer = radii.back();
+  lc->line.fit_rms_px = fit_rms;
+  lc->line.polarity = pol ? 1 : -1;
+  lc->polarity = pol;
+  lc->length = covered;
+  return true;
+}
+
+void LineExtractor::refit_crowded_lines(const MirrorCircle& circle) {
   // Step 5 again for the lines that have a neighbour: each angle is refitted from its support
   // pixels at radii where every other candidate line is at least isolation_px away, so that
   // no pixel whose Sobel window or sub-pixel parabola reaches into the other edge's gradient
@@ -340,32 +365,37 @@ void LineExtractor::extract(const cv::Mat& gray,
   // the support that made no peak of its own (a door leaf 0.6 degree from its frame: one
   // peak, whose fit those pixels pull). A line whose neighbour is that close over most of its
   // length is marked `crowded` and keeps its full fit. The length stays the full support's.
+  if (!(options_.isolation_px > 0)) return;
   const double sep = deg2rad(options_.min_separation_deg);
-  if (options_.isolation_px > 0) {
-    const double D = options_.isolation_px;
-    // Two lines further apart than this (radians) are D pixels apart everywhere in the annulus.
-    const double reach = std::asin(std::min(1.0, D / std::max(1.0, circle.r_min)));
-    std::vector<double>& near = near_;
-    for (LineCandidate& f : found) {
-      near.clear();
-      for (const LineCandidate& g : found) {
-        const double d = std::abs(angle_diff(g.line.image_angle, f.line.image_angle));
-        // A peak of the same polarity closer than min_separation is the same edge (merged
-        // below), not a neighbour.
-        if (&g == &f || d >= reach || (g.polarity == f.polarity && d < sep)) continue;
-        near.push_back(g.line.image_angle);
-      }
-      hidden_neighbours(f.peak, f.polarity, f.line.image_angle, f.length, cx, cy, &near);
-      if (near.empty()) continue;
-      const double a = fit_angle(f.peak, f.polarity, f.line.image_angle, cx, cy, &near, D, nullptr);
-      if (std::isfinite(a))
-        f.line.image_angle = f.line.bearing = wrap_angle(a);
-      else
-        f.line.crowded = true;
+  const double cx = circle.center.x(), cy = circle.center.y();
+  const double D = options_.isolation_px;
+  // Two lines further apart than this (radians) are D pixels apart everywhere in the annulus.
+  const double reach = std::asin(std::min(1.0, D / std::max(1.0, circle.r_min)));
+  std::vector<double>& near = near_;
+  for (LineCandidate& f : found_) {
+    near.clear();
+    for (const LineCandidate& g : found_) {
+      const double d = std::abs(angle_diff(g.line.image_angle, f.line.image_angle));
+      // A peak of the same polarity closer than min_separation is the same edge (merged
+      // below), not a neighbour.
+      if (&g == &f || d >= reach || (g.polarity == f.polarity && d < sep)) continue;
+      near.push_back(g.line.image_angle);
     }
+    hidden_neighbours(f.peak, f.polarity, f.line.image_angle, f.length, cx, cy, &near);
+    if (near.empty()) continue;
+    const double a = fit_angle(f.peak, f.polarity, f.line.image_angle, cx, cy, &near, D, nullptr);
+    if (std::isfinite(a))
+      f.line.image_angle = f.line.bearing = wrap_angle(a);
+    else
+      f.line.crowded = true;
   }
+}
 
+void LineExtractor::threshold_lines(const MirrorCircle& circle, std::vector<VerticalLine>& out) {
   // Histogram thresholding (Sec. 2, last step) and the preprint's alternatives.
+  std::vector<LineCandidate>& found = found_;
+  const double L = circle.r_max - circle.r_min;
+  const double sep = deg2rad(options_.min_separation_deg);
   double thr = options_.length_fraction * L;
   if (options_.threshold == LineThreshold::kAdaptive && !found.empty()) {
     double m = 0, m2 = 0;
@@ -381,7 +411,8 @@ void LineExtractor::extract(const cv::Mat& gray,
   });
   for (const LineCandidate& f : found) {
     if (f.length < thr) break;
-    if (options_.threshold == LineThreshold::kTopK && static_cast<int>(out.size()) >= options_.top_k)
+    if (options_.threshold == LineThreshold::kTopK &&
+        static_cast<int>(out.size()) >= options_.top_k)
       break;
     bool dup = false;
     for (const VerticalLine& o : out)

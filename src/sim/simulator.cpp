@@ -96,150 +96,151 @@ std::string free_space_violation(const World& world,
 
 namespace {
 
-void write_dataset(const World& world,
-                   const Trajectory& trajectory,
-                   const SimConfig& cfg,
-                   const fs::path& dir,
-                   SimSummary& summary,
-                   const std::function<void(int, int)>& progress) {
-  const Pose2 start = trajectory.has_start ? trajectory.start : Pose2(world.start);
-  const std::vector<MotionPiece> motion = trajectory.pieces(start);
-  const double t_motion = duration(motion);
+// Frame times: the first 10 ms after the start of the wheel data (so that every image
+// timestamp falls between two wheel samples), then every 1/rate.
+struct FrameTimes {
+  std::int64_t step_ns = 0;
+  std::int64_t first_offset_ns = 10'000'000;
+  int count = 0;
+  double time(int k) const { return static_cast<double>(first_offset_ns + k * step_ns) * 1e-9; }
+  double last() const { return time(count - 1); }
+};
 
-  // Frame times: the first 10 ms after the start of the wheel data (so that every image
-  // timestamp falls between two wheel samples), then every 1/rate.
-  const std::int64_t frame_step_ns = std::llround(1e9 / cfg.frame_rate);
-  const std::int64_t first_offset_ns = 10'000'000;
+FrameTimes frame_times(const SimConfig& cfg, double t_motion) {
+  FrameTimes f;
+  f.step_ns = std::llround(1e9 / cfg.frame_rate);
   // The last frame is at or after the end of the motion, so that it shows the final pose.
-  int n_frames =
-      static_cast<int>(std::ceil((t_motion * 1e9 - static_cast<double>(first_offset_ns)) /
-                                 static_cast<double>(frame_step_ns))) +
-      1;
-  n_frames = std::max(n_frames, 1);
-  if (cfg.max_frames > 0) n_frames = std::min(n_frames, cfg.max_frames);
-  auto frame_time = [&](int k) {
-    return static_cast<double>(first_offset_ns + k * frame_step_ns) * 1e-9;
-  };
-  const double t_last = frame_time(n_frames - 1);
+  f.count = static_cast<int>(std::ceil((t_motion * 1e9 - static_cast<double>(f.first_offset_ns)) /
+                                       static_cast<double>(f.step_ns))) +
+            1;
+  f.count = std::max(f.count, 1);
+  if (cfg.max_frames > 0) f.count = std::min(f.count, cfg.max_frames);
+  return f;
+}
 
-  // The robot must stay in the free space of the world.
-  if (const std::string p = free_space_violation(world, motion, t_last, cfg.min_clearance);
-      !p.empty()) {
-    throw InputError("trajectory '" + trajectory.name + "' leaves the free space: " + p +
-                     "; give the trajectory a 'start' or choose another world");
-  }
-
-  fs::create_directories(dir / "cam0" / "data");
-  fs::create_directories(dir / "wheel0");
-  fs::create_directories(dir / "ground_truth");
-  const std::int64_t t0 = cfg.start_ns;
-
-  // Wheels (50 Hz), covering every image.
-  std::mt19937_64 wheel_rng(cfg.seed * 2 + 1);
-  const WheelSamples wheels = simulate_wheels(motion, t_last, cfg.wheel, wheel_rng);
-  {
-    FILE* f = open_or_throw(dir / "wheel0" / "data.csv");
-    FileCloser closer{f};
-    const WheelConfig& wc = cfg.wheel;
-    std::fprintf(f,
-                 wc.ticks ? "#timestamp [ns],left [ticks],right [ticks]\n"
-                          : "#timestamp [ns],left [m],right [m]\n");
-    for (std::size_t i = 0; i < wheels.t.size(); ++i) {
-      const std::int64_t ts = t0 + std::llround(wheels.t[i] * 1e9);
-      if (wc.ticks) {
-        std::fprintf(f,
-                     "%" PRId64 ",%" PRId64 ",%" PRId64 "\n",
-                     ts,
-                     to_ticks(wheels.left[i], wc.ticks_per_meter_left, wc.counter_bits),
-                     to_ticks(wheels.right[i], wc.ticks_per_meter_right, wc.counter_bits));
-      } else {
-        std::fprintf(f, "%" PRId64 ",%.9f,%.9f\n", ts, wheels.left[i], wheels.right[i]);
-      }
-    }
-    summary.wheel_samples = static_cast<int>(wheels.t.size());
-  }
-  {
-    const WheelConfig& wc = cfg.wheel;
-    std::string y = "# omnivert simulator: wheel encoders (dataset format: docs/simulator.md)\n";
-    y += "wheel_base: " + fmt("%.9g", wc.wheel_base) + "   # e [m], eq. (15)\n";
-    y += std::string("unit: ") + (wc.ticks ? "ticks" : "meters") + "\n";
+// wheel0/data.csv: the wheel samples (50 Hz), covering every image.
+void write_wheel_data(const fs::path& path,
+                      const WheelSamples& wheels,
+                      const WheelConfig& wc,
+                      std::int64_t t0) {
+  FILE* f = open_or_throw(path);
+  FileCloser closer{f};
+  std::fprintf(f,
+               wc.ticks ? "#timestamp [ns],left [ticks],right [ticks]\n"
+                        : "#timestamp [ns],left [m],right [m]\n");
+  for (std::size_t i = 0; i < wheels.t.size(); ++i) {
+    const std::int64_t ts = t0 + std::llround(wheels.t[i] * 1e9);
     if (wc.ticks) {
-      y += "ticks_per_meter_left: " + fmt("%.9g", wc.ticks_per_meter_left) + "\n";
-      y += "ticks_per_meter_right: " + fmt("%.9g", wc.ticks_per_meter_right) + "\n";
-      if (wc.counter_bits > 0) y += "counter_bits: " + std::to_string(wc.counter_bits) + "\n";
-    }
-    y += "odometry_k: " + fmt("%.9g", wc.odometry_k) + "   # Chong-Kleeman K [m], eq. (31)\n";
-    y += "rate_hz: " + fmt("%.9g", wc.rate_hz) + "\n";
-    write_text(dir / "wheel0" / "sensor.yaml", y);
-  }
-  {
-    const CatadioptricCamera& c = cfg.camera;
-    std::string y = "# omnivert simulator: catadioptric camera, unified sphere model with the\n";
-    y += "# mirror axis vertical: r = gamma cos(el) / (xi - sin(el)) (docs/simulator.md)\n";
-    y += "model: unified\n";
-    y += "resolution: [" + std::to_string(c.width) + ", " + std::to_string(c.height) + "]\n";
-    y += "center: [" + fmt("%.9g", c.cx) + ", " + fmt("%.9g", c.cy) + "]\n";
-    y += "r_min: " + fmt("%.9g", c.r_min) + "\n";
-    y += "r_max: " + fmt("%.9g", c.r_max) + "\n";
-    y += "bearing_sign: " + std::to_string(c.bearing_sign) + "\n";
-    y += "rim_radius: " + fmt("%.9g", c.rim_radius()) +
-         "   # dark beyond: the mirror's outer boundary\n";
-    y += "xi: " + fmt("%.9g", c.xi) + "\n";
-    y += "gamma: " + fmt("%.9g", c.gamma) + "\n";
-    y += "rate_hz: " + fmt("%.9g", cfg.frame_rate) + "\n";
-    write_text(dir / "cam0" / "sensor.yaml", y);
-  }
-  {
-    const Extrinsics& x = cfg.extrinsics;
-    const double tx = x.rho * std::cos(x.phi), ty = x.rho * std::sin(x.phi);
-    std::string y = "# Camera-to-odometry extrinsics (NOTES Sec. 1, Fig. 19): camera centre at\n";
-    y += "# rho (cos phi, sin phi) in the robot frame, camera x-axis at phi + psi.\n";
-    y += "phi: " + fmt("%.12g", x.phi) + "   # [rad]\n";
-    y += "rho: " + fmt("%.12g", x.rho) + "   # [m]\n";
-    y += "psi: " + fmt("%.12g", x.psi) + "   # [rad]\n";
-    y += "# the same as T_base_cam = [Rz(yaw) | (x, y, z)]\n";
-    y += "T_base_cam: {x: " + fmt("%.12g", tx) + ", y: " + fmt("%.12g", ty) +
-         ", z: " + fmt("%.12g", cfg.camera_height) +
-         ", yaw: " + fmt("%.12g", wrap_angle(x.phi + x.psi)) + "}\n";
-    write_text(dir / "ground_truth" / "extrinsics.yaml", y);
-  }
-  save_world(world, (dir / "ground_truth" / "world.yaml").string());
-
-  Renderer renderer(cfg.camera, world);
-  {
-    FILE* f = open_or_throw(dir / "ground_truth" / "edges.csv");
-    FileCloser closer{f};
-    std::fprintf(f, "#line_id,x [m],y [m],z_bottom [m],z_top [m]\n");
-    for (const VerticalEdge& e : renderer.edges()) {
-      std::fprintf(f, "%d,%.6f,%.6f,%.4f,%.4f\n", e.id, e.p.x(), e.p.y(), e.z0, e.z1);
+      std::fprintf(f,
+                   "%" PRId64 ",%" PRId64 ",%" PRId64 "\n",
+                   ts,
+                   to_ticks(wheels.left[i], wc.ticks_per_meter_left, wc.counter_bits),
+                   to_ticks(wheels.right[i], wc.ticks_per_meter_right, wc.counter_bits));
+    } else {
+      std::fprintf(f, "%" PRId64 ",%.9f,%.9f\n", ts, wheels.left[i], wheels.right[i]);
     }
   }
-  {
-    const WheelConfig& wc = cfg.wheel;
-    const ImageSensor& s = cfg.image;
-    std::string y = "# Settings of the simulation that wrote this dataset.\n";
-    y += "seed: " + std::to_string(cfg.seed) + "\n";
-    y += "world: " + world.name + "\n";
-    y += "trajectory: " + trajectory.name + "\n";
-    y += "start: [" + fmt("%.9g", start.x()) + ", " + fmt("%.9g", start.y()) + ", " +
-         fmt("%.9g", start.z()) + "]\n";
-    y += "frames: " + std::to_string(n_frames) + "\n";
-    y += "frame_rate: " + fmt("%.9g", cfg.frame_rate) + "\n";
-    y += "camera_height: " + fmt("%.9g", cfg.camera_height) + "\n";
-    y += "true_wheel_base: " + fmt("%.9g", wc.true_wheel_base()) + "\n";
-    y += "wheel_base_error: " + fmt("%.9g", wc.wheel_base_error) + "\n";
-    y += "radius_error_left: " + fmt("%.9g", wc.radius_error_left) + "\n";
-    y += "radius_error_right: " + fmt("%.9g", wc.radius_error_right) + "\n";
-    y += "odometry_k: " + fmt("%.9g", wc.odometry_k) + "\n";
-    y += "image_noise_sigma: " + fmt("%.9g", s.noise_sigma) + "\n";
-    y += "gain_flicker: " + fmt("%.9g", s.gain_flicker) + "\n";
-    y += "exposure: " + fmt("%.9g", s.exposure) + "\n";
-    y += "blur_sigma: " + fmt("%.9g", s.blur_sigma) + "\n";
-    y += "min_line_px: " + fmt("%.9g", cfg.min_line_px) + "\n";
-    write_text(dir / "ground_truth" / "simulation.yaml", y);
-  }
+}
 
-  // Frames.
+// wheel0/sensor.yaml.
+void write_wheel_sensor(const fs::path& path, const WheelConfig& wc) {
+  std::string y = "# omnivert simulator: wheel encoders (dataset format: docs/simulator.md)\n";
+  y += "wheel_base: " + fmt("%.9g", wc.wheel_base) + "   # e [m], eq. (15)\n";
+  y += std::string("unit: ") + (wc.ticks ? "ticks" : "meters") + "\n";
+  if (wc.ticks) {
+    y += "ticks_per_meter_left: " + fmt("%.9g", wc.ticks_per_meter_left) + "\n";
+    y += "ticks_per_meter_right: " + fmt("%.9g", wc.ticks_per_meter_right) + "\n";
+    if (wc.counter_bits > 0) y += "counter_bits: " + std::to_string(wc.counter_bits) + "\n";
+  }
+  y += "odometry_k: " + fmt("%.9g", wc.odometry_k) + "   # Chong-Kleeman K [m], eq. (31)\n";
+  y += "rate_hz: " + fmt("%.9g", wc.rate_hz) + "\n";
+  write_text(path, y);
+}
+
+// cam0/sensor.yaml.
+void write_camera_sensor(const fs::path& path, const CatadioptricCamera& c, double frame_rate) {
+  std::string y = "# omnivert simulator: catadioptric camera, unified sphere model with the\n";
+  y += "# mirror axis vertical: r = gamma cos(el) / (xi - sin(el)) (docs/simulator.md)\n";
+  y += "model: unified\n";
+  y += "resolution: [" + std::to_string(c.width) + ", " + std::to_string(c.height) + "]\n";
+  y += "center: [" + fmt("%.9g", c.cx) + ", " + fmt("%.9g", c.cy) + "]\n";
+  y += "r_min: " + fmt("%.9g", c.r_min) + "\n";
+  y += "r_max: " + fmt("%.9g", c.r_max) + "\n";
+  y += "bearing_sign: " + std::to_string(c.bearing_sign) + "\n";
+  y += "rim_radius: " + fmt("%.9g", c.rim_radius()) +
+       "   # dark beyond: the mirror's outer boundary\n";
+  y += "xi: " + fmt("%.9g", c.xi) + "\n";
+  y += "gamma: " + fmt("%.9g", c.gamma) + "\n";
+  y += "rate_hz: " + fmt("%.9g", frame_rate) + "\n";
+  write_text(path, y);
+}
+
+// ground_truth/extrinsics.yaml.
+void write_extrinsics(const fs::path& path, const Extrinsics& x, double camera_height) {
+  const double tx = x.rho * std::cos(x.phi), ty = x.rho * std::sin(x.phi);
+  std::string y = "# Camera-to-odometry extrinsics (NOTES Sec. 1, Fig. 19): camera centre at\n";
+  y += "# rho (cos phi, sin phi) in the robot frame, camera x-axis at phi + psi.\n";
+  y += "phi: " + fmt("%.12g", x.phi) + "   # [rad]\n";
+  y += "rho: " + fmt("%.12g", x.rho) + "   # [m]\n";
+  y += "psi: " + fmt("%.12g", x.psi) + "   # [rad]\n";
+  y += "# the same as T_base_cam = [Rz(yaw) | (x, y, z)]\n";
+  y += "T_base_cam: {x: " + fmt("%.12g", tx) + ", y: " + fmt("%.12g", ty) +
+       ", z: " + fmt("%.12g", camera_height) + ", yaw: " + fmt("%.12g", wrap_angle(x.phi + x.psi)) +
+       "}\n";
+  write_text(path, y);
+}
+
+// ground_truth/edges.csv: the world's vertical lines.
+void write_edges(const fs::path& path, const Renderer& renderer) {
+  FILE* f = open_or_throw(path);
+  FileCloser closer{f};
+  std::fprintf(f, "#line_id,x [m],y [m],z_bottom [m],z_top [m]\n");
+  for (const VerticalEdge& e : renderer.edges()) {
+    std::fprintf(f, "%d,%.6f,%.6f,%.4f,%.4f\n", e.id, e.p.x(), e.p.y(), e.z0, e.z1);
+  }
+}
+
+// ground_truth/simulation.yaml: the settings of the simulation that wrote the dataset.
+void write_simulation_settings(const fs::path& path,
+                               const World& world,
+                               const Trajectory& trajectory,
+                               const SimConfig& cfg,
+                               const Pose2& start,
+                               int n_frames) {
+  const WheelConfig& wc = cfg.wheel;
+  const ImageSensor& s = cfg.image;
+  std::string y = "# Settings of the simulation that wrote this dataset.\n";
+  y += "seed: " + std::to_string(cfg.seed) + "\n";
+  y += "world: " + world.name + "\n";
+  y += "trajectory: " + trajectory.name + "\n";
+  y += "start: [" + fmt("%.9g", start.x()) + ", " + fmt("%.9g", start.y()) + ", " +
+       fmt("%.9g", start.z()) + "]\n";
+  y += "frames: " + std::to_string(n_frames) + "\n";
+  y += "frame_rate: " + fmt("%.9g", cfg.frame_rate) + "\n";
+  y += "camera_height: " + fmt("%.9g", cfg.camera_height) + "\n";
+  y += "true_wheel_base: " + fmt("%.9g", wc.true_wheel_base()) + "\n";
+  y += "wheel_base_error: " + fmt("%.9g", wc.wheel_base_error) + "\n";
+  y += "radius_error_left: " + fmt("%.9g", wc.radius_error_left) + "\n";
+  y += "radius_error_right: " + fmt("%.9g", wc.radius_error_right) + "\n";
+  y += "odometry_k: " + fmt("%.9g", wc.odometry_k) + "\n";
+  y += "image_noise_sigma: " + fmt("%.9g", s.noise_sigma) + "\n";
+  y += "gain_flicker: " + fmt("%.9g", s.gain_flicker) + "\n";
+  y += "exposure: " + fmt("%.9g", s.exposure) + "\n";
+  y += "blur_sigma: " + fmt("%.9g", s.blur_sigma) + "\n";
+  y += "min_line_px: " + fmt("%.9g", cfg.min_line_px) + "\n";
+  write_text(path, y);
+}
+
+// The frames: cam0/data/*.png and cam0/data.csv, with ground_truth/poses.csv and lines.csv.
+void write_frames(const fs::path& dir,
+                  Renderer& renderer,
+                  const std::vector<MotionPiece>& motion,
+                  const SimConfig& cfg,
+                  const FrameTimes& times,
+                  SimSummary& summary,
+                  const std::function<void(int, int)>& progress) {
+  const std::int64_t t0 = cfg.start_ns;
+  const int n_frames = times.count;
   FILE* fcam = open_or_throw(dir / "cam0" / "data.csv");
   FileCloser ccam{fcam};
   FILE* fpose = open_or_throw(dir / "ground_truth" / "poses.csv");
@@ -254,10 +255,10 @@ void write_dataset(const World& world,
   cv::Mat1b img;
   const std::vector<int> png_params = {cv::IMWRITE_PNG_COMPRESSION, 3};
   long total_lines = 0;
-  Pose2 prev = pose_at(motion, frame_time(0));
+  Pose2 prev = pose_at(motion, times.time(0));
   for (int k = 0; k < n_frames; ++k) {
-    const double t = frame_time(k);
-    const std::int64_t ts = t0 + first_offset_ns + k * frame_step_ns;
+    const double t = times.time(k);
+    const std::int64_t ts = t0 + times.first_offset_ns + k * times.step_ns;
     const Pose2 robot = pose_at(motion, t);
     summary.distance += (robot.head<2>() - prev.head<2>()).norm();
     prev = robot;
@@ -284,25 +285,68 @@ void write_dataset(const World& world,
     }
     if (progress) progress(k + 1, n_frames);
   }
-  // A top view of the world and the path, for people to look at.
-  {
-    std::vector<Pose2> path;
-    std::vector<Eigen::Vector2d> cams;
-    for (double t = 0.0; t <= t_last + 1e-9; t += 0.1) {
-      path.push_back(pose_at(motion, t));
-      const CameraPose c = camera_pose(path.back(), cfg.extrinsics, cfg.camera_height);
-      cams.emplace_back(c.x, c.y);
-    }
-    const fs::path map = dir / "ground_truth" / "map.png";
-    if (!cv::imwrite(map.string(), draw_map(world, path, cams))) {
-      throw std::runtime_error("cannot write " + map.string());
-    }
-  }
-  summary.frames = n_frames;
   summary.mean_lines = static_cast<double>(total_lines) / n_frames;
   for (FILE* f : {fcam, fpose, flines}) {
     if (std::ferror(f)) throw std::runtime_error("write error in " + dir.string());
   }
+}
+
+// ground_truth/map.png: a top view of the world and the path, for people to look at.
+void write_map(const fs::path& path,
+               const World& world,
+               const std::vector<MotionPiece>& motion,
+               const SimConfig& cfg,
+               double t_last) {
+  std::vector<Pose2> path_poses;
+  std::vector<Eigen::Vector2d> cams;
+  for (double t = 0.0; t <= t_last + 1e-9; t += 0.1) {
+    path_poses.push_back(pose_at(motion, t));
+    const CameraPose c = camera_pose(path_poses.back(), cfg.extrinsics, cfg.camera_height);
+    cams.emplace_back(c.x, c.y);
+  }
+  if (!cv::imwrite(path.string(), draw_map(world, path_poses, cams))) {
+    throw std::runtime_error("cannot write " + path.string());
+  }
+}
+
+void write_dataset(const World& world,
+                   const Trajectory& trajectory,
+                   const SimConfig& cfg,
+                   const fs::path& dir,
+                   SimSummary& summary,
+                   const std::function<void(int, int)>& progress) {
+  const Pose2 start = trajectory.has_start ? trajectory.start : Pose2(world.start);
+  const std::vector<MotionPiece> motion = trajectory.pieces(start);
+  const FrameTimes times = frame_times(cfg, duration(motion));
+  const double t_last = times.last();
+
+  // The robot must stay in the free space of the world.
+  if (const std::string p = free_space_violation(world, motion, t_last, cfg.min_clearance);
+      !p.empty()) {
+    throw InputError("trajectory '" + trajectory.name + "' leaves the free space: " + p +
+                     "; give the trajectory a 'start' or choose another world");
+  }
+
+  fs::create_directories(dir / "cam0" / "data");
+  fs::create_directories(dir / "wheel0");
+  fs::create_directories(dir / "ground_truth");
+
+  std::mt19937_64 wheel_rng(cfg.seed * 2 + 1);
+  const WheelSamples wheels = simulate_wheels(motion, t_last, cfg.wheel, wheel_rng);
+  write_wheel_data(dir / "wheel0" / "data.csv", wheels, cfg.wheel, cfg.start_ns);
+  summary.wheel_samples = static_cast<int>(wheels.t.size());
+  write_wheel_sensor(dir / "wheel0" / "sensor.yaml", cfg.wheel);
+  write_camera_sensor(dir / "cam0" / "sensor.yaml", cfg.camera, cfg.frame_rate);
+  write_extrinsics(dir / "ground_truth" / "extrinsics.yaml", cfg.extrinsics, cfg.camera_height);
+  save_world(world, (dir / "ground_truth" / "world.yaml").string());
+
+  Renderer renderer(cfg.camera, world);
+  write_edges(dir / "ground_truth" / "edges.csv", renderer);
+  write_simulation_settings(
+      dir / "ground_truth" / "simulation.yaml", world, trajectory, cfg, start, times.count);
+  write_frames(dir, renderer, motion, cfg, times, summary, progress);
+  write_map(dir / "ground_truth" / "map.png", world, motion, cfg, t_last);
+  summary.frames = times.count;
 }
 
 }  // namespace

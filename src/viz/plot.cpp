@@ -142,16 +142,25 @@ cv::Mat draw_heatmap(const cv::Mat1f& m, const HeatmapOptions& o) {
   return img;
 }
 
-cv::Mat draw_plot(const std::vector<PlotSeries>& series_in, const PlotOptions& o) {
-  // A logarithmic y axis plots log10(y) (non-positive values are left out) and labels the
-  // ticks with the values themselves.
-  std::vector<PlotSeries> logged;
-  if (o.log_y) {
-    logged = series_in;
-    for (auto& s : logged)
-      for (double& v : s.y) v = v > 0 ? std::log10(v) : std::numeric_limits<double>::quiet_NaN();
+namespace {
+
+// The plot area in the image (margins left, top; size pw x ph) and the data ranges it shows.
+struct PlotFrame {
+  static constexpr int left = 80, right = 30, top = 45, bottom = 65;
+  int pw = 0, ph = 0;
+  double xlo = 0, xhi = 0, ylo = 0, yhi = 0;
+  int X(double x) const {
+    return left + static_cast<int>(std::lround((x - xlo) / (xhi - xlo) * pw));
   }
-  const std::vector<PlotSeries>& series = o.log_y ? logged : series_in;
+  int Y(double y) const {
+    return top + ph - static_cast<int>(std::lround((y - ylo) / (yhi - ylo) * ph));
+  }
+};
+
+// The axis ranges: the options', else the data's (with a margin in y). With a logarithmic
+// y axis, series holds log10(y) and the y range is converted too.
+PlotFrame plot_frame(const std::vector<PlotSeries>& series, const PlotOptions& o) {
+  PlotFrame f;
   double xlo = o.x_lo, xhi = o.x_hi, ylo = o.y_lo, yhi = o.y_hi;
   if (o.log_y && ylo < yhi) {
     ylo = ylo > 0 ? std::log10(ylo) : 0.0;
@@ -174,20 +183,21 @@ cv::Mat draw_plot(const std::vector<PlotSeries>& series_in, const PlotOptions& o
       ylo = c - pad, yhi = d + pad;
     }
   }
-  const int left = 80, right = 30, top = 45, bottom = 65;
-  cv::Mat img(o.height, o.width, CV_8UC3, kWhite);
-  const int pw = o.width - left - right, ph = o.height - top - bottom;
-  auto X = [&](double x) {
-    return left + static_cast<int>(std::lround((x - xlo) / (xhi - xlo) * pw));
-  };
-  auto Y = [&](double y) {
-    return top + ph - static_cast<int>(std::lround((y - ylo) / (yhi - ylo) * ph));
-  };
+  f.xlo = xlo, f.xhi = xhi, f.ylo = ylo, f.yhi = yhi;
+  f.pw = o.width - PlotFrame::left - PlotFrame::right;
+  f.ph = o.height - PlotFrame::top - PlotFrame::bottom;
+  return f;
+}
+
+// Grid lines, ticks and tick labels of both axes, the frame, and the options' vertical lines.
+void draw_plot_axes(cv::Mat& img, const PlotFrame& f, const PlotOptions& o) {
+  const int left = PlotFrame::left, top = PlotFrame::top, pw = f.pw, ph = f.ph;
+  const double xlo = f.xlo, xhi = f.xhi, ylo = f.ylo, yhi = f.yhi;
   const double xs = tick_step(xhi - xlo, 8), ys = tick_step(yhi - ylo, 6);
   for (double v = std::ceil(xlo / xs - 1e-9) * xs; v <= xhi + 1e-9 * xs; v += xs) {
-    cv::line(img, {X(v), top}, {X(v), top + ph}, kLight);
-    cv::line(img, {X(v), top + ph}, {X(v), top + ph + 5}, kBlack);
-    text(img, fmt(v), {X(v), top + ph + 20}, 0.45, kBlack, true);
+    cv::line(img, {f.X(v), top}, {f.X(v), top + ph}, kLight);
+    cv::line(img, {f.X(v), top + ph}, {f.X(v), top + ph + 5}, kBlack);
+    text(img, fmt(v), {f.X(v), top + ph + 20}, 0.45, kBlack, true);
   }
   if (o.log_y) {
     // Decades labelled, 2 and 5 times each decade as light lines.
@@ -195,34 +205,40 @@ cv::Mat draw_plot(const std::vector<PlotSeries>& series_in, const PlotOptions& o
       for (double m : {1.0, 2.0, 5.0}) {
         const double v = d + std::log10(m);
         if (v < ylo - 1e-9 || v > yhi + 1e-9) continue;
-        cv::line(img, {left, Y(v)}, {left + pw, Y(v)}, kLight);
-        cv::line(img, {left - (m == 1.0 ? 5 : 3), Y(v)}, {left, Y(v)}, kBlack);
-        if (m == 1.0 || yhi - ylo < 2.5) text(img, fmt(std::pow(10.0, v)), {left - 55, Y(v) + 5}, 0.45);
+        cv::line(img, {left, f.Y(v)}, {left + pw, f.Y(v)}, kLight);
+        cv::line(img, {left - (m == 1.0 ? 5 : 3), f.Y(v)}, {left, f.Y(v)}, kBlack);
+        if (m == 1.0 || yhi - ylo < 2.5)
+          text(img, fmt(std::pow(10.0, v)), {left - 55, f.Y(v) + 5}, 0.45);
       }
     }
   } else {
     for (double v = std::ceil(ylo / ys - 1e-9) * ys; v <= yhi + 1e-9 * ys; v += ys) {
-      cv::line(img, {left, Y(v)}, {left + pw, Y(v)}, kLight);
-      cv::line(img, {left - 5, Y(v)}, {left, Y(v)}, kBlack);
-      text(img, fmt(v), {left - 55, Y(v) + 5}, 0.45);
+      cv::line(img, {left, f.Y(v)}, {left + pw, f.Y(v)}, kLight);
+      cv::line(img, {left - 5, f.Y(v)}, {left, f.Y(v)}, kBlack);
+      text(img, fmt(v), {left - 55, f.Y(v) + 5}, 0.45);
     }
   }
   cv::rectangle(img, cv::Rect(left, top, pw, ph), kBlack);
   for (std::size_t k = 0; k < o.vertical_lines.size(); ++k) {
     const double v = o.vertical_lines[k];
     if (v < xlo || v > xhi) continue;
-    dashed_line(img, {X(v), top}, {X(v), top + ph}, kGrey, 2);
+    dashed_line(img, {f.X(v), top}, {f.X(v), top + ph}, kGrey, 2);
     if (k < o.vertical_labels.size())
-      text(img, o.vertical_labels[k], {X(v) + 4, top + ph - 8}, 0.45, {90, 90, 90});
+      text(img, o.vertical_labels[k], {f.X(v) + 4, top + ph - 8}, 0.45, {90, 90, 90});
   }
-  cv::Mat plot_area = img(cv::Rect(left, top, pw + 1, ph + 1));
-  cv::Mat1b ink(ph + 1, pw + 1, uchar{0});  // where the data is drawn (legend placement)
+}
+
+// The series, clipped to the plot area; returns where the data is drawn (for the legend).
+cv::Mat1b draw_series(cv::Mat& img, const PlotFrame& f, const std::vector<PlotSeries>& series) {
+  const int left = PlotFrame::left, top = PlotFrame::top;
+  cv::Mat plot_area = img(cv::Rect(left, top, f.pw + 1, f.ph + 1));
+  cv::Mat1b ink(f.ph + 1, f.pw + 1, uchar{0});
   for (std::size_t si = 0; si < series.size(); ++si) {
     const auto& s = series[si];
     std::vector<cv::Point> pts;
     for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i)
       if (std::isfinite(s.x[i]) && std::isfinite(s.y[i]))
-        pts.push_back({X(s.x[i]) - left, Y(s.y[i]) - top});
+        pts.push_back({f.X(s.x[i]) - left, f.Y(s.y[i]) - top});
     for (std::size_t i = 1; i < pts.size(); ++i) {
       if (s.dashed) {
         dashed_line(plot_area, pts[i - 1], pts[i], s.color, 2);
@@ -235,10 +251,16 @@ cv::Mat draw_plot(const std::vector<PlotSeries>& series_in, const PlotOptions& o
     if (s.markers)
       for (const auto& p : pts) cv::circle(plot_area, p, 4, s.color, cv::FILLED, cv::LINE_AA);
   }
-  text(img, o.title, {o.width / 2, 28}, 0.6, kBlack, true);
-  text(img, o.x_label, {left + pw / 2, o.height - 18}, 0.5, kBlack, true);
-  vertical_text(img, o.y_label, {15, top + ph / 2});
-  // Legend, inside the plot (series without a name are left out of it).
+  return ink;
+}
+
+// Legend, inside the plot (series without a name are left out of it), in the corner (or
+// side) where it covers the least data (`ink`); the preferred one on ties.
+void draw_legend(cv::Mat& img,
+                 const PlotFrame& f,
+                 const std::vector<PlotSeries>& series,
+                 const cv::Mat1b& ink,
+                 bool legend_bottom) {
   std::vector<const PlotSeries*> named;
   for (const auto& s : series)
     if (!s.name.empty()) named.push_back(&s);
@@ -248,33 +270,54 @@ cv::Mat draw_plot(const std::vector<PlotSeries>& series_in, const PlotOptions& o
     int base = 0;
     lw = std::max(lw, cv::getTextSize(s.name, cv::FONT_HERSHEY_SIMPLEX, 0.45, 1, &base).width);
   }
-  if (!named.empty()) {
-    const int bw = lw + 50, bh = 20 * static_cast<int>(named.size()) + 8;
-    // The corner (or side) where the legend covers the least data; the preferred one on ties.
-    const int xr = pw - bw - 8, xl = 8, yt = 8, yb = ph - bh - 24, ym = (ph - bh) / 2;
-    std::vector<cv::Point> spots = {{xr, yt}, {xr, yb}, {xl, yt}, {xl, yb}, {xr, ym}, {xl, ym}};
-    if (o.legend_bottom) std::swap(spots[0], spots[1]);
-    cv::Point best = spots[0];
-    int best_ink = std::numeric_limits<int>::max();
-    for (const auto& sp : spots) {
-      const cv::Rect r = cv::Rect(sp.x, sp.y, bw, bh) & cv::Rect(0, 0, ink.cols, ink.rows);
-      const int n = r.area() > 0 ? cv::countNonZero(ink(r)) : 0;
-      if (n < best_ink) best_ink = n, best = sp;
-    }
-    const cv::Rect box(left + best.x, top + best.y, bw, bh);
-    img(box).setTo(kWhite);
-    cv::rectangle(img, box, kGrey);
-    for (std::size_t si = 0; si < named.size(); ++si) {
-      const PlotSeries& ns = *named[si];
-      const int y = box.y + 16 + 20 * static_cast<int>(si);
-      if (ns.dashed) {
-        dashed_line(img, {box.x + 6, y - 4}, {box.x + 36, y - 4}, ns.color, 2);
-      } else {
-        cv::line(img, {box.x + 6, y - 4}, {box.x + 36, y - 4}, ns.color, 2, cv::LINE_AA);
-      }
-      text(img, ns.name, {box.x + 42, y}, 0.45);
-    }
+  if (named.empty()) return;
+  const int pw = f.pw, ph = f.ph;
+  const int bw = lw + 50, bh = 20 * static_cast<int>(named.size()) + 8;
+  const int xr = pw - bw - 8, xl = 8, yt = 8, yb = ph - bh - 24, ym = (ph - bh) / 2;
+  std::vector<cv::Point> spots = {{xr, yt}, {xr, yb}, {xl, yt}, {xl, yb}, {xr, ym}, {xl, ym}};
+  if (legend_bottom) std::swap(spots[0], spots[1]);
+  cv::Point best = spots[0];
+  int best_ink = std::numeric_limits<int>::max();
+  for (const auto& sp : spots) {
+    const cv::Rect r = cv::Rect(sp.x, sp.y, bw, bh) & cv::Rect(0, 0, ink.cols, ink.rows);
+    const int n = r.area() > 0 ? cv::countNonZero(ink(r)) : 0;
+    if (n < best_ink) best_ink = n, best = sp;
   }
+  const cv::Rect box(PlotFrame::left + best.x, PlotFrame::top + best.y, bw, bh);
+  img(box).setTo(kWhite);
+  cv::rectangle(img, box, kGrey);
+  for (std::size_t si = 0; si < named.size(); ++si) {
+    const PlotSeries& ns = *named[si];
+    const int y = box.y + 16 + 20 * static_cast<int>(si);
+    if (ns.dashed) {
+      dashed_line(img, {box.x + 6, y - 4}, {box.x + 36, y - 4}, ns.color, 2);
+    } else {
+      cv::line(img, {box.x + 6, y - 4}, {box.x + 36, y - 4}, ns.color, 2, cv::LINE_AA);
+    }
+    text(img, ns.name, {box.x + 42, y}, 0.45);
+  }
+}
+
+}  // namespace
+
+cv::Mat draw_plot(const std::vector<PlotSeries>& series_in, const PlotOptions& o) {
+  // A logarithmic y axis plots log10(y) (non-positive values are left out) and labels the
+  // ticks with the values themselves.
+  std::vector<PlotSeries> logged;
+  if (o.log_y) {
+    logged = series_in;
+    for (auto& s : logged)
+      for (double& v : s.y) v = v > 0 ? std::log10(v) : std::numeric_limits<double>::quiet_NaN();
+  }
+  const std::vector<PlotSeries>& series = o.log_y ? logged : series_in;
+  const PlotFrame f = plot_frame(series, o);
+  cv::Mat img(o.height, o.width, CV_8UC3, kWhite);
+  draw_plot_axes(img, f, o);
+  const cv::Mat1b ink = draw_series(img, f, series);
+  text(img, o.title, {o.width / 2, 28}, 0.6, kBlack, true);
+  text(img, o.x_label, {PlotFrame::left + f.pw / 2, o.height - 18}, 0.5, kBlack, true);
+  vertical_text(img, o.y_label, {15, PlotFrame::top + f.ph / 2});
+  draw_legend(img, f, series, ink, o.legend_bottom);
   return img;
 }
 

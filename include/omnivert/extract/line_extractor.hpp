@@ -92,27 +92,27 @@ class LineExtractor {
   // Edge pixels of the last call (after thinning), for drawing and tests: sub-pixel
   // position in the image.
   struct EdgePoint {
-    float x, y;     // image position (sub-pixel)
-    float weight;   // gradient magnitude
-    float radius;   // distance from the centre
-    int16_t sector; // nearest sector
+    float x, y;      // image position (sub-pixel)
+    float weight;    // gradient magnitude
+    float radius;    // distance from the centre
+    int16_t sector;  // nearest sector
     int8_t polarity;
   };
   const std::vector<EdgePoint>& last_edge_points() const { return edges_; }
 
  private:
   struct LutEntry {
-    int32_t du, dv;       // offset from the rounded centre
-    float ux, uy;         // radial unit vector
-    float inv_r;          // 1 / radius
-    float sector;         // continuous sector coordinate of the pixel, in [0, sectors)
+    int32_t du, dv;  // offset from the rounded centre
+    float ux, uy;    // radial unit vector
+    float inv_r;     // 1 / radius
+    float sector;    // continuous sector coordinate of the pixel, in [0, sectors)
   };
   void build_lut(const MirrorCircle& circle);
   // Step 5's fit: the angle of the radial line through the centre (cx, cy) fitted to the
   // support pixels of polarity `pol` near sector k, starting at angle a. With `avoid`, the
   // pixels at radii where any of those lines (angles) is nearer than avoid_px to this one
-  // are left out, and NaN is returned when less than a fifth of the support's weight is left. `radii` receives the distances
-  // from the centre of the pixels used.
+  // are left out, and NaN is returned when less than a fifth of the support's weight is left.
+  // `radii` receives the distances from the centre of the pixels used.
   double fit_angle(int k,
                    int pol,
                    double a,
@@ -154,6 +154,24 @@ class LineExtractor {
     int polarity;
     double length;
   };
+  // Steps of extract (Sec. 2), each on the buffers below.
+  // Step 2: one pass over the annulus (rounded centre cxi, cyi): Sobel (eq. 1), magnitude
+  // threshold, orientation test; fills cands_ and mag_.
+  void edge_pass(const cv::Mat& gray, int cxi, int cyi);
+  // Step 3: thinning along the gradient, sub-pixel position, soft sector votes into hist_;
+  // fills edges_ ((fx, fy): the centre's offset from (cxi, cyi)) and clears mag_.
+  void vote_sectors(int cxi, int cyi, float fx, float fy);
+  // Buckets of edge points by (sector, polarity), for gathering a line's support.
+  void bucket_edges();
+  // Step 4: circular non-maximum suppression of the vote score; each peak fitted (step 5)
+  // into found_.
+  void suppress_non_maxima(const MirrorCircle& circle);
+  // Step 5: the support of the peak at sector k and its fitted line; false when too small.
+  bool fit_peak(int k, int pol, double cx, double cy, double max_gap, LineCandidate* lc);
+  // Step 5 again for the lines of found_ that have a neighbour.
+  void refit_crowded_lines(const MirrorCircle& circle);
+  // Histogram thresholding (Sec. 2, last step) of found_ into out, sorted by image angle.
+  void threshold_lines(const MirrorCircle& circle, std::vector<VerticalLine>& out);
   // Reused buffers (no allocation per frame once warmed up).
   cv::Mat mag_;  // float magnitude of candidates (0 elsewhere)
   std::vector<Candidate> cands_;

@@ -155,9 +155,9 @@ struct TrackerStats {
   std::int64_t rejected_test1 = 0;
   std::int64_t rejected_test2 = 0;
   std::int64_t rejected_test3 = 0;
-  std::int64_t rejected_mutual = 0;   // not mutual nearest neighbours
-  std::int64_t rejected_claimed = 0;  // track already taken in this frame (mutual on)
-  std::int64_t rejected_gate = 0;     // odometry gate veto
+  std::int64_t rejected_mutual = 0;      // not mutual nearest neighbours
+  std::int64_t rejected_claimed = 0;     // track already taken in this frame (mutual on)
+  std::int64_t rejected_gate = 0;        // odometry gate veto
   std::int64_t rejected_continuity = 0;  // track continuity veto
   std::int64_t rejected_fork = 0;        // heads_only: track observed since that frame
   std::string BriefReport() const;
@@ -196,10 +196,85 @@ class Tracker {
     OdometryAccumulator odometry;
   };
 
+  // The candidates of frame t-k for the lines of the new frame still unmatched (query rows):
+  // their descriptor distances (the Matcher's last call), the odometry gate since frame t-k,
+  // and whether some candidates are left out (same polarity, gate-restricted candidates).
+  struct CandidateSearch {
+    int k = 0;
+    const Slot* slot = nullptr;
+    int num_queries = 0;
+    bool all_rows = false;  // every line of the new frame is a query: row q is line q
+    BearingGate gate;
+    bool gate_restricts = false;  // TrackerOptions::gate_candidates with an informative gate
+    bool restricted = false;      // gate_restricts or TrackerOptions::same_polarity
+  };
+  // Whether line `line` of the new frame is linked to its best candidate, and if not, the
+  // first rule that refused it.
+  struct LinkDecision {
+    bool ok = false;
+    LinkVerdict why = LinkVerdict::kNoCandidates;
+    std::int64_t track_id = -1;
+  };
+
   // The slot of frame (frame_count_ - k), k = 1..look_back; requires k <= frames held.
   Slot& slot_back(int k);
   const Slot& slot_back(int k) const;
+
+  // Steps of add_frame.
+  void check_frame(const FrameFeatures& frame) const;
+  void begin_frame(const FrameFeatures& frame,
+                   const WheelIncrement& since_previous,
+                   std::vector<TrackAssignment>* out);
+  CandidateSearch search_candidates(const FrameFeatures& frame, int k);
+  void match_queries(const FrameFeatures& frame, const CandidateSearch& c);
+  // May line `a` of the new frame be matched to line `j` of frame t-k?
+  bool admissible(const FrameFeatures& frame, const CandidateSearch& c, int a, int j) const;
+  // Tests 1 and 3 among the admissible candidates only (test 2's mean over all of them).
+  void retest_admissible(const FrameFeatures& frame, const CandidateSearch& c);
+  void link_lines(const FrameFeatures& frame,
+                  const CandidateSearch& c,
+                  std::vector<TrackAssignment>* out);
+  LinkDecision decide_link(const FrameFeatures& frame,
+                           const CandidateSearch& c,
+                           int line,
+                           const MatchResult& r);
+  void start_new_tracks(std::vector<TrackAssignment>* out);
   void store_frame(const FrameFeatures& frame, const std::vector<TrackAssignment>& out);
+
+  // The rules of the link decision (decide_link), in the order they are applied.
+  // Test 1 with TrackerOptions::look_back_f1 for a link across a gap.
+  bool refused_by_look_back_f1(int k, const MatchResult& r) const;
+  // TrackerOptions::confirm_f1: a link refused by test 1 alone (F1 or the look-back F1, `why`)
+  // that passes tests 1-3 with F1 = confirm_f1, for the track to confirm.
+  bool needs_confirmation(const CandidateSearch& c, const MatchResult& r, LinkVerdict why) const;
+  // The rules below count their rejections in stats_ and return LinkVerdict::kLinked when they
+  // do not refuse the link.
+  // Tests 1-3 of Sec. 4 (the Matcher's verdict); a test 1 failure to be confirmed is not
+  // counted here.
+  LinkVerdict match_test_verdict(const MatchResult& r, bool needs_confirmation);
+  // TrackerOptions::mutual: mutual nearest neighbours, and one line per track and frame.
+  LinkVerdict mutual_verdict(const FrameFeatures& frame,
+                             const CandidateSearch& c,
+                             int line,
+                             const MatchResult& r,
+                             std::int64_t id);
+  // The nearest line of the new frame to line j of frame t-k (among the admissible ones when
+  // candidates are restricted), ties to the lowest index.
+  int nearest_new_line(const FrameFeatures& frame, const CandidateSearch& c, int j) const;
+  // The odometry gate's veto.
+  LinkVerdict gate_verdict(const FrameFeatures& frame,
+                           const CandidateSearch& c,
+                           int line,
+                           const MatchResult& r);
+  // Track continuity, and the confirmation of a confirmed-F1 link (refused as `f1_verdict`).
+  LinkVerdict continuity_verdict(const FrameFeatures& frame,
+                                 int k,
+                                 int line,
+                                 const MatchResult& r,
+                                 bool needs_confirmation,
+                                 LinkVerdict f1_verdict);
+  // TrackerOptions::heads_only.
+  LinkVerdict fork_verdict(int k, std::int64_t id);
   bool track_claimed(std::int64_t id) const;
   // The rotation-free bearing u = beta + theta that track continuity predicts for the track of
   // line j of frame t-k in the new frame, and the spread its model allows on top of the
@@ -218,6 +293,9 @@ class Tracker {
   bool confirms_track(const TrackPrediction& p, const FrameFeatures& frame, int line) const;
   // TrackerOptions::heads_only: was track `id` observed in frames t-k+1 .. t-1?
   bool observed_since(std::int64_t id, int k);
+  // Track continuity: the rates (parallax per metre driven, per radian turned) of each line
+  // of the new frame, into rates_ and turn_rates_, before its slot is stored.
+  void measure_track_rates(const FrameFeatures& frame, const std::vector<TrackAssignment>& out);
   std::vector<double> rates_, turn_rates_;  // work space of store_frame
 
   TrackerOptions options_;
