@@ -6,7 +6,7 @@ Usage: scripts/break-tracks.py IN.csv OUT.csv P SEED
 Each track gets a new id with probability P at each frame after its first (the line is lost
 and found again under a new id; the bearings are untouched). For studying the calibration's
 joining of pieces of one line from pixels (`omnivert calibrate DATASET --tracks OUT.csv`,
-with and without `--no-join`; docs/calib.md, "Broken tracks").
+with and without `--no-join`; docs/theory/association.md#pieces-of-one-line).
 """
 import csv
 import random

@@ -158,22 +158,22 @@ void add_calibrate_command(CLI::App& app) {
   cmd->add_flag("--no-join", a->no_join,
                 "Filter (window and after) and refinement: keep a track that starts where a line "
                 "the tracker lost is predicted as a line of its own, instead of joining it to that "
-                "line (docs/calib.md, \"Broken tracks\")");
+                "line (docs/theory/association.md#pieces-of-one-line)");
   cmd->add_option("--crossing-guard", a->crossing_guard_deg,
                   "Leave out a track's bearings while another line is predicted within this "
                   "angle [degrees] of it (the extractor merges lines that close, and the "
-                  "bearing is pulled; docs/calib.md, \"Lines that cross\"); 0 turns it off")
+                  "bearing is pulled; docs/theory/association.md#lines-that-cross); 0 turns it off")
       ->check(CLI::Range(0.0, 20.0))
       ->capture_default_str();
   cmd->add_flag("!--no-noise-check", a->noise_check,
                 "Report the model's covariances as they are, without the data's check of the "
-                "bearing noise (errors summed along each track; docs/calib.md, \"The noise check\")");
+                "bearing noise (errors summed along each track; docs/theory/noise-check.md)");
   cmd->add_option("--noise-check-lower-level",
                   a->noise_check_lower_level,
                   "The noise check finds the bearings less noisy than the model assumes when "
                   "errors this small have at most this probability under the model, and then "
                   "shrinks the bearings' share of the covariance where the tracker kept its "
-                  "lines (docs/calib.md, \"The noise check\"); 0 turns this side off")
+                  "lines (docs/theory/noise-check.md); 0 turns this side off")
       ->check(kTestLevel)
       ->capture_default_str();
   cmd->add_option("--tracks", a->tracks_file,
@@ -206,27 +206,27 @@ void add_calibrate_command(CLI::App& app) {
   cmd->add_option("--bearing-sigma", a->bearing_sigma_deg,
                   "Bearing noise sigma [degrees] of the observation model, eq. (30). The default "
                   "(0.025) is what makes the estimate consistent (NEES) on rendered images with "
-                  "our extractor (docs/calib.md); the paper used 0.3")
+                  "our extractor (docs/validation.md); the paper used 0.3")
       ->check(kPositive)
       ->group(gm);
   cmd->add_option("--odometry-inflation", a->odometry_inflation,
                   "Factor on the Chong-Kleeman K of wheel0/sensor.yaml, eq. (31), in the filter "
                   "(default 1: K as given; the paper used 5, which costs efficiency when K is "
-                  "right and helps when the wheels are off: docs/calib.md)")
+                  "right and helps when the wheels are off: docs/theory/filter.md#odometry-noise)")
       ->check(kPositive)
       ->group(gm);
   cmd->add_option("--track-bias-sigma", a->track_bias_sigma_deg,
                   "A constant bearing error per track [degrees], in the filter, the refinement "
                   "and the bounds (default 0: none; --bearing-sigma is then the error that "
                   "changes from frame to frame; measured from pixels it does not make our "
-                  "extractor's sigmas consistent in every row: docs/calib.md, \"Per-track "
+                  "extractor's sigmas consistent in every row: docs/theory/filter.md#per-track-bias
                   "bearing bias\")")
       ->check(kNonNegative)
       ->group(gm);
   cmd->add_option("--lateral-sigma", a->lateral_sigma,
                   "Sideways slip per image step [m] allowed by the batch problems (the filter's "
                   "window and the refinement); eq. (14) has none. Raise it for a robot that "
-                  "slips sideways (docs/calib.md, \"lateral sigma\")")
+                  "slips sideways (docs/theory/refinement.md#odometry-factor)")
       ->check(kPositive)
       ->capture_default_str()
       ->group(gm);

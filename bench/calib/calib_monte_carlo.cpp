@@ -2,7 +2,7 @@
 // trajectory from the paper's rough prior; errors against truth, RMS against the
 // Cramer-Rao bound, NEES against the chi-square interval. Filter alone and with the batch
 // refinement; with --refine also both with the covariances after the noise check
-// (calib::calibrate, docs/calib.md "The noise check").
+// (calib::calibrate, docs/theory/noise-check.md).
 //
 //   calib_monte_carlo [--runs 50] [--sigma-deg 0.3] [--init anchored|inverse|naive]
 //                     [--inflation 1] [--iterations 3] [--trajectory paper|zigzag]
@@ -16,9 +16,9 @@
 // --correlation A: AR(1) coefficient of each track's bearing errors from frame to frame.
 // --lateral M: sideways slip per step allowed by the batch problems (window, refinement).
 // --break P: each track gets a new id with probability P per frame (a tracker that loses
-//   lines and finds them again; docs/calib.md, "Pieces of one line").
+//   lines and finds them again; docs/theory/association.md#pieces-of-one-line).
 // --model-sigma-deg S: the bearing sigma the filter and the batches assume (default: the
-//   simulated one), to study the noise check (docs/calib.md, "The noise check").
+//   simulated one), to study the noise check (docs/theory/noise-check.md).
 // --bias-deg B: a constant bearing error per line, sigma B degrees (SyntheticRunOptions::
 //   track_bias_sigma); --model-bias-deg B: the one the estimators assume (Options::
 //   track_bias_sigma; default: the simulated one).

@@ -360,7 +360,7 @@ void LineExtractor::refit_crowded_lines(const MirrorCircle& circle) {
   // Step 5 again for the lines that have a neighbour: each angle is refitted from its support
   // pixels at radii where every other candidate line is at least isolation_px away, so that
   // no pixel whose Sobel window or sub-pixel parabola reaches into the other edge's gradient
-  // biases the angle (docs/extraction.md, "Edges close to another"). The neighbours are the
+  // biases the angle (docs/theory/extraction.md#edges-close-to-another). The neighbours are the
   // other candidate peaks and, on each side, a line of same-polarity edge pixels just outside
   // the support that made no peak of its own (a door leaf 0.6 degree from its frame: one
   // peak, whose fit those pixels pull). A line whose neighbour is that close over most of its

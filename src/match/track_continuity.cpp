@@ -1,5 +1,5 @@
 // Track continuity of the tracker (TrackerOptions::continuity_tolerance, continuity_model,
-// confirm_f1; docs/tracking.md Sec. 3): the prediction of a track's bearing in the new frame,
+// confirm_f1; docs/theory/matching.md): the prediction of a track's bearing in the new frame,
 // the checks against it, and the rates each observation carries.
 #include <algorithm>
 #include <cmath>

@@ -63,7 +63,7 @@ TrackerOptions recommended_tracker_options(double wheel_base) {
   o.continuity_model = TrackerOptions::ContinuityModel::kTrack;
   o.match.f1 = 0.6;
   o.look_back_f1 = 0.5;
-  // Confirmed F1 (docs/tracking.md Sec. 3): with the extractor's finer peaks it brings
+  // Confirmed F1 (docs/theory/matching.md): with the extractor's finer peaks it brings
   // the corridor's false new entries under target at little cost in false matches.
   o.confirm_f1 = 1.05;
   o.confirm_tolerance = deg2rad(0.3);

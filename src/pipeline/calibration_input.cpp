@@ -44,7 +44,7 @@ DatasetRun calibration_run_from_tracks(const dataset::Dataset& data,
   // turn moves it as it moved. (Eq. 14 once over such a frame puts the robot 0.47 mm to the
   // side of where it went, simulator's paper trajectory, frame 61; the batch allows 0.01 mm
   // of side slip per frame, and the 0.47 mm went into rho: -0.3 mm of bias over 50 runs in
-  // both worlds, docs/calib.md.)
+  // both worlds, docs/theory/filter.md#each-frames-motion-from-its-wheel-samples.)
   const double e = data.wheel_sensor().wheel_base;
   std::vector<Eigen::Vector2d> steps;
   for (std::size_t i = 1; i < n; ++i) {

@@ -2,7 +2,7 @@
 # checked against its ground truth (summary.json). CASE names the run.
 #
 # The filter's batch window solved from several starts (calib::Options::bootstrap_starts,
-# docs/calib.md "Window starts"), CASE prior and flow:
+# docs/theory/window.md#starts), CASE prior and flow:
 # - prior: the office, zigzag, seed 11 run, whose window solved from the prior alone ends in a
 #   local minimum (measured before the fix: camera yaw 2.0 degrees off, NEES 9175);
 # - flow: the corridor, zigzag, seed 57 run with the camera mounted at -107.5 degrees of yaw

@@ -108,7 +108,7 @@ if(MODE STREQUAL "end_to_end")
   if(NOT out MATCHES "error vs ground truth \\(refinement\\)")
     fail("stdout lacks the comparison with the ground truth: ${out}")
   endif()
-  # The noise check (docs/calib.md): made, a positive scale over the tracks, and the
+  # The noise check (docs/theory/noise-check.md): made, a positive scale over the tracks, and the
   # refinement's reported covariance is the checked one when the check rejected the model,
   # the model's otherwise.
   string(JSON checked GET "${json}" noise_check checked)

@@ -31,22 +31,19 @@ struct CalibrateOptions {
   // checked minus the model covariance of its own check), but only when the tracker kept its
   // lines: at most noise_check_lower_max_joins pieces joined per track checked. A tracker that
   // loses lines leaves pieces of one line that the joins miss, independent tracks to the
-  // check, which then reads less noise than there is: shrunk without this guard, runs with
-  // tracks broken every ~10 frames became overconfident (session 13: corridor, paper
-  // trajectory, refinement 3.25 -> 4.12, 25 runs), with it they are untouched (they join
-  // 2.6-7.4 pieces per track, medians by row; our tracker's runs from pixels at most 0.6),
-  // and the corridor's runs from pixels come closer to the NEES interval (200 seeds: 2.31 ->
-  // 2.48; docs/calib.md, "The noise check", session 14). Otherwise the verdict is reported
-  // and the covariances kept (noise_check_line names the sigma the data want).
+  // check, which then reads less noise than there is: runs with tracks broken every ~10
+  // frames join 2.6-7.4 pieces per track (our tracker's runs from pixels at most 0.6), and
+  // shrunk they would be overconfident (docs/theory/noise-check.md#verdicts). Otherwise the
+  // verdict is reported and the covariances kept (noise_check_line names the sigma the data
+  // want).
   // false: no check, the model's covariances.
   bool noise_check = true;
   // The levels of noise_check_verdict's two sides. "More noise" at 1%: enlarging sigmas that
   // were right costs accuracy nowhere and is rare. "Less noise" at 20%: when the model is
   // right, 1 run in 5 is shrunk, a mean NEES 0.10-0.15 higher (synthetic, 0.03 degree, 200
-  // runs: paper 2.92 -> 3.02, zigzag 2.81 -> 2.96, inside [2.67, 3.35]); where the model's
+  // runs: still inside the 95% interval [2.67, 3.35]); where the model's
   // sigma is too large, most runs are (from pixels, corridor, paper trajectory, 188 of 200
-  // runs, mean NEES 2.48 / 2.53 -> 2.65 / 2.71; at 1% 74 of 200). Session 15, docs/calib.md
-  // "The noise check".
+  // runs; at 1% 74 of 200; docs/theory/noise-check.md#verdicts).
   double noise_check_level = 0.01;
   double noise_check_lower_level = 0.2;
   // Pieces joined per track checked above which "less noise" is reported, not applied (< 0:
@@ -121,7 +118,7 @@ CalibrationResult calibrate(const CalibrationRun& run,
 // ellipsoid (squared Mahalanobis distance under the filter's covariance above 16.27,
 // chi-square with 3 degrees of freedom): the filter is biased or overconfident on this run,
 // and the refinement's answer is the one to trust (seen where tracks slip onto a
-// neighbouring line, docs/calib.md).
+// neighbouring line, docs/theory/association.md#slipped-tracks).
 // A warning, too, when the wheel check (WheelCheck, at the refinement or at the filter's
 // noise check) finds a systematic wheel error, with its size and what to correct.
 std::vector<std::string> result_warnings(const CalibrationResult& result);
@@ -130,7 +127,7 @@ std::vector<std::string> result_warnings(const CalibrationResult& result);
 // check's (not made: ok = false).
 const WheelCheck& wheel_check_of(const CalibrationResult& result);
 
-// DIR/extrinsics.yaml of issue 5: phi, rho, psi, sigma_phi, sigma_rho, sigma_psi, covariance
+// DIR/extrinsics.yaml (docs/outputs.md): phi, rho, psi, sigma_phi, sigma_rho, sigma_psi, covariance
 // (3x3, row-major), x, y, yaw (= phi + psi), T_base_cam (4x4), observable, crlb_phi,
 // crlb_rho, crlb_psi (.inf when not determined), plus source (filter / refinement) and
 // message. Written to a temporary file and renamed, so a partial file never looks complete.

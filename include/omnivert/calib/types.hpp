@@ -88,18 +88,20 @@ struct Options {
   double odometry_K = 1e-5;                // [m]
   // Factor on K. The paper (Sec. 8.2, before eq. 31) uses 5, "to make the method robust with
   // respect to the system non-linearities"; our feature initialisation already keeps the filter
-  // consistent from the rough prior at 1, and 5 costs efficiency when K is right (docs/calib.md,
-  // "The odometry inflation"): 1 by default, the paper's 5 one option away.
+  // consistent from the rough prior at 1, and 5 costs efficiency when K is right
+  // (docs/theory/filter.md#odometry-noise): 1 by default; paper_options() sets 5.
   double odometry_inflation = 1.0;
   double odometry_variance_floor = 1e-12;  // [m^2], keeps the noise positive at rest
   // Camera.
-  double bearing_sigma = 0.3 * 3.14159265358979323846 / 180.0;  // [rad]
+  // [rad] The paper's 0.3 degree (Sec. 8.2). recommended_options() sets the 0.025 degree that
+  // our extractor's bearings have on rendered images (docs/theory/filter.md#observation).
+  double bearing_sigma = 0.3 * 3.14159265358979323846 / 180.0;
   // [rad] A constant bearing error per track, b ~ N(0, track_bias_sigma^2) (0: none). Each
   // bearing is then predicted as eq. (30) + b, with bearing_sigma the error that changes from
   // frame to frame. The filter carries b as one more entry of the track's block
   // (FeatureSlot::bias); the batch problems (window, refinement, bound) as one parameter per
   // track with that prior. Against the ground truth our extractor's bearings have both parts
-  // (docs/calib.md, "Per-track bearing bias").
+  // (docs/theory/filter.md#per-track-bias).
   double track_bias_sigma = 0.0;
   // Prior on (phi, rho, psi): the paper's hand measurement with wide sigmas.
   Extrinsics prior{0.0, 0.2, 0.0};
@@ -112,9 +114,9 @@ struct Options {
   double max_feature_distance = 20.0;  // [m]
   // A feature that a batch solve (window, refinement) puts closer than this to the camera at
   // a frame that sees it has collapsed onto the camera, where its bearing (eq. 30) is not
-  // defined and its information without bound (synthetic, tracks broken every ~10 frames, 0.1
-  // degree, seed 2: a feature 3e-9 m from the camera, information 1e21 on rho, the filter's
-  // sigmas 1e-6 and its NEES 2.7e7). Such a feature is left out with its bearings.
+  // defined and its information without bound (the filter's sigmas collapse; regression test
+  // CalibrationFilter.AFeatureCollapsedOntoTheCameraIsLeftOut). Such a feature is left out
+  // with its bearings.
   double min_feature_range = 0.05;  // [m]
   double convert_ratio = 0.05;         // sigma_D / D below which (q, theta) -> (D, theta); 0: never
   // Delayed initialisation (kAnchoredInverseDepth only): the frames up to the first turn are
@@ -125,14 +127,14 @@ struct Options {
   // not. The window ends at the first frame whose dead-reckoned heading differs from the
   // window's first by bootstrap_rotation, or after bootstrap_max_frames frames (or at
   // finish()). bootstrap_rotation <= 0: no window (the undelayed anchored initialisation).
-  double bootstrap_rotation = 1.5;  // [rad] (measured: 0.1 ... 2.0, docs/calib.md)
+  double bootstrap_rotation = 1.5;  // [rad] (docs/theory/window.md#where-the-window-ends)
   int bootstrap_min_frames = 5;
   int bootstrap_max_frames = 300;
   double bootstrap_depth_prior_scale = 100.0;  // window's inverse-depth prior sigma, x sigma_q
   // Starts of the window's solve (1-5): the prior, then phi moved by -0.5, +0.5, -1 and +1 rad
-  // (psi the other way), in that order; the lowest cost is kept (docs/calib.md). Where the
-  // bearings' flow puts the camera yaw far from the prior's (camera_yaw_from_flow), the same
-  // starts are solved at the flow's camera yaw as well.
+  // (psi the other way), in that order; the lowest cost is kept (docs/theory/window.md#starts).
+  // Where the bearings' flow puts the camera yaw far from the prior's (camera_yaw_from_flow),
+  // the same starts are solved at the flow's camera yaw as well.
   int bootstrap_starts = 5;
   // Tracks that slipped onto a neighbouring line are split in the window's solve, with the
   // refinement's test (BatchOptions::split_chi2, which has the same default); 0: off.
@@ -151,18 +153,17 @@ struct Options {
   // known (converted, convert_ratio) and which is not seen in this frame, is predicted (its
   // first bearing within the gate of that feature and of no other, no other new track
   // claiming it, and no feature seen in this frame within crossing_guard of it) continues
-  // that feature. Without this each piece was a feature of its own and
-  // the filter was overconfident (tracks broken every ~10 frames: NEES 9.0; docs/calib.md,
-  // "Broken tracks"). false: off.
+  // that feature. Kept apart, the pieces act as independent features and the filter is
+  // overconfident (docs/theory/association.md#pieces-of-one-line). false: off.
   bool join_pieces = true;
   int min_track_length = 3;         // batch/observability: shorter tracks are ignored
   // Crossing guard [rad]: a bearing is not used while another feature's predicted bearing
   // is within this angle of its own (filter: features in the state; batches: tracks over
   // their span). The extractor merges two lines that close into one detection, whose
-  // bearing is pulled towards the other line (docs/calib.md, "Lines that cross"); 0: off.
-  // 0.75 degree: from pixels, bearings within 0.5-0.75 degree of another line are off by
-  // 0.04-0.08 degree RMS, against 0.01-0.03 beyond 1 degree; 1 degree left out up to two
-  // thirds of the hall's bearings (docs/calib.md).
+  // bearing is pulled towards the other line; 0: off. 0.75 degree: from pixels, bearings
+  // within 0.5-0.75 degree of another line are off by 0.04-0.08 degree RMS, against 0.01-0.03
+  // beyond 1 degree; 1 degree leaves out up to two thirds of the hall's bearings
+  // (docs/theory/association.md#lines-that-cross).
   double crossing_guard = 0.75 * 3.14159265358979323846 / 180.0;
 
   // True when usable; otherwise false with the reason in *why (may be null).

@@ -24,7 +24,7 @@ struct VerticalLine {
   // its length, so that their gradients overlap and the angle is pulled towards or pushed
   // from it (rendered door frames and their leaves 0.6-0.75 degree apart: 0.04-0.13 degree).
   // Left for the user to judge: the calibration uses them (leaving them out was measured and
-  // not better: docs/extraction.md, "Edges close to another").
+  // not better: docs/theory/extraction.md#edges-close-to-another).
   bool crowded = false;
 };
 

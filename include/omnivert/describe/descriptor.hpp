@@ -20,7 +20,7 @@
 // - normalisation unit: the pair H_i = [H_iL, H_iR] of eq. (3) (kPerPair, three 64-vectors)
 //   or each half (kPerHalf, six 32-vectors).
 // The defaults were chosen by measuring nearest-neighbour matching on rotated and re-lit
-// images (docs/descriptor.md gives the numbers).
+// images (docs/theory/descriptor.md#measurements gives the numbers).
 
 #include <span>
 #include <string>

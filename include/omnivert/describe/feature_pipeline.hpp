@@ -26,7 +26,7 @@ struct FeaturePipelineOptions {
   // A centre given in sensor.yaml is used as given on every frame: it is the camera's
   // calibration, and the rim fit that would replace it is pulled by the scene just inside the
   // rim (rendered tours: 0.0065 px along the robot's axis in every world, which moved the
-  // calibrated camera 0.14 mm forward; docs/extraction.md, "A given centre"). True: the given
+  // calibrated camera 0.14 mm forward; docs/theory/extraction.md#a-given-centre). True: the given
   // centre only seeds the search, and the centre is fitted and tracked as without it.
   bool refine_given_center = false;
 

@@ -1,6 +1,6 @@
 #pragma once
 // Tracking evaluation against ground truth: the paper's Table 3 (Sec. 9.1), detection recall
-// of long lines and bearing error. The rules (docs/tracking.md, "Evaluation"):
+// of long lines and bearing error. The rules (docs/tracking.md#evaluation):
 //
 //  1. Association: a detection is associated to the ground-truth line of the same frame whose
 //     bearing is nearest (wrapped difference), if that difference is at most 1 degree

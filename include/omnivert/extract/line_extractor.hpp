@@ -57,7 +57,7 @@ struct LineExtractorOptions {
   // at least this far (pixels) from every other candidate: nearer, the 3x3 Sobel window and
   // the 3-pixel sub-pixel parabola reach into the other edge's gradient, which pushes the two
   // edges of a thin bar apart (drawn bars 1 degree wide: each edge 0.015 degree outwards;
-  // docs/extraction.md, "Edges close to another"). Kept only when at least a fifth of the
+  // docs/theory/extraction.md#edges-close-to-another). Kept only when at least a fifth of the
   // support's weight is that far; otherwise the line is marked crowded (VerticalLine). 0: off.
   double isolation_px = 3.0;
   // Step 4's peak score sums the votes of 2 * peak_window + 1 sectors, and a peak must beat
@@ -65,7 +65,7 @@ struct LineExtractorOptions {
   // sector, peaks at least 2 sectors = 1 degree apart) resolve two edges 1 degree apart, which
   // a door frame and its leaf often are; with 1 and 2 (a 1.5-degree score, peaks 1.5 degrees
   // apart) extraction finds one of the two in each frame, whichever is stronger, and trackers
-  // link them (docs/extraction.md, "Angular resolution").
+  // link them (docs/theory/extraction.md#sector-votes-and-peaks).
   int peak_window = 0;
   int nms_radius = 1;
 

@@ -1,6 +1,6 @@
 #pragma once
 // A gate on the bearing change of a static world vertical line between two frames, from the
-// wheel travel alone: no extrinsics needed (docs/tracking.md, "Odometry gate").
+// wheel travel alone: no extrinsics needed (docs/theory/matching.md#odometry-gate).
 //
 // Bearing model, eqs. (16)-(17) (docs/theory/conventions.md):
 //   beta = atan2(y_f - y_C, x_f - x_C) - (theta_R + phi + psi).

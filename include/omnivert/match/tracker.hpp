@@ -21,7 +21,7 @@
 //  - odometry gate (odometry_gate.hpp): an accepted match whose bearing change contradicts
 //    the wheel travel since the candidate frame is vetoed; the line goes on looking back.
 //  - same polarity, gate-restricted candidates, track continuity, look-back F1, heads only,
-//    confirmed F1: see TrackerOptions and docs/tracking.md Sec. 3 (recommended_tracker_options()
+//    confirmed F1: see TrackerOptions and docs/theory/matching.md (recommended_tracker_options()
 //    turns on mutual, the gate, same polarity and continuity with the track model, with F1 0.6,
 //    look-back F1 0.5 and confirmed F1 1.05 at 0.3 degree).
 //
@@ -48,12 +48,12 @@ struct TrackerOptions {
   // mutual check) are taken among the lines the gate admits, instead of the gate vetoing the
   // nearest of all lines afterwards. Test 2's mean stays over all lines of the frame. A
   // look-alike that the wheels rule out then neither wins nor makes the true line fail test 3
-  // (docs/tracking.md, measured there).
+  // (docs/theory/matching.md, measured there).
   bool gate_candidates = false;
   // Candidates of the opposite edge polarity (VerticalLine::polarity; 0 = unknown matches
   // anything) are left out of tests 1-3 and the mutual check. The two sides of a thin door
   // frame look alike to the descriptor but have opposite polarities: where extraction finds
-  // them in turn, the paper's rules link them (docs/tracking.md, measured there).
+  // them in turn, the paper's rules link them (docs/theory/matching.md, measured there).
   bool same_polarity = false;
   // Track continuity (needs the odometry gate's wheel data; 0 = off): a link to track T is
   // refused when the new bearing deviates from T's predicted one by more than this (radians)
@@ -62,7 +62,7 @@ struct TrackerOptions {
   // observation's own link when it spans at most 3 frames (otherwise the link is not checked).
   // It targets two close edges that extraction finds in turn.
   double continuity_tolerance = 0.0;
-  // How track continuity predicts (docs/tracking.md Sec. 3):
+  // How track continuity predicts (docs/theory/matching.md):
   //  - kLink: the parallax per metre of the observation linked to, measured on its own link
   //    when that spans at most 3 frames; links to other observations are not checked, and
   //    rotation is covered by the gate's camera-swing bound alone.
@@ -79,13 +79,13 @@ struct TrackerOptions {
   double continuity_turn_curvature = 0.3;  // rad per rad^2 (kTrack)
   // Test 1 for links across a look-back gap (frames t-2 .. t-look_back): min D_i <= this
   // (0 = F1, as in the paper). Descriptors of a line change with the viewpoint; a link across
-  // a gap is less certain and needs a closer descriptor (docs/tracking.md Sec. 3).
+  // a gap is less certain and needs a closer descriptor (docs/theory/matching.md).
   double look_back_f1 = 0.0;
   // Look-back links only to a track's latest observation: a line of frame t-k (k >= 2) whose
   // track was observed again in frames t-k+1 .. t-1 cannot be linked to (the line then goes on
   // looking back). Look-back bridges frames where a line was missed; a link to an older
   // observation of a track seen since would fork it (two lines that extraction finds in turn
-  // become one track; docs/tracking.md Sec. 3).
+  // become one track; docs/theory/matching.md).
   bool heads_only = false;
   // Confirmed F1 (needs track continuity; 0 = off): a link whose descriptor distance fails
   // test 1 (F1, or look_back_f1 across a gap) but is at most confirm_f1 is accepted when tests
@@ -93,7 +93,7 @@ struct TrackerOptions {
   // the new bearing is within confirm_tolerance (plus the model's curvature terms) of the
   // prediction, and no other line of the new frame is within continuity_tolerance of it. A
   // line's descriptor changes fastest where its bearing does (near lines); there the
-  // geometry is most telling (docs/tracking.md Sec. 3).
+  // geometry is most telling (docs/theory/matching.md).
   double confirm_f1 = 0.0;
   double confirm_tolerance = 0.0;  // radians
 
@@ -102,7 +102,7 @@ struct TrackerOptions {
 
 // The paper's tracker alone: tests 1-3 with Table 2's factors, look-back 20 (Sec. 9.1).
 TrackerOptions paper_tracker_options();
-// What we recommend (docs/tracking.md, measured there): the paper's rules with F1 = 0.6 and
+// What we recommend (docs/theory/matching.md, measured there): the paper's rules with F1 = 0.6 and
 // 0.5 across a look-back gap, plus the mutual constraint, same edge polarity, and the odometry
 // gate with track continuity (track model, 0.8 degree) and confirmed F1 (1.05 where the track
 // predicts the line to 0.3 degree) when the wheel base is known (wheel_base > 0; pass 0 when

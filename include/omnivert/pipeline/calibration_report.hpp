@@ -48,7 +48,7 @@ struct ReportInputs {
   bool wrote_extrinsics = false;
 };
 
-// One line on the noise check (docs/calib.md, "The noise check"), for the terminal and the
+// One line on the noise check (docs/theory/noise-check.md), for the terminal and the
 // report: over how many tracks, the independent noise the errors act as, and what was done;
 // empty when no check was made.
 std::string noise_check_line(const CalibrationResult& result);
