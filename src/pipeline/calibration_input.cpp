@@ -25,20 +25,14 @@ std::size_t sample_before(const std::vector<dataset::WheelRecord>& w, std::int64
 
 }  // namespace
 
-DatasetRun calibration_run_from_tracks(const dataset::Dataset& data,
-                                       const std::vector<TrackRow>& rows,
-                                       const DatasetRunOptions& opt) {
-  if (!data.has_wheel())
-    throw InputError(data.root() + "/wheel0", 0,
-                     "calibration needs wheel odometry (wheel0/data.csv and wheel0/sensor.yaml)");
+namespace {
+
+// Wheel travel per frame (eq. 14-15's inputs), and the heading for the motion summary.
+void add_frame_motion(const dataset::Dataset& data, DatasetRun& out) {
   const auto& images = data.images();
   const auto& travel = data.travel_at_images();
   const auto& wheel = data.wheel();
   const std::size_t n = images.size();
-  DatasetRun out;
-  out.run.frames.resize(n);
-
-  // Wheel travel per frame (eq. 14-15's inputs), and the heading for the motion summary.
   // Every wheel sample between two images is used: eq. (14) per sample, composed
   // (compose_wheel_steps), so that a frame in which the robot ends a straight and starts to
   // turn moves it as it moved. (Eq. 14 once over such a frame puts the robot 0.47 mm to the
@@ -67,7 +61,15 @@ DatasetRun calibration_run_from_tracks(const dataset::Dataset& data,
     if (e > 0) out.rotation += std::abs((f.d_right - f.d_left) / e);
   }
 
-  // Wheel gaps: an image whose bracketing wheel samples are further apart than the limit.
+}
+
+// Wheel gaps: an image whose bracketing wheel samples are further apart than the limit.
+// Returns, per frame, whether its bearings are left out.
+std::vector<char> wheel_gaps(const dataset::Dataset& data, const DatasetRunOptions& opt,
+                             DatasetRun& out) {
+  const auto& images = data.images();
+  const auto& wheel = data.wheel();
+  const std::size_t n = images.size();
   std::vector<char> gap(n, 0);
   {
     int gap_first = -1, gap_last = -1;
@@ -111,7 +113,13 @@ DatasetRun calibration_run_from_tracks(const dataset::Dataset& data,
     flush();
   }
 
-  // Track lengths (short tracks carry no parallax) and double claims.
+  return gap;
+}
+
+// Track lengths (short tracks carry no parallax) and double claims; the bearings used.
+void add_bearings(const std::vector<TrackRow>& rows, const std::vector<char>& gap,
+                  const DatasetRunOptions& opt, DatasetRun& out) {
+  const std::size_t n = out.run.frames.size();
   std::map<std::int64_t, int> length;
   std::map<std::pair<std::int64_t, std::int64_t>, int> per_frame;  // (frame, track) -> count
   for (const TrackRow& r : rows) {
@@ -144,7 +152,13 @@ DatasetRun calibration_run_from_tracks(const dataset::Dataset& data,
                            "it); those bearings were not used (the recommended rules prevent it)");
   }
 
-  // Starved stretches: too few lines for too long.
+}
+
+// Starved stretches: too few lines for too long (a warning); no frame with lines at all is
+// an InputError.
+void check_starved(const dataset::Dataset& data, const DatasetRunOptions& opt, DatasetRun& out) {
+  const auto& images = data.images();
+  const std::size_t n = images.size();
   int starved_first = -1, frames_with_lines = 0;
   auto starved_flush = [&](std::size_t end) {  // [starved_first, end)
     if (starved_first < 0) return;
@@ -178,15 +192,23 @@ DatasetRun calibration_run_from_tracks(const dataset::Dataset& data,
                          " or more tracked lines: nothing to calibrate from (check the images "
                          "with `omnivert extract`, or the annulus in cam0/sensor.yaml)");
   }
-  return out;
 }
 
-Options options_from_dataset(const dataset::Dataset& data, Options base) {
-  if (data.has_wheel()) {
-    base.wheel_base = data.wheel_sensor().wheel_base;
-    if (data.wheel_sensor().odometry_k) base.odometry_K = *data.wheel_sensor().odometry_k;
-  }
-  return base;
+}  // namespace
+
+DatasetRun calibration_run_from_tracks(const dataset::Dataset& data,
+                                       const std::vector<TrackRow>& rows,
+                                       const DatasetRunOptions& opt) {
+  if (!data.has_wheel())
+    throw InputError(data.root() + "/wheel0", 0,
+                     "calibration needs wheel odometry (wheel0/data.csv and wheel0/sensor.yaml)");
+  DatasetRun out;
+  out.run.frames.resize(data.images().size());
+  add_frame_motion(data, out);
+  const std::vector<char> gap = wheel_gaps(data, opt, out);
+  add_bearings(rows, gap, opt, out);
+  check_starved(data, opt, out);
+  return out;
 }
 
 }  // namespace omnivert::calib

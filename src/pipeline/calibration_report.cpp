@@ -172,14 +172,9 @@ std::string wheel_check_line(const CalibrationResult& r) {
   return buf;
 }
 
-std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
-  json j;
-  j["tool"] = "omnivert calibrate";
-  j["dataset"] = in.dataset;
-  j["command"] = in.command;
-  j["exit_code"] = in.exit_code;
-  j["forced"] = in.force;
-  j["wrote_extrinsics"] = in.wrote_extrinsics;
+namespace {
+
+json inputs_json(const CalibrationResult& r, const ReportInputs& in) {
   json inputs;
   inputs["frames"] = in.frames;
   inputs["frames_skipped"] = in.frames_skipped;
@@ -207,10 +202,11 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
                      {"sigma_phi", num(in.options.prior_sigma(0))},
                      {"sigma_rho", num(in.options.prior_sigma(1))},
                      {"sigma_psi", num(in.options.prior_sigma(2))}};
-  j["inputs"] = inputs;
+  return inputs;
+}
 
-  const ObservabilityReport& o = r.observability;
-  j["observability"] = {{"observable", o.all_determined()},
+json observability_json(const ObservabilityReport& o) {
+  return {{"observable", o.all_determined()},
                         {"phi", verdict_json(o.phi)},
                         {"rho", verdict_json(o.rho)},
                         {"psi", verdict_json(o.psi)},
@@ -222,89 +218,110 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
                         {"heading_range_deg", num(rad2deg(o.heading_range))},
                         {"heading_noise_deg", num(rad2deg(o.heading_noise))},
                         {"message", o.message}};
-  j["filter"] = extrinsics_json(r.filter.extrinsics, r.filter.covariance);
-  {
+}
+
+json filter_json(const FilterResult& f) {
+  json j = extrinsics_json(f.extrinsics, f.covariance);
     // Tracks split in the filter's bootstrap window (they slipped onto a neighbouring line).
-    j["filter"]["tracks_split"] = r.filter.splits.size();
-    j["filter"]["tracks_joined"] = r.filter.joins.size();
-    j["filter"]["joins"] = joins_json(r.filter.joins);
-    j["filter"]["window_frames"] = r.filter.window_frames;
-    j["filter"]["window_solved"] = r.filter.window_frames > 0 && r.filter.window_failure.empty();
-    if (!r.filter.window_failure.empty()) j["filter"]["window_failure"] = r.filter.window_failure;
-    j["filter"]["splits"] = splits_json(r.filter.splits);
-    // Bearings left out where lines cross (Options::crossing_guard), window and EKF.
-    j["filter"]["bearings_guarded"] = r.filter.guarded.size();
-    // Refused by the chi-square gate (outliers), window and EKF.
-    j["filter"]["bearings_rejected"] = r.filter.rejected.size();
-  }
-  if (r.refined) {
-    json ref = extrinsics_json(r.refinement.extrinsics, r.refinement.covariance);
-    ref["converged"] = r.refinement.converged;
-    ref["covariance_ok"] = r.refinement.covariance_ok;
-    ref["covariance_from_information"] = r.covariance_from_information;
-    ref["iterations"] = r.refinement.iterations;
-    ref["bearings_used"] = r.refinement.num_bearings;
-    ref["bearings_rejected"] = r.refinement.num_rejected;
-    ref["bearings_guarded"] = r.refinement.guarded.size();
-    ref["tracks_split"] = r.refinement.num_splits;
-    ref["features"] = r.refinement.num_features;
-    ref["splits"] = splits_json(r.refinement.splits);
-    ref["tracks_merged"] = r.refinement.merges.size();
-    ref["merges"] = joins_json(r.refinement.merges);
-    ref["bearing_residual_sigma_deg"] = num(rad2deg(r.refinement.bearing_residual_sigma));
-    ref["initial_cost"] = num(r.refinement.initial_cost);
-    ref["final_cost"] = num(r.refinement.final_cost);
-    j["refinement"] = ref;
-  }
+  j["tracks_split"] = f.splits.size();
+  j["tracks_joined"] = f.joins.size();
+  j["joins"] = joins_json(f.joins);
+  j["window_frames"] = f.window_frames;
+  j["window_solved"] = f.window_frames > 0 && f.window_failure.empty();
+  if (!f.window_failure.empty()) j["window_failure"] = f.window_failure;
+  j["splits"] = splits_json(f.splits);
+  // Bearings left out where lines cross (Options::crossing_guard), window and EKF.
+  j["bearings_guarded"] = f.guarded.size();
+  // Refused by the chi-square gate (outliers), window and EKF.
+  j["bearings_rejected"] = f.rejected.size();
+  return j;
+}
+
+json refinement_json(const CalibrationResult& r) {
+  json ref = extrinsics_json(r.refinement.extrinsics, r.refinement.covariance);
+  ref["converged"] = r.refinement.converged;
+  ref["covariance_ok"] = r.refinement.covariance_ok;
+  ref["covariance_from_information"] = r.covariance_from_information;
+  ref["iterations"] = r.refinement.iterations;
+  ref["bearings_used"] = r.refinement.num_bearings;
+  ref["bearings_rejected"] = r.refinement.num_rejected;
+  ref["bearings_guarded"] = r.refinement.guarded.size();
+  ref["tracks_split"] = r.refinement.num_splits;
+  ref["features"] = r.refinement.num_features;
+  ref["splits"] = splits_json(r.refinement.splits);
+  ref["tracks_merged"] = r.refinement.merges.size();
+  ref["merges"] = joins_json(r.refinement.merges);
+  ref["bearing_residual_sigma_deg"] = num(rad2deg(r.refinement.bearing_residual_sigma));
+  ref["initial_cost"] = num(r.refinement.initial_cost);
+  ref["final_cost"] = num(r.refinement.final_cost);
+  return ref;
+}
+
+json noise_check_json(const CalibrationResult& r) {
+  const BatchNoiseCheck& n = r.noise;
+  json nc;
+  nc["checked"] = r.noise_checked;
+  nc["applied"] = r.noise_applied;  // the reported covariance is the checked one
+  nc["verdict"] = verdict_name(r.noise_verdict);
+  // The levels of the verdict's sides (CalibrateOptions::noise_check_level, _lower_level).
+  nc["level_more_noise"] = r.noise_check_level;
+  nc["level_less_noise"] = r.noise_check_lower_level;
+  nc["scale"] = num(n.ok ? n.scale : NAN);
+  nc["tracks"] = n.clusters;
+  nc["effective_bearing_sigma_deg"] = num(rad2deg(effective_bearing_sigma(r)));
+  nc["effective_track_bias_sigma_deg"] = num(rad2deg(effective_track_bias_sigma(r)));
+  nc["variance_ratio"] = num(r.noise_checked ? r.noise_ratio : NAN);  // 1 when not applied
+  nc["of"] = r.refined && r.refinement.covariance_ok ? "refinement" : "filter";
+  nc["filter_scale"] = num(r.filter_noise.ok ? r.filter_noise.scale : NAN);
+  nc["filter_variance_ratio"] = num(r.filter_noise.ok ? r.filter_noise_ratio : NAN);
+  nc["filter_applied"] = r.filter_noise_applied;
+  nc["filter_verdict"] = verdict_name(r.filter_noise_verdict);
+  auto mat = [&](const Eigen::Matrix3d& m, bool ok) {
+    json a = json::array();
+    for (int i = 0; i < 9; ++i) a.push_back(num(ok && m.allFinite() ? m(i / 3, i % 3) : NAN));
+    return a;
+  };
+  nc["filter_model_covariance"] = mat(r.filter_model_covariance, true);
+  nc["refinement_model_covariance"] = mat(r.refinement_model_covariance, r.refined);
+  nc["batch_model_covariance"] = mat(n.model_covariance, n.ok);
+  nc["batch_checked_covariance"] = mat(n.covariance, n.ok);
+  // The Cramer-Rao bounds at the noise the check found: each bound times the square root of
+  // the checked over the model variance of that parameter.
+  auto checked = [&](double crlb, int i) {
+    return num(r.noise_checked ? crlb * std::sqrt(n.covariance(i, i) / n.model_covariance(i, i)) : NAN);
+  };
   {
-    const BatchNoiseCheck& n = r.noise;
-    json nc;
-    nc["checked"] = r.noise_checked;
-    nc["applied"] = r.noise_applied;  // the reported covariance is the checked one
-    nc["verdict"] = verdict_name(r.noise_verdict);
-    // The levels of the verdict's sides (CalibrateOptions::noise_check_level, _lower_level).
-    nc["level_more_noise"] = r.noise_check_level;
-    nc["level_less_noise"] = r.noise_check_lower_level;
-    nc["scale"] = num(n.ok ? n.scale : NAN);
-    nc["tracks"] = n.clusters;
-    nc["effective_bearing_sigma_deg"] = num(rad2deg(effective_bearing_sigma(r)));
-    nc["effective_track_bias_sigma_deg"] = num(rad2deg(effective_track_bias_sigma(r)));
-    nc["variance_ratio"] = num(r.noise_checked ? r.noise_ratio : NAN);  // 1 when not applied
-    nc["of"] = r.refined && r.refinement.covariance_ok ? "refinement" : "filter";
-    nc["filter_scale"] = num(r.filter_noise.ok ? r.filter_noise.scale : NAN);
-    nc["filter_variance_ratio"] = num(r.filter_noise.ok ? r.filter_noise_ratio : NAN);
-    nc["filter_applied"] = r.filter_noise_applied;
-    nc["filter_verdict"] = verdict_name(r.filter_noise_verdict);
-    auto mat = [&](const Eigen::Matrix3d& m, bool ok) {
-      json a = json::array();
-      for (int i = 0; i < 9; ++i) a.push_back(num(ok && m.allFinite() ? m(i / 3, i % 3) : NAN));
-      return a;
-    };
-    nc["filter_model_covariance"] = mat(r.filter_model_covariance, true);
-    nc["refinement_model_covariance"] = mat(r.refinement_model_covariance, r.refined);
-    nc["batch_model_covariance"] = mat(n.model_covariance, n.ok);
-    nc["batch_checked_covariance"] = mat(n.covariance, n.ok);
-    // The Cramer-Rao bounds at the noise the check found: each bound times the square root of
-    // the checked over the model variance of that parameter.
-    auto checked = [&](double crlb, int i) {
-      return num(r.noise_checked ? crlb * std::sqrt(n.covariance(i, i) / n.model_covariance(i, i)) : NAN);
-    };
-    {
-      const WheelCheck& w = wheel_check_of(r);
-      nc["wheels"] = {{"checked", w.ok},
-                      {"frames", w.frames},
-                      {"rotation_scale", num(w.ok ? w.rotation_scale : NAN)},
-                      {"sigma_rotation_scale", num(w.ok ? w.sigma_rotation_scale : NAN)},
-                      {"drift_deg_per_m", num(w.ok ? rad2deg(w.drift_per_m) : NAN)},
-                      {"sigma_drift_deg_per_m", num(w.ok ? rad2deg(w.sigma_drift_per_m) : NAN)},
-                      {"chi2", num(w.ok ? w.chi2 : NAN)},
-                      {"rejects_model", wheel_check_rejects_model(w)}};
-    }
-    nc["crlb_checked"] = {{"phi", checked(r.observability.phi.crlb, 0)},
-                          {"rho", checked(r.observability.rho.crlb, 1)},
-                          {"psi", checked(r.observability.psi.crlb, 2)}};
-    j["noise_check"] = nc;
+    const WheelCheck& w = wheel_check_of(r);
+    nc["wheels"] = {{"checked", w.ok},
+                    {"frames", w.frames},
+                    {"rotation_scale", num(w.ok ? w.rotation_scale : NAN)},
+                    {"sigma_rotation_scale", num(w.ok ? w.sigma_rotation_scale : NAN)},
+                    {"drift_deg_per_m", num(w.ok ? rad2deg(w.drift_per_m) : NAN)},
+                    {"sigma_drift_deg_per_m", num(w.ok ? rad2deg(w.sigma_drift_per_m) : NAN)},
+                    {"chi2", num(w.ok ? w.chi2 : NAN)},
+                    {"rejects_model", wheel_check_rejects_model(w)}};
   }
+  nc["crlb_checked"] = {{"phi", checked(r.observability.phi.crlb, 0)},
+                        {"rho", checked(r.observability.rho.crlb, 1)},
+                        {"psi", checked(r.observability.psi.crlb, 2)}};
+  return nc;
+}
+
+}  // namespace
+
+std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
+  json j;
+  j["tool"] = "omnivert calibrate";
+  j["dataset"] = in.dataset;
+  j["command"] = in.command;
+  j["exit_code"] = in.exit_code;
+  j["forced"] = in.force;
+  j["wrote_extrinsics"] = in.wrote_extrinsics;
+  j["inputs"] = inputs_json(r, in);
+  j["observability"] = observability_json(r.observability);
+  j["filter"] = filter_json(r.filter);
+  if (r.refined) j["refinement"] = refinement_json(r);
+  j["noise_check"] = noise_check_json(r);
   j["result"] = extrinsics_json(r.extrinsics, r.covariance);
   j["result"]["source"] = r.refined && r.refinement.covariance_ok ? "refinement" : "filter";
   if (in.truth) {
@@ -321,27 +338,12 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
   return j.dump(2) + "\n";
 }
 
-std::string report_html(const CalibrationResult& r, const ReportInputs& in) {
-  std::ostringstream h;
-  const ObservabilityReport& o = r.observability;
-  h << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>omnivert calibrate: "
-    << html_escape(in.dataset) << "</title>\n<style>body{font-family:sans-serif;max-width:1700px;"
-       "margin:1em auto;padding:0 1em}table{border-collapse:collapse;margin:0.5em 0}"
-       "td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}th{background:#eee}"
-       "td:first-child,th:first-child{text-align:left}.ok{color:#060}.bad{color:#a00}"
-       "img{max-width:100%;border:1px solid #ccc}</style></head><body>\n";
-  h << "<h1>Camera-to-odometry calibration</h1>\n";
-  h << "<p>Dataset <code>" << html_escape(in.dataset) << "</code>; command <code>"
-    << html_escape(in.command) << "</code>.</p>\n";
-  const bool obs = o.all_determined();
-  h << "<h2>Verdict</h2>\n<p class=\"" << (obs ? "ok" : "bad") << "\"><b>"
-    << (obs ? "Determined." : "Not determined.") << "</b> " << html_escape(o.message)
-    << "</p>\n";
-  if (!obs)
-    h << "<p>" << (in.force ? "--force was given: extrinsics.yaml was written anyway."
-                            : "extrinsics.yaml was not written (exit code 3); --force writes it.")
-      << "</p>\n";
+namespace {
 
+// The estimates (prior, filter, refinement, truth), the run's Cramer-Rao bounds, and the
+// errors against the truth when known.
+void html_estimates(std::ostringstream& h, const CalibrationResult& r, const ReportInputs& in) {
+  const ObservabilityReport& o = r.observability;
   h << "<h2>Estimates</h2>\n<table><tr><th></th><th>phi [deg]</th><th>rho [mm]</th><th>psi [deg]</th>"
        "<th>camera x [mm]</th><th>camera y [mm]</th><th>camera yaw [deg]</th></tr>\n";
   auto row = [&](const std::string& name, const Extrinsics& e, const Eigen::Matrix3d* C) {
@@ -382,6 +384,10 @@ std::string report_html(const CalibrationResult& r, const ReportInputs& in) {
     h << "</table>\n";
   }
 
+}
+
+// The run's inputs and what each stage did with them.
+void html_inputs(std::ostringstream& h, const CalibrationResult& r, const ReportInputs& in) {
   h << "<h2>Inputs</h2>\n<table>\n";
   auto kv = [&](const std::string& k, const std::string& v) {
     h << "<tr><td>" << k << "</td><td>" << html_escape(v) << "</td></tr>\n";
@@ -431,6 +437,33 @@ std::string report_html(const CalibrationResult& r, const ReportInputs& in) {
                          " joined to the line they continue");
   kv("time: tracking / calibration", f("%.1f s", in.seconds_tracking) + " / " + f("%.1f s", in.seconds_calibration));
   h << "</table>\n";
+}
+
+}  // namespace
+
+std::string report_html(const CalibrationResult& r, const ReportInputs& in) {
+  std::ostringstream h;
+  const ObservabilityReport& o = r.observability;
+  h << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>omnivert calibrate: "
+    << html_escape(in.dataset) << "</title>\n<style>body{font-family:sans-serif;max-width:1700px;"
+       "margin:1em auto;padding:0 1em}table{border-collapse:collapse;margin:0.5em 0}"
+       "td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}th{background:#eee}"
+       "td:first-child,th:first-child{text-align:left}.ok{color:#060}.bad{color:#a00}"
+       "img{max-width:100%;border:1px solid #ccc}</style></head><body>\n";
+  h << "<h1>Camera-to-odometry calibration</h1>\n";
+  h << "<p>Dataset <code>" << html_escape(in.dataset) << "</code>; command <code>"
+    << html_escape(in.command) << "</code>.</p>\n";
+  const bool obs = o.all_determined();
+  h << "<h2>Verdict</h2>\n<p class=\"" << (obs ? "ok" : "bad") << "\"><b>"
+    << (obs ? "Determined." : "Not determined.") << "</b> " << html_escape(o.message)
+    << "</p>\n";
+  if (!obs)
+    h << "<p>" << (in.force ? "--force was given: extrinsics.yaml was written anyway."
+                            : "extrinsics.yaml was not written (exit code 3); --force writes it.")
+      << "</p>\n";
+
+  html_estimates(h, r, in);
+  html_inputs(h, r, in);
   if (!in.warnings.empty()) {
     h << "<h2>Warnings</h2>\n<ul>\n";
     for (const auto& w : in.warnings) h << "<li>" << html_escape(w) << "</li>\n";
