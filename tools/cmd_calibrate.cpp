@@ -219,8 +219,8 @@ void add_calibrate_command(CLI::App& app) {
                   "A constant bearing error per track [degrees], in the filter, the refinement "
                   "and the bounds (default 0: none; --bearing-sigma is then the error that "
                   "changes from frame to frame; measured from pixels it does not make our "
-                  "extractor's sigmas consistent in every row: docs/theory/filter.md#per-track-bias
-                  "bearing bias\")")
+                  "extractor's sigmas consistent in every row: "
+                  "docs/theory/filter.md#per-track-bias)")
       ->check(kNonNegative)
       ->group(gm);
   cmd->add_option("--lateral-sigma", a->lateral_sigma,

@@ -1,8 +1,8 @@
 // Matching and track bookkeeping per frame (Sec. 4, 9.1), against OpenCV's brute-force
 // matcher (NORM_L2, knnMatch k = 2) on the same descriptor sets, in the same run.
 //
-//   build/bench/match/match_bench --benchmark_repetitions=10 \
-//       --benchmark_report_aggregates_only=true
+//   build/bench/match/match_bench --benchmark_repetitions=10
+//       --benchmark_report_aggregates_only=true   (one command line)
 //
 // One benchmark iteration = one frame. Sequences: a world of 1.5 x N lines with paper-like
 // 192-D descriptors, about N visible per frame (N = 20, 30, 40), each detection perturbed by

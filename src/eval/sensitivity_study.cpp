@@ -270,7 +270,9 @@ void rule_study(const std::vector<MatchRecord>& records,
     po.y_hi = std::max({po.y_hi, 1.08 * yc[i], 1.08 * yi[i]});
   if (!(po.y_hi > 0)) po.y_hi = 1;
   po.vertical_lines = {threshold};
-  po.vertical_labels = {"F" + std::to_string(rule) + " = " + f6(threshold)};
+  std::string label = "F";  // built by appends: GCC 12 warns falsely on "F" + std::string&&
+  label += std::to_string(rule) + " = " + f6(threshold);
+  po.vertical_labels = {label};
   out.plot("rule" + std::to_string(rule) + "_pdf.png",
            {{"correct matches", x, yc, plot_color(2), false},
             {"incorrect matches", x, yi, plot_color(3), false}},

@@ -195,7 +195,9 @@ TEST(Matcher, AgreesWithBruteForceOnRandomInputs) {
       }
       EXPECT_NEAR(f.min_distance, r.min_distance, 2e-4);
       EXPECT_NEAR(f.mean_distance, r.mean_distance, 2e-4);
-      if (nb >= 2) EXPECT_NEAR(f.second_distance, r.second_distance, 2e-4);
+      if (nb >= 2) {
+        EXPECT_NEAR(f.second_distance, r.second_distance, 2e-4);
+      }
       // Float rounding may swap a near-tie; everything else must agree exactly.
       if (r.second_distance - r.min_distance > 1e-3f) {
         EXPECT_EQ(f.best, r.best);
@@ -203,7 +205,9 @@ TEST(Matcher, AgreesWithBruteForceOnRandomInputs) {
       const bool near_boundary = std::abs(r.min_distance - 1.05) < 1e-3 ||
                                  std::abs(r.min_distance - 0.75 * r.mean_distance) < 1e-3 ||
                                  std::abs(r.min_distance - 0.8 * r.second_distance) < 1e-3;
-      if (!near_boundary) EXPECT_EQ(f.verdict, r.verdict) << "query " << i;
+      if (!near_boundary) {
+        EXPECT_EQ(f.verdict, r.verdict) << "query " << i;
+      }
       accepted += r.accepted();
     }
   }
