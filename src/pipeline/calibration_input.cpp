@@ -211,4 +211,12 @@ DatasetRun calibration_run_from_tracks(const dataset::Dataset& data,
   return out;
 }
 
+Options options_from_dataset(const dataset::Dataset& data, Options base) {
+  if (data.has_wheel()) {
+    base.wheel_base = data.wheel_sensor().wheel_base;
+    if (data.wheel_sensor().odometry_k) base.odometry_K = *data.wheel_sensor().odometry_k;
+  }
+  return base;
+}
+
 }  // namespace omnivert::calib

@@ -329,8 +329,9 @@ TEST(FrameMotion, ComposedWheelStepsAndTheFiltersTwoStepsGiveThePose) {
     const auto steps = frame_steps(m(0), m(1), m(2), e);
     Eigen::Vector3d two = integrate_pose(start, steps[0](0), steps[0](1), e);
     two = integrate_pose(two, steps[1](0), steps[1](1), e);
-    if (std::abs(m(2)) <= 0.5 * std::abs(0.5 * (m(0) + m(1))))
+    if (std::abs(m(2)) <= 0.5 * std::abs(0.5 * (m(0) + m(1)))) {
       EXPECT_LT((two - direct).norm(), 1e-12) << "trial " << trial;
+    }
     max_lateral = std::max(max_lateral, std::abs(m(2)));
   }
   EXPECT_GT(max_lateral, 1e-4);  // the test has sideways steps to compose

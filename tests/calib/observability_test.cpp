@@ -110,7 +110,7 @@ TEST(Observability, BoundIsTheMarginalOfTheFullInverseOfTheSolvedProblem) {
     rejected += r.refinement.num_rejected;
     const Eigen::Matrix3d& fast = r.observability.crlb_covariance;
     const Eigen::Matrix3d& plain = r.refinement.noise.model_covariance;
-    for (const Eigen::Vector3d v : {Eigen::Vector3d(1, 0, 0),
+    for (const Eigen::Vector3d& v : {Eigen::Vector3d(1, 0, 0),
                                     Eigen::Vector3d(0, 1, 0),
                                     Eigen::Vector3d(0, 0, 1),
                                     Eigen::Vector3d(1, 0, 1)}) {
