@@ -33,7 +33,8 @@ struct TrackerFlags {
 
   // The options these flags select (the wheel base is filled in from the dataset).
   TrackerOptions options() const {
-    TrackerOptions o = rules == "paper" ? paper_tracker_options() : recommended_tracker_options(1.0);
+    TrackerOptions o =
+        rules == "paper" ? paper_tracker_options() : recommended_dataset_tracker_options();
     if (no_mutual) o.mutual = false;
     if (no_gate) o.gate.enabled = false;
     o.look_back = look_back;

@@ -74,6 +74,12 @@ TrackerOptions recommended_tracker_options(double wheel_base) {
   return o;
 }
 
+TrackerOptions recommended_dataset_tracker_options() {
+  TrackerOptions o = recommended_tracker_options(0.0);
+  o.gate.enabled = true;  // wheel_base: track_dataset's, from wheel0/sensor.yaml
+  return o;
+}
+
 const char* to_string(LinkVerdict v) {
   switch (v) {
     case LinkVerdict::kLinked:

@@ -24,13 +24,9 @@ class CalibrationDatasets : public SimulatedDatasets {
 };
 
 // The options `omnivert calibrate DATASET --out DIR` passes without flags
-// (tools/cmd_calibrate.cpp): the recommended tracker with the odometry gate on (its wheel base
-// then comes from wheel0/sensor.yaml), the recommended calibration options.
-inline pipeline::CalibrateDatasetOptions cli_defaults() {
-  pipeline::CalibrateDatasetOptions o;
-  o.tracker = recommended_tracker_options(1.0);
-  return o;
-}
+// (tools/cmd_calibrate.cpp): the library's defaults (the recommended tracker with the odometry
+// gate on, its wheel base from wheel0/sensor.yaml; the recommended calibration options).
+inline pipeline::CalibrateDatasetOptions cli_defaults() { return {}; }
 
 inline pipeline::CalibrateDatasetOptions cli_defaults_refined() {
   pipeline::CalibrateDatasetOptions o = cli_defaults();

@@ -37,11 +37,7 @@ dataset::Dataset load_for_tracking(const fs::path& dir) {
 }
 
 // The options `omnivert track` passes without flags (tools/cmd_track.cpp).
-TrackDatasetOptions cli_track_options() {
-  TrackDatasetOptions o;
-  o.tracker = recommended_tracker_options(1.0);
-  return o;
-}
+TrackDatasetOptions cli_track_options() { return {}; }
 
 std::set<std::int64_t> frames_of(const std::vector<TrackRow>& rows) {
   std::set<std::int64_t> frames;

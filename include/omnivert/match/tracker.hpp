@@ -108,6 +108,10 @@ TrackerOptions paper_tracker_options();
 // predicts the line to 0.3 degree) when the wheel base is known (wheel_base > 0; pass 0 when
 // there is no odometry).
 TrackerOptions recommended_tracker_options(double wheel_base);
+// The recommended set for a whole dataset (track_dataset, pipeline::calibrate_dataset, the
+// CLI): the odometry gate on, its wheel base filled in from wheel0/sensor.yaml by
+// track_dataset (which turns the gate off when the dataset has no wheel data).
+TrackerOptions recommended_dataset_tracker_options();
 
 // Why a line of frame t was or was not linked to a line of an earlier frame (TrackerOptions:
 // the first rule that refused it).

@@ -32,7 +32,7 @@ namespace omnivert::pipeline {
 struct CalibrateDatasetOptions {
   FeaturePipelineOptions features;  // extraction and descriptor (Sec. 2-3)
   // The tracker; its odometry gate takes the wheel base of wheel0/sensor.yaml.
-  TrackerOptions tracker = recommended_tracker_options(0.0);
+  TrackerOptions tracker = recommended_dataset_tracker_options();
   // Prior and models. The wheel base and Chong-Kleeman K come from wheel0/sensor.yaml
   // (calib::options_from_dataset); everything else from here.
   calib::Options calibration = calib::recommended_options();

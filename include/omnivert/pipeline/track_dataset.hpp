@@ -22,7 +22,7 @@ namespace omnivert {
 
 struct TrackDatasetOptions {
   FeaturePipelineOptions pipeline;
-  TrackerOptions tracker = recommended_tracker_options(0.0);
+  TrackerOptions tracker = recommended_dataset_tracker_options();
   // Use the wheel odometry for the tracker's bearing gate when the dataset has it (and the
   // gate is enabled in `tracker`; its wheel base is taken from wheel0/sensor.yaml).
   bool use_odometry = true;
