@@ -1,3 +1,4 @@
+cmake_minimum_required(VERSION 3.22)
 # ctest: install the build tree to a scratch prefix, then configure and build tests/consumer
 # against it. -DBUILD=<omnivert build dir> -DSRC=<source dir> -DWORK=<scratch dir>
 file(REMOVE_RECURSE "${WORK}")
@@ -27,7 +28,12 @@ if(rc)
 endif()
 # omnivert::calib must not bring OpenCV: its link line (Ninja's) names no opencv library.
 file(READ "${WORK}/build/build.ninja" ninja)
-string(REGEX MATCH "build calib_only:[^\n]*\n([^\n]*\n)*[^\n]*LINK_LIBRARIES = [^\n]*" link "${ninja}")
+string(FIND "${ninja}" "build calib_only:" at)
+string(SUBSTRING "${ninja}" ${at} -1 rest)
+string(REGEX MATCH "LINK_LIBRARIES = [^\n]*" link "${rest}")
+if(at EQUAL -1 OR NOT link MATCHES "omnivert_calib")
+  message(FATAL_ERROR "no link line of calib_only in ${WORK}/build/build.ninja")
+endif()
 if(link MATCHES "opencv")
   message(FATAL_ERROR "omnivert::calib links OpenCV: ${link}")
 endif()
