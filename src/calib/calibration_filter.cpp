@@ -7,8 +7,9 @@
 #include <set>
 #include <string>
 
-#include "omnivert/calib/batch.hpp"
+#include "calib/window.hpp"
 #include "omnivert/calib/model.hpp"
+#include "omnivert/calib/track_ids.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
 

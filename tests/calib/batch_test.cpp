@@ -11,7 +11,11 @@
 
 #include <Eigen/Dense>
 
-#include "omnivert/calib/batch.hpp"
+#include "omnivert/calib/batch_point.hpp"
+#include "omnivert/calib/diagnostics.hpp"
+#include "omnivert/calib/flow_yaw.hpp"
+#include "omnivert/calib/refinement.hpp"
+#include "omnivert/calib/track_ids.hpp"
 #include "omnivert/calib/calibrate.hpp"
 #include "omnivert/calib/report.hpp"
 #include "omnivert/calib/calibration_filter.hpp"

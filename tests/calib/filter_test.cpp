@@ -10,7 +10,11 @@
 #include <map>
 #include <set>
 
-#include "omnivert/calib/batch.hpp"
+#include "omnivert/calib/batch_point.hpp"
+#include "omnivert/calib/observability.hpp"
+#include "omnivert/calib/refinement.hpp"
+#include "omnivert/calib/track_ids.hpp"
+#include "calib/window.hpp"
 #include "omnivert/calib/calibrate.hpp"
 #include "omnivert/calib/calibration_filter.hpp"
 #include "omnivert/calib/feature_initializer.hpp"

@@ -3,7 +3,7 @@
 
 #include <Eigen/Cholesky>
 
-#include "omnivert/calib/batch.hpp"
+#include "omnivert/calib/batch_point.hpp"
 #include "omnivert/calib/synthetic_run.hpp"
 #include "omnivert/core/angles.hpp"
 

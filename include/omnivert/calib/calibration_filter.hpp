@@ -67,7 +67,7 @@ class CalibrationFilter {
   const std::vector<FrameEstimate>& history() const { return history_; }
   const std::map<int, TrackEstimate>& tracks() const { return tracks_; }
   // Tracks split in the bootstrap window (a track that slipped onto a neighbouring line):
-  // (tracker's track id, first frame of the new part); see split_tracks (batch.hpp).
+  // (tracker's track id, first frame of the new part); see split_tracks (track_ids.hpp).
   const std::vector<std::pair<int, int>>& splits() const { return splits_; }
   // The bootstrap window: how many frames it held (0: none), and, when it could not be
   // solved, why (the filter then ran over it from the prior, undelayed).
