@@ -6,6 +6,7 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 #include <cstddef>
+#include <functional>
 #include <map>
 #include <utility>
 #include <vector>
@@ -147,5 +148,59 @@ Built final_with_bias(const CalibrationRun& run,
                       const BatchOptions& batch,
                       bool robust,
                       int min_track_length);
+
+// The association loop of a batch estimator (refine_batch, the start-up window), on its
+// solved problem: bearings left out where lines cross (reject_crossings), features that
+// collapsed onto the camera dropped, outliers rejected at the filter's gate (up to three
+// rounds), each step followed by a solve; then rounds of joining the pieces of one line
+// (merge_round) and rounds of splitting the tracks that slipped (find_splits, split_round),
+// each on the problem rebuilt from the last solution, solved, and judged again as above.
+struct AssociationSetup {
+  // crossing_guard, max_missed_frames, gate_probability, min_feature_range.
+  const Options* options = nullptr;
+  // A feature keeps at least this many bearings: 2 (two rays fix a point), 1 with a prior on
+  // its depth (the window).
+  int min_bearings = 2;
+  bool join_pieces = true;
+  // split_chi2 (0: no splitting), split_rounds, split_min_bearings, split_keep_fraction.
+  BatchOptions split;
+  // The tracker's id of each renamed id of the run given (the window's parts after a gap).
+  std::map<int, int> base_origin;
+  // Whether a problem left without features ends the loop (AssociationEnd); otherwise it is
+  // solved on.
+  bool stop_when_empty = false;
+  // The problem of a renamed run from a starting point (the estimator's own build), and its
+  // solve.
+  std::function<Built(const CalibrationRun&, const BatchPoint&)> rebuild;
+  std::function<void(Built*)> solve;
+};
+
+// What the association decided.
+struct Association {
+  CalibrationRun merged;  // the run with the joined pieces under their line's first id
+  CalibrationRun split;   // `merged` with the slipped tracks split (when splits is not empty)
+  std::vector<std::pair<int, int>> merges;  // (earlier piece's id, joined piece's id)
+  std::vector<std::pair<int, int>> splits;  // (id in `merged`, first frame of the new part)
+  std::map<int, int> origin;                // id of a split part -> its id in `merged`
+  int num_splits = 0;
+  int num_rejected = 0;  // outliers rejected by the last rejection
+  // The run the solved problem's ids are of.
+  const CalibrationRun& solved() const { return splits.empty() ? merged : split; }
+};
+
+// The tracker's id of each renamed id: `origin` (split parts) composed with `base` (ids of
+// the run given).
+std::map<int, int> tracker_ids(const std::map<int, int>& base, const std::map<int, int>& origin);
+
+enum class AssociationEnd {
+  kDone,
+  kNoTrack,      // a rebuilt problem had no feature (stop_when_empty)
+  kNoTrackLeft,  // the rejections left no feature (stop_when_empty)
+};
+// The association loop on `b`, a solved problem of `run`; *b is the last problem solved.
+AssociationEnd associate(Built* b,
+                         const CalibrationRun& run,
+                         const AssociationSetup& setup,
+                         Association* out);
 
 }  // namespace omnivert::calib::internal
