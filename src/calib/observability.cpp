@@ -19,32 +19,30 @@ namespace omnivert::calib {
 
 using namespace internal;
 
-ObservabilityReport analyse_observability(const CalibrationRun& run,
-                                          const Options& options,
-                                          const BatchPoint& at,
-                                          const BatchOptions& batch,
-                                          const ObservabilityOptions& obs) {
-  std::string why;
-  if (!options.IsValid(&why)) throw InputError("calibration options: " + why);
-  Built b = build(run, options, at, batch, /*robust=*/false);
-  // The Jacobian of the whitened residuals: Fisher information F = J^T J (the residuals are
-  // already divided by their sigmas). Frame 0 is not a variable (gauge).
+namespace {
+
+// The Fisher information F = J^T J of the batch problem at its point (n x n, the variables of
+// variable_blocks; the residuals are already divided by their sigmas). Frame 0 is not a
+// variable (gauge).
+Eigen::MatrixXd fisher_information(Built& b) {
   ceres::Problem::EvaluateOptions eo;
   eo.parameter_blocks = variable_blocks(b);
   eo.apply_loss_function = false;
   ceres::CRSMatrix crs;
   b.problem->Evaluate(eo, nullptr, nullptr, nullptr, &crs);
-  const Eigen::MatrixXd F = information_from_jacobian(crs);
-  const int n = static_cast<int>(F.rows()), no = n - 3;
+  return information_from_jacobian(crs);
+}
 
-  // Marginal information of the extrinsics: Schur complement of the nuisance block
-  // (pseudo-inverse, so that features without parallax do not poison it). The nuisance
-  // variables are scaled to unit information first (Jacobi): poses, features in metres and
-  // bearings whitened by a small sigma span many orders of magnitude, and unscaled, the
-  // pseudo-inverse's cut (relative to the largest eigenvalue) dropped the depth of a feature
-  // seen with little parallax while its coupling to the extrinsics stayed: the bound of
-  // phi + psi came out 2.2 times too small (corridor paper seeds 9, 10: 1.3e-4 rad against
-  // 2.9e-4 from the full inverse; errors 6.4e-4 and 5.1e-4).
+// Marginal information of the extrinsics: Schur complement of the nuisance block
+// (pseudo-inverse, so that features without parallax do not poison it). The nuisance
+// variables are scaled to unit information first (Jacobi): poses, features in metres and
+// bearings whitened by a small sigma span many orders of magnitude, and unscaled, the
+// pseudo-inverse's cut (relative to the largest eigenvalue) dropped the depth of a feature
+// seen with little parallax while its coupling to the extrinsics stayed: the bound of
+// phi + psi came out 2.2 times too small against the full inverse's
+// (Observability.BoundIsTheMarginalOfTheFullInverseOfTheSolvedProblem).
+Eigen::Matrix3d marginal_information(const Eigen::MatrixXd& F) {
+  const int n = static_cast<int>(F.rows()), no = n - 3;
   Eigen::VectorXd scale(no);
   for (int i = 0; i < no; ++i) scale(i) = F(i, i) > 0.0 ? 1.0 / std::sqrt(F(i, i)) : 1.0;
   const Eigen::MatrixXd Foo = scale.asDiagonal() * F.topLeftCorner(no, no) * scale.asDiagonal();
@@ -58,8 +56,16 @@ ObservabilityReport analyse_observability(const CalibrationRun& run,
   const Eigen::MatrixXd UtFoe = es.eigenvectors().transpose() * Foe;
   Eigen::Matrix3d S = F.bottomRightCorner<3, 3>() - UtFoe.transpose() * inv.asDiagonal() * UtFoe;
   S = 0.5 * (S + S.transpose()).eval();
+  return S;
+}
 
-  ObservabilityReport rep;
+// The verdicts on S, the marginal information: its eigenvalues scaled by the thresholds, its
+// rank and condition, each parameter's bound, and the inverse.
+void judge_information(const Eigen::Matrix3d& S,
+                       const Extrinsics& ex,
+                       const ObservabilityOptions& obs,
+                       ObservabilityReport* out) {
+  ObservabilityReport& rep = *out;
   rep.information = S;
   // Scale by the thresholds so that "determined" is "[S~^-1]_ii < 1".
   const Eigen::Vector3d thr(obs.max_sigma_angle, obs.max_sigma_rho, obs.max_sigma_angle);
@@ -94,36 +100,45 @@ ObservabilityReport analyse_observability(const CalibrationRun& run,
     p.determined = p.crlb < threshold;
     return p;
   };
-  const Extrinsics& ex = at.extrinsics;
   rep.phi = verdict({1, 0, 0}, obs.max_sigma_angle);
   rep.rho = verdict({0, 1, 0}, obs.max_sigma_rho);
   rep.psi = verdict({0, 0, 1}, obs.max_sigma_angle);
   rep.yaw = verdict({1, 0, 1}, obs.max_sigma_angle);
   rep.x = verdict({-ex.rho * std::sin(ex.phi), std::cos(ex.phi), 0}, obs.max_sigma_rho);
   rep.y = verdict({ex.rho * std::cos(ex.phi), std::sin(ex.phi), 0}, obs.max_sigma_rho);
-  // Did the robot turn (Sec. 8.1)? Its heading's span against the heading noise of eq. (31)
-  // accumulated over the run: below min_rotation_sigmas, the information about phi, rho and
-  // psi individually comes from the estimated trajectory's noise, not from a turn.
-  {
-    double lo = 0.0, hi = 0.0, var = 0.0;
-    for (std::size_t k = 0; k < at.poses.size(); ++k) {
-      lo = std::min(lo, at.poses[k](2) - at.poses[0](2));
-      hi = std::max(hi, at.poses[k](2) - at.poses[0](2));
-    }
-    const double K = options.odometry_K * batch.odometry_inflation;
-    for (const FrameInput& f : run.frames) var += K * (std::abs(f.d_right) + std::abs(f.d_left));
-    rep.heading_range = hi - lo;
-    rep.heading_noise = std::sqrt(var) / options.wheel_base;
-    if (rep.heading_range < obs.min_rotation_sigmas * rep.heading_noise)
-      for (ParameterVerdict* p : {&rep.phi, &rep.rho, &rep.psi, &rep.x, &rep.y})
-        p->determined = false;
-  }
   if (rep.rank == 3) {
     rep.crlb_covariance = S.ldlt().solve(Eigen::Matrix3d::Identity());
   } else {
     rep.crlb_covariance.setConstant(inf);
   }
+}
 
+// Did the robot turn (Sec. 8.1)? Its heading's span against the heading noise of eq. (31)
+// accumulated over the run: below min_rotation_sigmas, the information about phi, rho and psi
+// individually comes from the estimated trajectory's noise, not from a turn.
+void check_rotation(const CalibrationRun& run,
+                    const Options& options,
+                    const BatchPoint& at,
+                    const BatchOptions& batch,
+                    const ObservabilityOptions& obs,
+                    ObservabilityReport* out) {
+  ObservabilityReport& rep = *out;
+  double lo = 0.0, hi = 0.0, var = 0.0;
+  for (std::size_t k = 0; k < at.poses.size(); ++k) {
+    lo = std::min(lo, at.poses[k](2) - at.poses[0](2));
+    hi = std::max(hi, at.poses[k](2) - at.poses[0](2));
+  }
+  const double K = options.odometry_K * batch.odometry_inflation;
+  for (const FrameInput& f : run.frames) var += K * (std::abs(f.d_right) + std::abs(f.d_left));
+  rep.heading_range = hi - lo;
+  rep.heading_noise = std::sqrt(var) / options.wheel_base;
+  if (rep.heading_range < obs.min_rotation_sigmas * rep.heading_noise)
+    for (ParameterVerdict* p : {&rep.phi, &rep.rho, &rep.psi, &rep.x, &rep.y})
+      p->determined = false;
+}
+
+// What is (not) determined and the motion that would fix it.
+std::string observability_message(const ObservabilityReport& rep, const ObservabilityOptions& obs) {
   std::ostringstream m;
   if (rep.all_determined()) {
     m << "phi, rho and psi are determined by this trajectory (Cramer-Rao bounds: phi "
@@ -151,7 +166,24 @@ ObservabilityReport analyse_observability(const CalibrationRun& run,
       m << ", not even the camera yaw phi + psi: drive a straight line with vertical lines "
            "around (a few meters away), then turn in place near them (Sec. 8.1).";
   }
-  rep.message = m.str();
+  return m.str();
+}
+
+}  // namespace
+
+ObservabilityReport analyse_observability(const CalibrationRun& run,
+                                          const Options& options,
+                                          const BatchPoint& at,
+                                          const BatchOptions& batch,
+                                          const ObservabilityOptions& obs) {
+  std::string why;
+  if (!options.IsValid(&why)) throw InputError("calibration options: " + why);
+  Built b = build(run, options, at, batch, /*robust=*/false);
+  const Eigen::Matrix3d S = marginal_information(fisher_information(b));
+  ObservabilityReport rep;
+  judge_information(S, at.extrinsics, obs, &rep);
+  check_rotation(run, options, at, batch, obs, &rep);
+  rep.message = observability_message(rep, obs);
   return rep;
 }
 
