@@ -89,7 +89,23 @@ class CalibrationFilter {
 
  private:
   void admit(const FrameInput& frame);
+  // One frame of the EKF (after the window): prediction, updates, new tracks, conversions,
+  // marginalisation.
   void step(const FrameInput& frame);
+  // The crossing guard in this frame: per entry (the state's features, then the frame's new
+  // tracks at n + their index in the frame) whether it is left out.
+  std::vector<char> crossing_entries(const FrameInput& frame) const;
+  // The frame's bearings sorted: guarded (counted in rec), new tracks (*fresh), updates of
+  // features of the state (*z, their own track ids *z_ids), a feature's second bearing
+  // refused.
+  void sort_bearings(const FrameInput& frame,
+                     const std::vector<char>& crossing,
+                     FrameEstimate* rec,
+                     std::vector<const BearingObservation*>* fresh,
+                     std::vector<BearingMeasurement>* z,
+                     std::vector<int>* z_ids);
+  // Inverse-depth blocks whose depth is now well known change parametrisation.
+  void convert_known_depths();
   // Removes from obs (frame `frame`) the bearings guard_ahead marked before a track that
   // starts after frame `started_after`, records them as guarded; returns how many.
   int leave_out_ahead(std::vector<BearingObservation>* obs, int frame, int started_after);
@@ -125,7 +141,7 @@ class CalibrationFilter {
   double window_heading_ = 0.0;
   double window_max_turn_ = 0.0;
   std::map<std::pair<int, int>, int> ahead_;  // guard_ahead
-  std::map<int, int> ahead_count_;       // frame -> bearings left out ahead
+  std::map<int, int> ahead_count_;            // frame -> bearings left out ahead
 };
 
 // The crossing guard ahead of a track's start (Options::crossing_guard): a track often starts
@@ -149,9 +165,9 @@ struct FilterResult {
   Eigen::Matrix3d covariance;
   std::vector<FrameEstimate> history;
   std::map<int, TrackEstimate> tracks;
-  std::vector<std::pair<int, int>> splits;  // CalibrationFilter::splits
-  int window_frames = 0;                     // CalibrationFilter::window_frames
-  std::string window_failure;                // CalibrationFilter::window_failure
+  std::vector<std::pair<int, int>> splits;    // CalibrationFilter::splits
+  int window_frames = 0;                      // CalibrationFilter::window_frames
+  std::string window_failure;                 // CalibrationFilter::window_failure
   std::vector<std::pair<int, int>> guarded;   // CalibrationFilter::guarded
   std::vector<std::pair<int, int>> rejected;  // CalibrationFilter::rejected
   std::vector<std::pair<int, int>> joins;     // CalibrationFilter::joins
