@@ -48,17 +48,17 @@ bool one_line(Built* b, int a, int c, double chi2, FeatureCovariance* cache);
 // another, its detections given to the other track meanwhile; the tracker bridges gaps of
 // max_missed_frames, the margin used.) There the extractor
 // sees one line where there are two: the detection is pulled towards the other line, or
-// belongs to it (office paper, seed 9: track 3 pulled by up to 0.19 degree by lines passing
-// within 1 degree, and then split by the slip test although it never left its line;
-// docs/calib.md, "Lines that cross"). The bearings are not independent Gaussian errors about
-// the line there, which is what eq. (30) assumes. Then the features left with fewer than
-// `min_bearings` bearings go (drop_unobserved_features). Returns how many bearings; their
-// keys are added to b->guarded.
-// A line the tracker lost and found again under a new id is not a crossing either: two tracks
-// that never share a frame and whose bearings one point explains (one_line) are one line.
-// Without this a track's pieces guarded each other over the margin, and with tracks broken
-// every ~10 frames the guard left out most bearings (synthetic paper run, break probability
-// 0.1: 950 of 1140 in the filter, most features of the refinement).
+// belongs to it (a track pulled by up to 0.19 degree by lines passing within 1 degree is then
+// split by the slip test although it never left its line; docs/calib.md, "Lines that cross";
+// CrossingGuard.MergedDetectionsAreLeftOutAndDoNotMoveTheEstimate). The bearings are not
+// independent Gaussian errors about the line there, which is what eq. (30) assumes. Then the
+// features left with fewer than `min_bearings` bearings go (drop_unobserved_features). Returns how
+// many bearings; their keys are added to b->guarded. A line the tracker lost and found again under
+// a new id is not a crossing either: two tracks that never share a frame and whose bearings one
+// point explains (one_line) are one line. Otherwise a track's pieces guard each other over the
+// margin, and with tracks broken every ~10 frames the guard leaves out most bearings
+// (CrossingGuard.PiecesOfOneLineDoNotGuardEachOther; synthetic paper run, break probability 0.1:
+// 950 of 1140 in the filter, most features of the refinement).
 int reject_crossings(Built* b,
                      double guard,
                      int margin,
@@ -72,17 +72,17 @@ int reject_crossings(Built* b,
 // their costs about their own points (the solution's, optimal there). About chi-square(2)
 // under one point. Unlike the Wald test it keeps its power when a piece is too short to
 // place its point: three bearings over three frames have no depth, their point's covariance
-// is enormous along the ray, and the Wald statistic of a piece of another line came out
-// 0.00 (synthetic, seed 90, tracks broken every ~10 frames: 4 of 44 joins wrong).
+// is enormous along the ray, and the Wald statistic of a piece of another line can come out
+// 0.00 (PiecesOfOneLine.AreJoinedOnlyWithTheirOwnLine).
 double one_point_statistic(Built* b, const std::vector<std::size_t>& blocks, int a, int c);
 
 // Pieces of one line (BatchOptions::merge_pieces, Options::join_pieces): a tracker that loses
 // a line and finds it again gives it a new id, and the batch then has two features where
 // there is one point. Each piece is estimated from its own few bearings, from little
 // parallax; with tracks broken every ~10 frames (synthetic paper runs, calib_monte_carlo
-// --break 0.1) the refinement's NEES was 4.1 over 100 runs where the unbroken tracks give 2.9
-// (docs/calib.md, "Broken tracks"). Candidates: two tracks that never share a frame, at most
-// `max_gap` frames apart (or interleaved: a chain of joins can skip a piece, which a later
+// --break 0.1) the refinement's NEES is 4.1 over 100 runs unjoined where the unbroken tracks
+// give 2.9 (docs/calib.md, "Broken tracks"). Candidates: two tracks that never share a frame, at
+// most `max_gap` frames apart (or interleaved: a chain of joins can skip a piece, which a later
 // round then joins). They are one line when one point explains both, by two tests that must
 // agree: one_point_statistic (poses held; keeps its power for a piece without depth) and the
 // Wald statistic of one_line (the whole problem's covariance; poses free, so long pieces of
@@ -135,9 +135,9 @@ bool merge_round(Built* b,
 // model whose sigma is a bearing's whole error, sqrt(bearing_sigma^2 + track_bias_sigma^2);
 // the estimate and its covariance under the model with the per-track bias, on the bearings
 // those decisions kept (final_with_bias). With the bias in the decisions, a slip onto a
-// neighbouring line was partly taken up by the slipped track's bias and left in: from pixels,
+// neighbouring line is partly taken up by the slipped track's bias and left in: from pixels,
 // office zigzag at 0.018 + 0.016 degree, 6 of 100 filter runs ended 0.25-0.36 degree off
-// (NEES 10-24), the window having kept 36 more bearings in seed 65.
+// (NEES 10-24).
 Options association_options(const Options& options);
 
 // The problem of `b`'s bearings (on `run`, the run its ids are of) with the per-track bias,

@@ -73,10 +73,11 @@ std::vector<std::pair<int, int>> unused_bearings(const CalibrationRun& run,
 }
 
 // Removes the features left with fewer than `min_bearings` bearings (with their remaining
-// bearings and any prior on them): their information is singular. Measured: hall zigzag,
-// seed 1, every bearing of one track was an outlier in the filter's bootstrap window, whose
-// information matrix then could not be inverted; the filter fell back on the undelayed
-// initialisation over 252 frames and ended 124 mm off (docs/calib.md, "The noise check").
+// bearings and any prior on them): their information is singular. A track whose bearings are
+// all outliers in the filter's window would leave the window's information singular, and the
+// filter would fall back on the undelayed initialisation
+// (CalibrationFilter.BootstrapWindowDropsATrackWithOnlyOutliers; docs/calib.md, "The noise
+// check").
 // Returns how many features.
 int drop_unobserved_features(Built* b, int min_bearings);
 
@@ -93,7 +94,7 @@ int reject_outliers(Built* b, double threshold, int min_bearings);
 // F = J^T J with a tiny ridge, relative to each variable's own information (their scales
 // differ by orders of magnitude): it keeps a feature seen without parallax from making F
 // singular. A variable without any residual left (a feature whose bearings were all removed
-// as outliers: hall zigzag, seed 1) has an empty row and column; a unit diagonal leaves it
+// as outliers) has an empty row and column; a unit diagonal leaves it
 // out of everything else.
 Eigen::SparseMatrix<double> information_with_ridge(const Eigen::SparseMatrix<double>& J);
 

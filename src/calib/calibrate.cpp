@@ -287,9 +287,9 @@ std::vector<std::string> result_warnings(const CalibrationResult& r) {
   char buf[1024];
   // The gate's refusals after the start-up window: the window's own outliers (left out of its
   // batch solve, counted in its frames) are no sign of a filter that diverged. Counted with
-  // them, this fired in 343 of 400 zigzag runs from pixels whose estimates were consistent
+  // them, this fires in 343 of 400 zigzag runs from pixels whose estimates are consistent
   // (the window is most of a zigzag run); counted after the window, in 1 of 800 runs of all
-  // four rows (office paper seed 106, the filter's NEES 6.0).
+  // four rows (ResultWarnings.GateRefusalsCountAfterTheWindow).
   const std::size_t from = r.filter.window_failure.empty()
                                ? static_cast<std::size_t>(std::max(r.filter.window_frames, 0))
                                : 0;

@@ -57,9 +57,8 @@ void CalibrationFilter::process(const FrameInput& frame) {
   // The bearings left out ahead (guard_before_starts), as guarded ones, after the window.
   // In the window, only those before a track that starts after it (end_bootstrap): the
   // window's batch problem guards the frames before the starts it sees itself
-  // (reject_crossings), and left out there as well, corridor zigzag seed 90 at a drawn mount,
-  // a track that slipped onto a neighbouring line was no longer split, and the window ended
-  // 3 mm off, 0.04 mm sure.
+  // (reject_crossings); left out there as well, they can hide the slip of a track onto a
+  // neighbouring line from the window's split test, and the window ends off and overconfident.
   if (!ahead_.empty() && !bootstrapping_) {
     FrameInput kept = frame;
     if (leave_out_ahead(&kept.observations, frame_, -1) > 0) return admit(kept);
@@ -124,10 +123,8 @@ void CalibrationFilter::end_bootstrap(FrameEstimate rec) {
     bootstrapping_ = false;
     window_frames_ = static_cast<int>(window_.frames.size());
     // Bearings before a line whose track starts after the window (guard_before_starts): the
-    // window cannot see that line. (Drawn-mount office paper seed 36: a line's two last
-    // bearings in the window 0.09-0.12 degree off, pushed by a line 0.2-0.3 degree away whose
-    // track started two frames after the window; the filter's rho moved 1.7 mm when the
-    // first line's clean bearings came.)
+    // window cannot see that line, whose detections push the bearings beside it before its
+    // track starts (CrossingGuard.BeforeATrackStartsBesideAnother).
     if (!ahead_.empty()) {
       const int first = frame_ - static_cast<int>(window_.frames.size()) + 1;
       for (int k = 0; k < static_cast<int>(window_.frames.size()); ++k) {
@@ -355,9 +352,8 @@ int CalibrationFilter::slot_of(int track_id) const {
 // candidate, which no other new track has as a candidate, continues it. (Only the features
 // seen in this frame crowd a candidate: the old piece of a line that was not joined stays in
 // the state for max_missed_frames frames unseen, and would crowd the new piece of the same
-// line. Without the crowding test, from pixels with tracks broken every ~10 frames, office
-// paper seed 7: a new track of a door's edge was joined to the feature of the edge beside
-// it, and the filter ended 1.2 degree off in yaw, NEES 273; with it 0.2 degree, NEES 10.3.)
+// line. Without the crowding test a new track of a door's edge can be joined to the feature
+// of the edge beside it, which puts the filter a degree off in yaw.)
 std::vector<const BearingObservation*> CalibrationFilter::join_pieces(
     std::vector<const BearingObservation*> fresh,
     std::vector<BearingMeasurement>* z,

@@ -14,8 +14,9 @@ std::map<int, int> join_roots(const std::vector<std::pair<int, int>>& joins) {
   // A piece's last join is the one kept (the pairs are taken from the last), and a join that
   // would close a loop is left out, so the chains end. The window reports its joins by the
   // tracker's ids, and two pieces of one tracker id (parted at a gap or a slip, then joined)
-  // gave (T, T), or T -> U -> T: the chain never ended (corridor zigzag seed 28 with
-  // --track-bias-sigma hung here). Where the pairs make no loop this is what it was.
+  // give (T, T), or T -> U -> T, a chain without end
+  // (PiecesOfOneLine.JoinChainsEndAtTheFirstPiece). Where the pairs make no loop, every pair is
+  // followed.
   for (auto it = joins.rbegin(); it != joins.rend(); ++it) {
     const auto& [a, c] = *it;
     if (a == c || earlier.count(c) || root_of(a) == c) continue;

@@ -31,11 +31,9 @@ struct BatchOptions {
   double odometry_inflation = 1.0;  // the batch uses K * this (the filter's inflation is a
                                     // robustness device of the EKF, not of the ML problem)
   // [m] per step. Eq. (14)-(15) (and the filter's eq. 29) have no lateral motion; a small
-  // slack keeps the problem well posed. Measured (docs/calib.md, "Session 7"): 1e-4 made
-  // every batch conservative (from pixels, zigzag NEES 1.8-1.9; synthetic refinement 1.95
-  // on seeds 51-100); 1e-5 is consistent on both. (Session 6 had rejected 1e-5 because the
-  // corridor zigzag filter then diverged: a rounding failure in the window's covariance,
-  // fixed since.) A robot that slips sideways needs more: --lateral-sigma.
+  // slack keeps the problem well posed. 1e-4 makes every batch conservative (from pixels,
+  // zigzag NEES 1.8-1.9; synthetic refinement 1.95 over 50 runs); 1e-5 is consistent on both
+  // (docs/calib.md). A robot that slips sideways needs more: --lateral-sigma.
   double lateral_sigma = 1e-5;
   bool robust = false;        // Huber loss on bearings
   double huber_sigmas = 3.0;  // Huber threshold in bearing sigmas

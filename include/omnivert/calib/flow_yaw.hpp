@@ -12,8 +12,9 @@ namespace omnivert::calib {
 // fitted for each candidate yaw; the yaw whose fits explain most of the flow is returned. NaN
 // when the run has too little translation or flow to tell (fewer than `min_pairs` bearing
 // pairs, or less than `min_explained` of the flow's sum of squares explained).
-// Why (docs/calib.md, "Window starts", session 16): the window's starts kept the prior's
-// camera yaw, and a camera mounted 80-110 degrees from it left all five starts far off.
+// The window starts at this yaw as well where it is far from the prior's: every start at the
+// prior's camera yaw is far off for a camera mounted 80-110 degrees from it (docs/calib.md,
+// "Window starts").
 double camera_yaw_from_flow(const CalibrationRun& run,
                             double wheel_base,
                             int min_pairs = 20,
