@@ -33,6 +33,7 @@ ceres::Solver::Options solver_options(const BatchOptions& batch) {
   so.parameter_tolerance = 1e-12;
   so.num_threads = 1;
   so.logging_type = ceres::SILENT;
+  so.minimizer_progress_to_stdout = false;
   return so;
 }
 
@@ -115,13 +116,9 @@ bool extrinsics_covariance(Built* b, Eigen::Matrix3d* covariance) {
   const std::vector<std::pair<const double*, const double*>> blocks = {
       {b->ex.data(), b->ex.data()}};
   // A rank-deficient problem is an expected outcome here (the caller falls back on the
-  // observability analysis), not an error for the user's terminal: Ceres' own log line
-  // ("Covariance matrix is near rank deficient ...") is silenced for this call.
-  const int saved_min_log_level = FLAGS_minloglevel;
-  FLAGS_minloglevel = google::GLOG_FATAL;
-  const bool cov_ok = cov.Compute(blocks, b->problem.get());
-  FLAGS_minloglevel = saved_min_log_level;
-  if (!cov_ok) return false;
+  // observability analysis). ceres::Covariance has no logging option: its line about the
+  // rank deficiency goes to Ceres' log, which the library leaves as the program set it.
+  if (!cov.Compute(blocks, b->problem.get())) return false;
   double C[9];
   cov.GetCovarianceBlock(b->ex.data(), b->ex.data(), C);
   *covariance = Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(C);

@@ -105,6 +105,7 @@ struct WindowProblem {
     so.max_num_iterations = 100;
     so.num_threads = 1;
     so.logging_type = ceres::SILENT;
+    so.minimizer_progress_to_stdout = false;
     batch.lateral_sigma = options.lateral_sigma;
     tracks.index(window);
   }
