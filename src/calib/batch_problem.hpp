@@ -24,8 +24,8 @@ struct Built {
   std::map<int, std::array<double, 2>> features;
   std::map<int, double> biases;  // Options::track_bias_sigma (std::map: stable addresses)
   std::map<int, ceres::ResidualBlockId> bias_priors;  // their priors, by track
-  std::vector<double> ex =
-      std::vector<double>(3, 0.0);  // heap storage: Built moves keep the address Ceres holds
+  // (phi, rho, psi); heap storage: moving a Built keeps the address Ceres holds.
+  std::vector<double> ex = std::vector<double>(3, 0.0);
   std::unique_ptr<ceres::Problem> problem;
   int num_bearings = 0;
   std::vector<ceres::ResidualBlockId> bearing_blocks;
@@ -98,24 +98,33 @@ int reject_outliers(Built* b, double threshold, int min_bearings);
 // out of everything else.
 Eigen::SparseMatrix<double> information_with_ridge(const Eigen::SparseMatrix<double>& J);
 
-// J^T J of a Jacobian in Ceres' compressed-row form, as a dense matrix. Each row of J has a
-// handful of entries (a bearing touches one pose, one feature and the extrinsics), so the
-// product is formed sparse: O(rows x 8^2) instead of the dense O(rows x cols^2). Hall zigzag,
-// 318 tracks: filter (its bootstrap window) 12.97 -> 8.44 s, observability 2.62 -> 0.68 s.
+// A Jacobian in Ceres' compressed-row form as an Eigen sparse matrix (rows x cols).
 Eigen::SparseMatrix<double> sparse_jacobian(const ceres::CRSMatrix& crs);
 
+// J^T J of a Jacobian in Ceres' compressed-row form, as a dense matrix. Each row of J has a
+// handful of entries (a bearing touches one pose, one feature and the extrinsics), so the
+// product is formed sparse: O(rows x 8^2) instead of the dense O(rows x cols^2) (318 tracks:
+// the filter's window 12.97 -> 8.44 s, the observability analysis 2.62 -> 0.68 s).
 Eigen::MatrixXd information_from_jacobian(const ceres::CRSMatrix& crs);
 
 // The variables of the batch problem in the order of its Jacobian's columns: poses of frames
-// 1..N (frame 0 is the gauge), features, extrinsics (the last three columns).
+// 1..N (frame 0 is the gauge), features, track biases, extrinsics (the last three columns).
 std::vector<double*> variable_blocks(Built& b);
 
+// The problem of `run` at `at` (the formulation of batch_point.hpp): a pose per frame (frame
+// 0 constant, the gauge), the extrinsics, a point per track with at least
+// options.min_track_length bearings and a finite starting point, and with
+// options.track_bias_sigma a bias per track with its prior; odometry factors between
+// consecutive frames (eq. 14-15, 31, with batch.lateral_sigma), a bearing factor per
+// observation (eq. 16-17, Huber loss when `robust`). Throws InputError when `at` has not one
+// pose per frame.
 Built build(const CalibrationRun& run,
             const Options& options,
             const BatchPoint& at,
             const BatchOptions& batch,
             bool robust);
 
+// The problem's current values, angles wrapped.
 BatchPoint point_of(const Built& b);
 
 }  // namespace omnivert::calib::internal
