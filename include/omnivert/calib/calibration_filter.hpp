@@ -153,9 +153,8 @@ class CalibrationFilter {
 // rate over b's first 3 frames both saw; a's bearings over the max_missed_frames frames
 // before k0 where it is within the guard are returned: (track id, frame index in run) -> k0
 // (the earliest, where several lines start beside it).
-// (Drawn-mount office paper seed 14: a line 0.2-0.3 degree from another before its track
-// started pushed that one's bearings 0.12 degree off for two frames; the filter ended with
-// rho 2.2 mm off, 3 times its sigma, against the refinement's 1.1 mm.)
+// (A line beside another before its track starts pushes that one's bearings off, and the
+// filter ends off by several of its sigmas: CrossingGuard.BeforeATrackStartsBesideAnother.)
 std::map<std::pair<int, int>, int> guard_before_starts(const CalibrationRun& run,
                                                        const Options& options);
 
