@@ -38,9 +38,12 @@
 #include <string>
 #include <vector>
 
-#include "omnivert/calib/batch.hpp"
+#include "omnivert/calib/batch_point.hpp"
 #include "omnivert/calib/calibrate.hpp"
 #include "omnivert/calib/calibration_filter.hpp"
+#include "omnivert/calib/observability.hpp"
+#include "omnivert/calib/refinement.hpp"
+#include "omnivert/calib/track_ids.hpp"
 #include "calib/synthetic_run.hpp"
 #include "omnivert/calib/updater.hpp"
 #include "omnivert/core/angles.hpp"

@@ -11,8 +11,8 @@
 #include <set>
 #include <sstream>
 
-#include <Eigen/Cholesky>
 #include <spdlog/spdlog.h>
+#include <Eigen/Cholesky>
 
 #include "omnivert/calib/updater.hpp"
 #include "omnivert/core/angles.hpp"
@@ -34,18 +34,159 @@ CalibrationRun without_bearings(const CalibrationRun& run,
   for (const auto& [k, ids] : by_frame) {
     if (k < 0 || k >= static_cast<int>(out.frames.size())) continue;
     auto& obs = out.frames[static_cast<std::size_t>(k)].observations;
-    obs.erase(std::remove_if(obs.begin(), obs.end(),
-                             [&ids](const BearingObservation& o) { return ids.count(o.track_id) > 0; }),
-              obs.end());
+    obs.erase(
+        std::remove_if(obs.begin(),
+                       obs.end(),
+                       [&ids](const BearingObservation& o) { return ids.count(o.track_id) > 0; }),
+        obs.end());
   }
   return out;
 }
 
 // CalibrateOptions::noise_check_lower_max_joins: whether "less noise" may be applied to a
 // check over check.clusters tracks after `joins` pieces of lines were joined.
-bool lower_side_applies(const CalibrateOptions& co, std::size_t joins, const BatchNoiseCheck& check) {
+bool lower_side_applies(const CalibrateOptions& co,
+                        std::size_t joins,
+                        const BatchNoiseCheck& check) {
   return co.noise_check_lower_max_joins >= 0.0 &&
          static_cast<double>(joins) <= co.noise_check_lower_max_joins * check.clusters;
+}
+
+// Each stage's time, on the log's debug level (omnivert -v).
+class StageTimer {
+ public:
+  void lap(const char* stage) {
+    const auto now = std::chrono::steady_clock::now();
+    spdlog::debug("calibrate: {} {:.2f} s", stage, std::chrono::duration<double>(now - t_).count());
+    t_ = now;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point t_ = std::chrono::steady_clock::now();
+};
+
+// The refinement (CalibrateOptions::refine) from the filter's point, and Sec. 8.1 at the best
+// estimate of the trajectory, the features and the extrinsics, on the bearings the estimate
+// used.
+void refine_and_analyse(const CalibrationRun& run,
+                        const Options& options,
+                        const CalibrateOptions& co,
+                        const BatchPoint& filter_point,
+                        StageTimer* timer,
+                        CalibrationResult* r) {
+  BatchPoint at = filter_point;
+  // Sec. 8.1 on the bearings the estimate used: those left out where lines cross
+  // (Options::crossing_guard) do not follow eq. (30)'s model, and those the gate refused are
+  // taken for outliers; neither carries information the estimators use.
+  // Pieces of one line that the filter joined (Options::join_pieces) are one feature there.
+  CalibrationRun analysed =
+      join_tracks(without_bearings(run, r->filter.guarded, r->filter.rejected), r->filter.joins);
+  if (co.refine) {
+    r->refinement = refine_batch(run, options, at, co.batch);
+    r->refined = true;
+    at = r->refinement.solution;
+    // The same problem (split where the refinement split the tracks), without the guarded
+    // bearings and those the refinement rejected as outliers: the bound is that of the
+    // problem the estimate solved (with the outliers' information counted, the bounds come
+    // out small: CalibrationFilter.RefusedBearingsAreListedAndLeftOutOfTheBound).
+    analysed = without_bearings(r->refinement.renamed() ? r->refinement.solved_run : run,
+                                r->refinement.guarded,
+                                r->refinement.rejected);
+    timer->lap("refinement");
+  }
+  r->observability = analyse_observability(analysed, options, at, co.batch, co.observability);
+  timer->lap("observability");
+  if (r->refined && !r->refinement.covariance_ok && r->observability.all_determined() &&
+      r->observability.crlb_covariance.allFinite()) {
+    // ceres::Covariance gives up on badly scaled problems (poses in metres, bearings whitened
+    // by a small sigma); the marginal Fisher information at the same solution is the same
+    // quantity, computed with the Schur complement.
+    r->refinement.covariance = r->observability.crlb_covariance;
+    r->refinement.covariance_ok = true;
+    r->covariance_from_information = true;
+  }
+}
+
+// The overall variance ratio tr(model^-1 checked) / 3 of a noise check; 0 when it failed.
+double ratio_of(const BatchNoiseCheck& n) {
+  const Eigen::LDLT<Eigen::Matrix3d> model(n.model_covariance);
+  if (!n.ok || model.info() != Eigen::Success) return 0.0;
+  const double ratio = model.solve(n.covariance).trace() / 3.0;
+  return std::isfinite(ratio) && ratio > 0.0 ? ratio : 0.0;
+}
+
+// The noise check of the filter: on its own tracks, joined where it joined them
+// (FilterResult::joins) and split only where its window split them (FilterResult::splits),
+// each part starting at the track's filter estimate (after the window the filter treats a
+// track that slipped onto a neighbouring line as one feature, and the check should see
+// that). With no splits or joins anywhere, the refinement already solved this very problem.
+BatchNoiseCheck filter_noise_check(const CalibrationRun& run,
+                                   const Options& options,
+                                   const CalibrateOptions& co,
+                                   const BatchPoint& filter_point,
+                                   const CalibrationResult& r) {
+  if (r.refined && !r.refinement.renamed() && r.filter.splits.empty() && r.filter.joins.empty())
+    return r.refinement.noise;
+  BatchOptions unsplit = co.batch;
+  unsplit.split_chi2 = 0.0;
+  unsplit.merge_pieces = false;
+  std::map<int, int> origin;
+  const CalibrationRun filter_run =
+      split_tracks(join_tracks(run, r.filter.joins), r.filter.splits, &origin);
+  BatchPoint start = filter_point;
+  for (const auto& [id, tracker] : origin)
+    if (const auto it = filter_point.features.find(tracker); it != filter_point.features.end())
+      start.features[id] = it->second;
+  return refine_batch(filter_run, options, start, unsplit).noise;
+}
+
+// The filter's noise check applied to its covariance: scaled by the ratio when the check
+// shows more noise, the bearings' share shrunk when it shows less where the tracker kept its
+// lines (CalibrateOptions::noise_check).
+void apply_filter_noise(const CalibrateOptions& co, CalibrationResult* r) {
+  const double ratio = ratio_of(r->filter_noise);
+  if (!(ratio > 0.0)) return;
+  r->noise_checked = true;
+  r->noise = r->filter_noise;
+  r->filter_noise_verdict =
+      noise_check_verdict(r->filter_noise, co.noise_check_level, co.noise_check_lower_level);
+  r->noise_verdict = r->filter_noise_verdict;
+  auto apply = [&](const Eigen::Matrix3d& covariance) {
+    r->filter.covariance = covariance;
+    r->filter_noise_applied = r->noise_applied = true;
+    r->filter_noise_ratio = r->noise_ratio = ratio;
+  };
+  if (r->filter_noise_verdict == NoiseVerdict::kMoreNoise) {
+    apply(r->filter.covariance * ratio);
+  } else if (r->filter_noise_verdict == NoiseVerdict::kLessNoise &&
+             lower_side_applies(co, r->filter.joins.size(), r->filter_noise)) {
+    const Eigen::Matrix3d shrunk =
+        r->filter.covariance + r->filter_noise.covariance - r->filter_noise.model_covariance;
+    if (shrunk.allFinite() && Eigen::LLT<Eigen::Matrix3d>(shrunk).info() == Eigen::Success)
+      apply(0.5 * (shrunk + shrunk.transpose()));
+  }
+}
+
+// The refinement's noise check (at its solution) applied to its covariance: the checked
+// covariance where the check shows more noise, or less where few pieces of lines were joined.
+void apply_refinement_noise(const CalibrateOptions& co, CalibrationResult* r) {
+  r->noise_checked = false;
+  r->noise_applied = false;
+  r->noise_verdict = NoiseVerdict::kAgrees;
+  r->noise_ratio = 1.0;
+  const double ratio = ratio_of(r->refinement.noise);
+  if (!(ratio > 0.0)) return;
+  r->noise_checked = true;
+  r->noise = r->refinement.noise;
+  r->noise_verdict =
+      noise_check_verdict(r->noise, co.noise_check_level, co.noise_check_lower_level);
+  if (r->noise_verdict == NoiseVerdict::kMoreNoise ||
+      (r->noise_verdict == NoiseVerdict::kLessNoise &&
+       lower_side_applies(co, r->refinement.merges.size(), r->noise))) {
+    r->noise_applied = true;
+    r->noise_ratio = ratio;
+    r->refinement.covariance = r->noise.covariance;
+  }
 }
 
 CalibrationResult calibrate_once(const CalibrationRun& run,
@@ -56,129 +197,27 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
   r.track_bias_sigma = options.track_bias_sigma;
   r.noise_check_level = co.noise_check_level;
   r.noise_check_lower_level = co.noise_check_lower_level;
-  // Each stage's time, on the log's debug level (omnivert -v).
-  auto t = std::chrono::steady_clock::now();
-  auto lap = [&t](const char* stage) {
-    const auto now = std::chrono::steady_clock::now();
-    spdlog::debug("calibrate: {} {:.2f} s", stage, std::chrono::duration<double>(now - t).count());
-    t = now;
-  };
+  StageTimer timer;
   r.filter = run_filter(run, options);
-  lap("filter");
+  timer.lap("filter");
   const BatchPoint filter_point = batch_point_from_filter(run, options, r.filter);
-  BatchPoint at = filter_point;
-  // Sec. 8.1 on the bearings the estimate used: those left out where lines cross
-  // (Options::crossing_guard) do not follow eq. (30)'s model, and those the gate refused are
-  // taken for outliers; neither carries information the estimators use.
-  // Pieces of one line that the filter joined (Options::join_pieces) are one feature there.
-  CalibrationRun analysed =
-      join_tracks(without_bearings(run, r.filter.guarded, r.filter.rejected), r.filter.joins);
-  if (co.refine) {
-    r.refinement = refine_batch(run, options, at, co.batch);
-    r.refined = true;
-    at = r.refinement.solution;
-    // The same problem (split where the refinement split the tracks).
-    // Neither the guarded bearings nor those the refinement rejected as outliers: the bound
-    // is that of the problem the estimate solved (with the outliers' information counted,
-    // corridor paper seed 27, 211 of 845 bearings rejected, the bounds came out 7% small).
-    analysed = without_bearings(r.refinement.renamed() ? r.refinement.solved_run : run,
-                                r.refinement.guarded, r.refinement.rejected);
-    lap("refinement");
-  }
-  // Sec. 8.1 at the best estimate of the trajectory, the features and the extrinsics.
-  r.observability = analyse_observability(analysed, options, at, co.batch, co.observability);
-  lap("observability");
-  if (r.refined && !r.refinement.covariance_ok && r.observability.all_determined() &&
-      r.observability.crlb_covariance.allFinite()) {
-    // ceres::Covariance gives up on badly scaled problems (poses in metres, bearings whitened
-    // by a small sigma); the marginal Fisher information at the same solution is the same
-    // quantity, computed with the Schur complement.
-    r.refinement.covariance = r.observability.crlb_covariance;
-    r.refinement.covariance_ok = true;
-    r.covariance_from_information = true;
-  }
+  refine_and_analyse(run, options, co, filter_point, &timer, &r);
   r.filter_model_covariance = r.filter.covariance;
   r.refinement_model_covariance = r.refinement.covariance;
   if (co.noise_check && r.observability.all_determined()) {
     // How large the errors really are, measured by the data (docs/calib.md, "The noise
     // check"): at a batch solution, the errors of each track summed before squaring. The
-    // filter is checked on its own tracks, split only where its window split them (after the
-    // window it treats a track that slipped onto a neighbouring line as one feature, and the
-    // check should see that), the refinement on the problem it solved (tracks split). A
-    // covariance is replaced by the checked one only when the check shows more noise than the
-    // model allows (noise_check_verdict): with 10-15 tracks one run's scale is uncertain, and
-    // applied always it made the refinement's NEES worse where the model is right (synthetic
-    // 0.3 degree, 50 runs: 3.50 -> 5.18). Less noise is applied only where few pieces of
-    // lines were joined (CalibrateOptions::noise_check, noise_check_lower_max_joins).
-    auto ratio_of = [](const BatchNoiseCheck& n) {
-      const Eigen::LDLT<Eigen::Matrix3d> model(n.model_covariance);
-      if (!n.ok || model.info() != Eigen::Success) return 0.0;
-      const double ratio = model.solve(n.covariance).trace() / 3.0;
-      return std::isfinite(ratio) && ratio > 0.0 ? ratio : 0.0;
-    };
-    BatchOptions unsplit = co.batch;
-    unsplit.split_chi2 = 0.0;
-    unsplit.merge_pieces = false;
-    // The filter's tracks: joined where it joined them (FilterResult::joins) and split where
-    // its window split them (FilterResult::splits), each part starting at the track's filter
-    // estimate. (With no splits anywhere, the refinement
-    // already solved this very problem.)
-    if (r.refined && !r.refinement.renamed() && r.filter.splits.empty() &&
-        r.filter.joins.empty()) {
-      r.filter_noise = r.refinement.noise;
-    } else {
-      std::map<int, int> origin;
-      const CalibrationRun filter_run =
-          split_tracks(join_tracks(run, r.filter.joins), r.filter.splits, &origin);
-      BatchPoint start = filter_point;
-      for (const auto& [id, tracker] : origin)
-        if (const auto it = filter_point.features.find(tracker); it != filter_point.features.end())
-          start.features[id] = it->second;
-      r.filter_noise = refine_batch(filter_run, options, start, unsplit).noise;
-    }
-    lap("the filter's noise check");
-    if (const double ratio = ratio_of(r.filter_noise); ratio > 0.0) {
-      r.noise_checked = true;
-      r.noise = r.filter_noise;
-      r.filter_noise_verdict =
-          noise_check_verdict(r.filter_noise, co.noise_check_level, co.noise_check_lower_level);
-      r.noise_verdict = r.filter_noise_verdict;
-      // Applied when the check shows more noise, or less where the tracker kept its lines
-      // (CalibrateOptions::noise_check).
-      auto apply = [&](const Eigen::Matrix3d& covariance) {
-        r.filter.covariance = covariance;
-        r.filter_noise_applied = r.noise_applied = true;
-        r.filter_noise_ratio = r.noise_ratio = ratio;
-      };
-      if (r.filter_noise_verdict == NoiseVerdict::kMoreNoise) {
-        apply(r.filter.covariance * ratio);
-      } else if (r.filter_noise_verdict == NoiseVerdict::kLessNoise &&
-                 lower_side_applies(co, r.filter.joins.size(), r.filter_noise)) {
-        const Eigen::Matrix3d shrunk =
-            r.filter.covariance + r.filter_noise.covariance - r.filter_noise.model_covariance;
-        if (shrunk.allFinite() && Eigen::LLT<Eigen::Matrix3d>(shrunk).info() == Eigen::Success)
-          apply(0.5 * (shrunk + shrunk.transpose()));
-      }
-    }
-    if (r.refined && r.refinement.covariance_ok) {
-      r.noise_checked = false;
-      r.noise_applied = false;
-      r.noise_verdict = NoiseVerdict::kAgrees;
-      r.noise_ratio = 1.0;
-      if (const double ratio = ratio_of(r.refinement.noise); ratio > 0.0) {
-        r.noise_checked = true;
-        r.noise = r.refinement.noise;
-        r.noise_verdict =
-            noise_check_verdict(r.noise, co.noise_check_level, co.noise_check_lower_level);
-        if (r.noise_verdict == NoiseVerdict::kMoreNoise ||
-            (r.noise_verdict == NoiseVerdict::kLessNoise &&
-             lower_side_applies(co, r.refinement.merges.size(), r.noise))) {
-          r.noise_applied = true;
-          r.noise_ratio = ratio;
-          r.refinement.covariance = r.noise.covariance;
-        }
-      }
-    }
+    // filter is checked on its own tracks, the refinement on the problem it solved (tracks
+    // split). A covariance is replaced by the checked one only when the check shows more
+    // noise than the model allows (noise_check_verdict): with 10-15 tracks one run's scale
+    // is uncertain, and applied always it made the refinement's NEES worse where the model
+    // is right (synthetic 0.3 degree, 50 runs: 3.50 -> 5.18). Less noise is applied only
+    // where few pieces of lines were joined (CalibrateOptions::noise_check,
+    // noise_check_lower_max_joins).
+    r.filter_noise = filter_noise_check(run, options, co, filter_point, r);
+    timer.lap("the filter's noise check");
+    apply_filter_noise(co, &r);
+    if (r.refined && r.refinement.covariance_ok) apply_refinement_noise(co, &r);
   }
   r.extrinsics = r.filter.extrinsics;
   r.covariance = r.filter.covariance;
@@ -209,152 +248,6 @@ double effective_bearing_sigma(const CalibrationResult& r) {
 
 double effective_track_bias_sigma(const CalibrationResult& r) {
   return checked_sigma(r, r.track_bias_sigma);
-}
-
-std::string bearing_noise_text(double bearing_sigma, double track_bias_sigma) {
-  char buf[96];
-  if (track_bias_sigma > 0.0)
-    std::snprintf(buf, sizeof buf, "%.3f deg + %.3f deg per track", rad2deg(bearing_sigma),
-                  rad2deg(track_bias_sigma));
-  else
-    std::snprintf(buf, sizeof buf, "%.3f deg", rad2deg(bearing_sigma));
-  return buf;
-}
-
-std::string noise_check_flags(const CalibrationResult& r) {
-  char buf[96];
-  std::snprintf(buf, sizeof buf, "--bearing-sigma %.3f", rad2deg(effective_bearing_sigma(r)));
-  std::string out = buf;
-  if (r.track_bias_sigma > 0.0) {
-    std::snprintf(buf, sizeof buf, " --track-bias-sigma %.3f",
-                  rad2deg(effective_track_bias_sigma(r)));
-    out += buf;
-  }
-  return out;
-}
-
-std::string noise_check_chance(double limit, const char* side, double level) {
-  char buf[96];
-  std::snprintf(
-      buf, sizeof buf, "x%.2f or %s has a %g%% chance under it", limit, side, 100.0 * level);
-  return buf;
-}
-
-std::vector<std::string> result_warnings(const CalibrationResult& r) {
-  std::vector<std::string> out;
-  char buf[1024];
-  // The gate's refusals after the start-up window: the window's own outliers (left out of its
-  // batch solve, counted in its frames) are no sign of a filter that diverged. Counted with
-  // them, this fired in 343 of 400 zigzag runs from pixels whose estimates were consistent
-  // (the window is most of a zigzag run); counted after the window, in 1 of 800 runs of all
-  // four rows (office paper seed 106, the filter's NEES 6.0).
-  const std::size_t from =
-      r.filter.window_failure.empty() ? static_cast<std::size_t>(std::max(r.filter.window_frames, 0)) : 0;
-  long used = 0, refused = 0;
-  for (std::size_t k = from; k < r.filter.history.size(); ++k) {
-    used += r.filter.history[k].num_updates;
-    refused += r.filter.history[k].num_rejected;
-  }
-  const long seen = used + refused;
-  if (seen >= 50 && refused > 0.2 * static_cast<double>(seen)) {
-    std::snprintf(buf, sizeof(buf),
-                  "the filter's chi-square gate refused %ld of %ld bearings (%.0f%%) after its "
-                  "start-up window: the filter has probably diverged or the tracks mix lines; "
-                  "look at tracks.png%s",
-                  refused, seen, 100.0 * static_cast<double>(refused) / static_cast<double>(seen),
-                  r.refined ? "" : " and run with --refine");
-    out.emplace_back(buf);
-  }
-  if (!r.filter.window_failure.empty()) {
-    std::snprintf(buf, sizeof(buf),
-                  "the filter's start-up window (%d frames, solved as a batch) could not be "
-                  "solved (%s); the filter ran over it from the prior, one frame at a time, and "
-                  "may be off by more than its sigma%s",
-                  r.filter.window_frames, r.filter.window_failure.c_str(),
-                  r.refined ? "; the refinement's answer is the one to trust" : ": run with --refine");
-    out.emplace_back(buf);
-  }
-  if (r.noise_checked && r.noise.clusters >= 2) {
-    // noise_check_rejects_model at the level the run used: under the model the check's scale
-    // is about chi-square(G) / G over G tracks.
-    const int g = r.noise.clusters;
-    if (noise_check_rejects_model(r.noise, r.noise_check_level)) {
-      std::snprintf(buf, sizeof(buf), "To weight the bearings as the data say, run again with "
-                    "%s", noise_check_flags(r).c_str());
-      std::string remedy = buf;
-      if (!r.refined)
-        remedy += "; or add --refine, which splits tracks that slipped onto a neighbouring "
-                  "line anywhere in the run (the filter splits them only in its start-up window "
-                  "and then treats each as one feature, which the check sees)";
-      std::snprintf(
-          buf,
-          sizeof(buf),
-          "the bearings' errors, summed along each track, are larger than the bearing "
-          "sigma of %s allows (variance x%.2f over %d tracks; %s): the sigmas "
-          "reported include it (noise check). %s",
-          bearing_noise_text(r.bearing_sigma, r.track_bias_sigma).c_str(),
-          r.noise.scale,
-          g,
-          noise_check_chance(noise_check_limit(g, r.noise_check_level), "more", r.noise_check_level)
-              .c_str(),
-          remedy.c_str());
-      out.emplace_back(buf);
-    }
-  }
-  if (const WheelCheck& w = wheel_check_of(r); wheel_check_rejects_model(w)) {
-    // The wheels' turns are (1 + s) x the robot's (eq. 15 divides by the wheel base: e (1 + s)
-    // fits); c: rotation per metre rolled that the wheels report and the robot did not make
-    // (right and left wheel scales |c| x e apart).
-    std::string what;
-    if (std::abs(w.rotation_scale) > 3.0 * w.sigma_rotation_scale) {
-      std::snprintf(buf, sizeof(buf),
-                    "the wheels report turns %.2f%% %s than the robot made (+-%.2f%%; a wheel base "
-                    "of %.4f m instead of %.4f m in wheel0/sensor.yaml would fit)",
-                    100.0 * std::abs(w.rotation_scale), w.rotation_scale > 0 ? "larger" : "smaller",
-                    100.0 * w.sigma_rotation_scale, w.wheel_base * (1.0 + w.rotation_scale),
-                    w.wheel_base);
-      what = buf;
-    }
-    if (std::abs(w.drift_per_m) > 3.0 * w.sigma_drift_per_m) {
-      std::snprintf(buf, sizeof(buf),
-                    "%sthe wheels report %.3f deg of turning per metre rolled that the robot did "
-                    "not make (+-%.3f; the right and left wheels' scales are about %.2f%% apart)",
-                    what.empty() ? "" : "; ", rad2deg(w.drift_per_m), rad2deg(w.sigma_drift_per_m),
-                    100.0 * std::abs(w.drift_per_m) * w.wheel_base);
-      what += buf;
-    }
-    if (what.empty()) what = "the wheels' rotation disagrees with the bearings'";
-    std::snprintf(buf, sizeof(buf),
-                  "wheel odometry has a systematic error that its model (eq. 31, K) does not "
-                  "describe (wheel check chi-square %.1f, 99.9%% limit %.1f): %s. The extrinsics "
-                  "may be biased by it: correct the wheel base and wheel scales in "
-                  "wheel0/sensor.yaml, or raise --odometry-inflation (the paper used 5)",
-                  w.chi2, chi2_quantile(0.999, 2), what.c_str());
-    out.emplace_back(buf);
-  }
-  if (r.refined && r.refinement.covariance_ok && r.filter.covariance.allFinite()) {
-    const Extrinsics& f = r.filter.extrinsics;
-    const Extrinsics& b = r.refinement.extrinsics;
-    const Eigen::Vector3d d(wrap_angle(b.phi - f.phi), b.rho - f.rho, wrap_angle(b.psi - f.psi));
-    const Eigen::LDLT<Eigen::Matrix3d> ldlt(r.filter.covariance);
-    const double m2 = ldlt.info() == Eigen::Success ? d.dot(ldlt.solve(d)) : 0.0;
-    constexpr double kChi2_3_999 = 16.27;  // chi-square, 3 dof, 99.9%
-    if (std::isfinite(m2) && m2 > kChi2_3_999) {
-      std::snprintf(buf, sizeof(buf),
-                    "the filter and the refinement disagree (squared Mahalanobis distance %.1f "
-                    "under the filter's covariance, 99.9%% limit %.1f; camera yaw %.3f vs %.3f "
-                    "deg): the filter is biased or overconfident on this run and the "
-                    "refinement's estimate is the one reported (tracks that slip onto a "
-                    "neighbouring line do this; docs/calib.md)",
-                    m2, kChi2_3_999, rad2deg(f.yaw()), rad2deg(b.yaw()));
-      out.emplace_back(buf);
-    }
-  }
-  return out;
-}
-
-const WheelCheck& wheel_check_of(const CalibrationResult& r) {
-  return r.refined ? r.refinement.noise.wheels : r.filter_noise.wheels;
 }
 
 namespace {

@@ -7,8 +7,9 @@
 #include <set>
 #include <string>
 
-#include "omnivert/calib/batch.hpp"
+#include "calib/window.hpp"
 #include "omnivert/calib/model.hpp"
+#include "omnivert/calib/track_ids.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
 
@@ -37,7 +38,8 @@ CalibrationFilter::CalibrationFilter(const Options& options)
 
 void CalibrationFilter::process(const FrameInput& frame) {
   const std::string where = "frame " + std::to_string(frame_);
-  if (!std::isfinite(frame.d_right) || !std::isfinite(frame.d_left) || !std::isfinite(frame.lateral))
+  if (!std::isfinite(frame.d_right) || !std::isfinite(frame.d_left) ||
+      !std::isfinite(frame.lateral))
     throw InputError(where + ": wheel travel is not a finite number");
   std::set<int> seen;
   for (const BearingObservation& o : frame.observations) {
@@ -55,9 +57,8 @@ void CalibrationFilter::process(const FrameInput& frame) {
   // The bearings left out ahead (guard_before_starts), as guarded ones, after the window.
   // In the window, only those before a track that starts after it (end_bootstrap): the
   // window's batch problem guards the frames before the starts it sees itself
-  // (reject_crossings), and left out there as well, corridor zigzag seed 90 at a drawn mount,
-  // a track that slipped onto a neighbouring line was no longer split, and the window ended
-  // 3 mm off, 0.04 mm sure.
+  // (reject_crossings); left out there as well, they can hide the slip of a track onto a
+  // neighbouring line from the window's split test, and the window ends off and overconfident.
   if (!ahead_.empty() && !bootstrapping_) {
     FrameInput kept = frame;
     if (leave_out_ahead(&kept.observations, frame_, -1) > 0) return admit(kept);
@@ -122,10 +123,8 @@ void CalibrationFilter::end_bootstrap(FrameEstimate rec) {
     bootstrapping_ = false;
     window_frames_ = static_cast<int>(window_.frames.size());
     // Bearings before a line whose track starts after the window (guard_before_starts): the
-    // window cannot see that line. (Drawn-mount office paper seed 36: a line's two last
-    // bearings in the window 0.09-0.12 degree off, pushed by a line 0.2-0.3 degree away whose
-    // track started two frames after the window; the filter's rho moved 1.7 mm when the
-    // first line's clean bearings came.)
+    // window cannot see that line, whose detections push the bearings beside it before its
+    // track starts (CrossingGuard.BeforeATrackStartsBesideAnother).
     if (!ahead_.empty()) {
       const int first = frame_ - static_cast<int>(window_.frames.size()) + 1;
       for (int k = 0; k < static_cast<int>(window_.frames.size()); ++k) {
@@ -193,21 +192,51 @@ void CalibrationFilter::step(const FrameInput& frame) {
   if (state_.num_features() > 0) propagator_.propagate(frame, &state_);
 
   // Updates of the tracks already in the state, eq. (30), all bearings of the frame at once.
-  // The crossing guard (Options::crossing_guard): a feature whose direction is within the
-  // guard of another line's is not updated in this frame: the extractor sees the two lines as
-  // one there, and the bearings are pulled or pushed (docs/calib.md, "Lines that cross").
-  // The other line is a feature of the state (its track seen within the last
-  // max_missed_frames frames) or a track that starts in this frame. A feature's direction is
-  // its bearing in this frame where it has one, else its predicted bearing (eq. 27). A track
-  // that starts within the guard of another line enters the state at its first bearing
-  // outside it. (Before, the guard judged by the predictions alone, and a track entered at
-  // its first bearing: drawn-mount office paper seed 32, a line entered at frame 80 0.5
-  // degree from one tracked over the whole run; its depth unknown, its prediction stayed by
-  // the other line, so it was never updated and the other line was left out to the end, 1.1
-  // degree from it: psi 0.82 degree off, 3.7 times the run's bound. Seed 14: a new line's
-  // first bearing was 0.14 degree off where the two lines were 0.4 degree apart; entered
-  // there, the filter ended 1.7 mm off in rho, NEES 6.8; entered once parted, 1.2 mm, NEES
-  // 3.7, as the refinement's 1.05 mm, 3.6.)
+  const std::vector<char> crossing = crossing_entries(frame);
+  std::vector<const BearingObservation*> fresh;
+  std::vector<BearingMeasurement> z;
+  std::vector<int> z_ids;  // each bearing's own track id (a joined track's, not its feature's)
+  sort_bearings(frame, crossing, &rec, &fresh, &z, &z_ids);
+  if (options_.join_pieces && !fresh.empty()) fresh = join_pieces(std::move(fresh), &z, &z_ids);
+  const std::vector<BearingUpdateResult> results = updater_.update(z, &state_);
+  for (std::size_t k = 0; k < z.size(); ++k) {
+    if (results[k].accepted) {
+      ++rec.num_updates;
+      ++state_.mutable_slots()[z[k].slot].num_updates;
+    } else {
+      ++rec.num_rejected;
+      rejected_.emplace_back(z_ids[k], frame_);
+    }
+  }
+  // Tracks that start enter the state (their first bearing is used by the initialisation).
+  for (const BearingObservation* o : fresh) {
+    initializer_.initialize(o->track_id, o->beta, frame_, &state_, o->sigma_scale);
+    ++rec.num_new;
+  }
+  convert_known_depths();
+  record_tracks();
+  // Tracks that ended leave the state (marginalisation).
+  for (int s = state_.num_features() - 1; s >= 0; --s)
+    if (frame_ - state_.slots()[s].last_seen_frame > options_.max_missed_frames)
+      state_.remove_feature(s);
+
+  rec.extrinsics = state_.extrinsics();
+  rec.covariance = state_.extrinsics_covariance();
+  rec.num_features = state_.num_features();
+  history_.push_back(rec);
+  ++frame_;
+}
+
+// The crossing guard (Options::crossing_guard): a feature whose direction is within the
+// guard of another line's is not updated in this frame: the extractor sees the two lines as
+// one there, and the bearings are pulled or pushed (docs/calib.md, "Lines that cross").
+// The other line is a feature of the state (its track seen within the last
+// max_missed_frames frames) or a track that starts in this frame. A feature's direction is
+// its bearing in this frame where it has one, else its predicted bearing (eq. 27). A track
+// that starts within the guard of another line enters the state at its first bearing
+// outside it: entered inside, its first bearing is pulled towards the other line, and with
+// its depth unknown its prediction stays by the other line, which is then left out as long.
+std::vector<char> CalibrationFilter::crossing_entries(const FrameInput& frame) const {
   const int n = state_.num_features();
   std::vector<char> crossing(frame.observations.size() + static_cast<std::size_t>(n), 0);
   if (options_.crossing_guard > 0.0) {
@@ -245,52 +274,44 @@ void CalibrationFilter::step(const FrameInput& frame) {
     for (int e : crowded_directions(std::move(lines), options_.crossing_guard, maybe_same))
       crossing[static_cast<std::size_t>(e)] = 1;
   }
-  std::vector<const BearingObservation*> fresh;
-  std::vector<BearingMeasurement> z;
-  std::vector<int> z_ids;  // each bearing's own track id (a joined track's, not its feature's)
+  return crossing;
+}
+
+void CalibrationFilter::sort_bearings(const FrameInput& frame,
+                                      const std::vector<char>& crossing,
+                                      FrameEstimate* rec,
+                                      std::vector<const BearingObservation*>* fresh,
+                                      std::vector<BearingMeasurement>* z,
+                                      std::vector<int>* z_ids) {
+  const int n = state_.num_features();
   std::set<int> measured;  // slots with a bearing in this frame
   for (std::size_t i = 0; i < frame.observations.size(); ++i) {
     const BearingObservation& o = frame.observations[i];
     const int slot = slot_of(o.track_id);
     if (slot >= 0) state_.mutable_slots()[slot].last_seen_frame = frame_;
     if (crossing[slot >= 0 ? static_cast<std::size_t>(slot) : static_cast<std::size_t>(n) + i]) {
-      ++rec.num_guarded;
+      ++rec->num_guarded;
       guarded_.emplace_back(o.track_id, frame_);
       continue;
     }
     if (slot < 0) {
-      fresh.push_back(&o);
+      fresh->push_back(&o);
       continue;
     }
     if (!measured.insert(slot).second) {
       // A feature's old track came back beside the track joined to it: one line seen twice
       // is not a bearing of eq. (30); the second is refused.
-      ++rec.num_rejected;
+      ++rec->num_rejected;
       rejected_.emplace_back(o.track_id, frame_);
       continue;
     }
-    z.push_back({slot, o.beta, o.sigma_scale});
-    z_ids.push_back(o.track_id);
+    z->push_back({slot, o.beta, o.sigma_scale});
+    z_ids->push_back(o.track_id);
   }
-  if (options_.join_pieces && !fresh.empty())
-    fresh = join_pieces(std::move(fresh), &z, &z_ids);
-  const std::vector<BearingUpdateResult> results = updater_.update(z, &state_);
-  for (std::size_t k = 0; k < z.size(); ++k) {
-    if (results[k].accepted) {
-      ++rec.num_updates;
-      ++state_.mutable_slots()[z[k].slot].num_updates;
-    } else {
-      ++rec.num_rejected;
-      rejected_.emplace_back(z_ids[k], frame_);
-    }
-  }
-  // Tracks that start enter the state (their first bearing is used by the initialisation).
-  for (const BearingObservation* o : fresh) {
-    initializer_.initialize(o->track_id, o->beta, frame_, &state_, o->sigma_scale);
-    ++rec.num_new;
-  }
-  // Inverse-depth blocks whose depth is now well known change to (D, theta) of eq. (28)
-  // (kInverseDistance) or to a robot-frame point (kAnchored).
+}
+
+// (D, theta) of eq. (28) for kInverseDistance, a robot-frame point for kAnchored.
+void CalibrationFilter::convert_known_depths() {
   if (options_.convert_ratio > 0.0) {
     for (int s = 0; s < state_.num_features(); ++s) {
       const FeatureSlot& slot = state_.slots()[s];
@@ -313,17 +334,6 @@ void CalibrationFilter::step(const FrameInput& frame) {
       }
     }
   }
-  record_tracks();
-  // Tracks that ended leave the state (marginalisation).
-  for (int s = state_.num_features() - 1; s >= 0; --s)
-    if (frame_ - state_.slots()[s].last_seen_frame > options_.max_missed_frames)
-      state_.remove_feature(s);
-
-  rec.extrinsics = state_.extrinsics();
-  rec.covariance = state_.extrinsics_covariance();
-  rec.num_features = state_.num_features();
-  history_.push_back(rec);
-  ++frame_;
 }
 
 int CalibrationFilter::slot_of(int track_id) const {
@@ -342,9 +352,8 @@ int CalibrationFilter::slot_of(int track_id) const {
 // candidate, which no other new track has as a candidate, continues it. (Only the features
 // seen in this frame crowd a candidate: the old piece of a line that was not joined stays in
 // the state for max_missed_frames frames unseen, and would crowd the new piece of the same
-// line. Without the crowding test, from pixels with tracks broken every ~10 frames, office
-// paper seed 7: a new track of a door's edge was joined to the feature of the edge beside
-// it, and the filter ended 1.2 degree off in yaw, NEES 273; with it 0.2 degree, NEES 10.3.)
+// line. Without the crowding test a new track of a door's edge can be joined to the feature
+// of the edge beside it, which puts the filter a degree off in yaw.)
 std::vector<const BearingObservation*> CalibrationFilter::join_pieces(
     std::vector<const BearingObservation*> fresh,
     std::vector<BearingMeasurement>* z,
@@ -461,9 +470,16 @@ FilterResult run_filter(const CalibrationRun& run, const Options& options) {
   filter.guard_ahead(guard_before_starts(run, options));
   for (const FrameInput& f : run.frames) filter.process(f);
   filter.finish();
-  return {filter.extrinsics(), filter.covariance(), filter.history(), filter.tracks(),
-          filter.splits(), filter.window_frames(), filter.window_failure(), filter.guarded(),
-          filter.rejected(), filter.joins()};
+  return {filter.extrinsics(),
+          filter.covariance(),
+          filter.history(),
+          filter.tracks(),
+          filter.splits(),
+          filter.window_frames(),
+          filter.window_failure(),
+          filter.guarded(),
+          filter.rejected(),
+          filter.joins()};
 }
 
 }  // namespace omnivert::calib

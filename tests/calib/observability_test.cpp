@@ -4,7 +4,9 @@
 
 #include <cmath>
 
-#include "omnivert/calib/batch.hpp"
+#include "omnivert/calib/batch_point.hpp"
+#include "omnivert/calib/observability.hpp"
+#include "omnivert/calib/refinement.hpp"
 #include "omnivert/calib/calibrate.hpp"
 #include "calib/synthetic_run.hpp"
 #include "omnivert/core/angles.hpp"

@@ -2,8 +2,11 @@
 // Helpers shared by the calibration tests on synthetic runs (calib/synthetic_run.hpp).
 
 #include <Eigen/Cholesky>
+#include <cmath>
 
-#include "omnivert/calib/batch.hpp"
+#include "omnivert/calib/batch_point.hpp"
+#include "omnivert/calib/model.hpp"
+#include "omnivert/calib/refinement.hpp"
 #include "calib/synthetic_run.hpp"
 #include "omnivert/core/angles.hpp"
 
@@ -29,9 +32,31 @@ inline Options options_for(const SyntheticRunOptions& so) {
 
 // NEES of (phi, rho, psi) against the truth (angles wrapped).
 inline double nees(const Extrinsics& est, const Eigen::Matrix3d& cov, const Extrinsics& truth) {
-  const Eigen::Vector3d e(wrap_angle(est.phi - truth.phi), est.rho - truth.rho,
-                          wrap_angle(est.psi - truth.psi));
+  const Eigen::Vector3d e(
+      wrap_angle(est.phi - truth.phi), est.rho - truth.rho, wrap_angle(est.psi - truth.psi));
   return e.dot(cov.ldlt().solve(e));
+}
+
+// NEES of a refinement's answer against the truth.
+inline double nees(const RefinementResult& r, const Extrinsics& truth) {
+  return nees(r.extrinsics, r.covariance, truth);
+}
+
+// From frame `from` on, the track of feature `f` follows a second line `behind` metres further
+// along the camera's ray of frame `from` (same noise): at the slip the two bearings coincide,
+// afterwards they drift apart as the robot moves, as a door leaf does behind its frame.
+inline SyntheticRun slip(SyntheticRun run, int track, int from, double behind) {
+  const Eigen::Vector2d f = run.features[run.track_feature.at(track)];
+  const Eigen::Vector3d& p = run.true_poses[from];
+  const double a = p(2) + run.truth.phi;
+  const Eigen::Vector2d c(p(0) + run.truth.rho * std::cos(a), p(1) + run.truth.rho * std::sin(a));
+  const Eigen::Vector2d g = f + behind * (f - c).normalized();
+  for (std::size_t k = from; k < run.run.frames.size(); ++k)
+    for (BearingObservation& o : run.run.frames[k].observations)
+      if (o.track_id == track)
+        o.beta += bearing_from_geometry(run.true_poses[k], g, run.truth) -
+                  bearing_from_geometry(run.true_poses[k], f, run.truth);
+  return run;
 }
 
 }  // namespace omnivert::calib::test_support

@@ -15,7 +15,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "omnivert/calib/batch.hpp"
+#include "omnivert/calib/batch_point.hpp"
 #include "omnivert/pipeline/calibration_input.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"

@@ -13,8 +13,11 @@
 #include <string>
 #include <vector>
 
-#include "omnivert/calib/batch.hpp"
 #include "omnivert/calib/calibration_filter.hpp"
+#include "omnivert/calib/diagnostics.hpp"
+#include "omnivert/calib/observability.hpp"
+#include "omnivert/calib/refinement.hpp"
+#include "omnivert/calib/track_ids.hpp"
 #include "omnivert/calib/types.hpp"
 
 namespace omnivert::calib {

@@ -67,7 +67,7 @@ class CalibrationFilter {
   const std::vector<FrameEstimate>& history() const { return history_; }
   const std::map<int, TrackEstimate>& tracks() const { return tracks_; }
   // Tracks split in the bootstrap window (a track that slipped onto a neighbouring line):
-  // (tracker's track id, first frame of the new part); see split_tracks (batch.hpp).
+  // (tracker's track id, first frame of the new part); see split_tracks (track_ids.hpp).
   const std::vector<std::pair<int, int>>& splits() const { return splits_; }
   // The bootstrap window: how many frames it held (0: none), and, when it could not be
   // solved, why (the filter then ran over it from the prior, undelayed).
@@ -89,7 +89,23 @@ class CalibrationFilter {
 
  private:
   void admit(const FrameInput& frame);
+  // One frame of the EKF (after the window): prediction, updates, new tracks, conversions,
+  // marginalisation.
   void step(const FrameInput& frame);
+  // The crossing guard in this frame: per entry (the state's features, then the frame's new
+  // tracks at n + their index in the frame) whether it is left out.
+  std::vector<char> crossing_entries(const FrameInput& frame) const;
+  // The frame's bearings sorted: guarded (counted in rec), new tracks (*fresh), updates of
+  // features of the state (*z, their own track ids *z_ids), a feature's second bearing
+  // refused.
+  void sort_bearings(const FrameInput& frame,
+                     const std::vector<char>& crossing,
+                     FrameEstimate* rec,
+                     std::vector<const BearingObservation*>* fresh,
+                     std::vector<BearingMeasurement>* z,
+                     std::vector<int>* z_ids);
+  // Inverse-depth blocks whose depth is now well known change parametrisation.
+  void convert_known_depths();
   // Removes from obs (frame `frame`) the bearings guard_ahead marked before a track that
   // starts after frame `started_after`, records them as guarded; returns how many.
   int leave_out_ahead(std::vector<BearingObservation>* obs, int frame, int started_after);
@@ -125,7 +141,7 @@ class CalibrationFilter {
   double window_heading_ = 0.0;
   double window_max_turn_ = 0.0;
   std::map<std::pair<int, int>, int> ahead_;  // guard_ahead
-  std::map<int, int> ahead_count_;       // frame -> bearings left out ahead
+  std::map<int, int> ahead_count_;            // frame -> bearings left out ahead
 };
 
 // The crossing guard ahead of a track's start (Options::crossing_guard): a track often starts
@@ -137,9 +153,8 @@ class CalibrationFilter {
 // rate over b's first 3 frames both saw; a's bearings over the max_missed_frames frames
 // before k0 where it is within the guard are returned: (track id, frame index in run) -> k0
 // (the earliest, where several lines start beside it).
-// (Drawn-mount office paper seed 14: a line 0.2-0.3 degree from another before its track
-// started pushed that one's bearings 0.12 degree off for two frames; the filter ended with
-// rho 2.2 mm off, 3 times its sigma, against the refinement's 1.1 mm.)
+// (A line beside another before its track starts pushes that one's bearings off, and the
+// filter ends off by several of its sigmas: CrossingGuard.BeforeATrackStartsBesideAnother.)
 std::map<std::pair<int, int>, int> guard_before_starts(const CalibrationRun& run,
                                                        const Options& options);
 
@@ -149,9 +164,9 @@ struct FilterResult {
   Eigen::Matrix3d covariance;
   std::vector<FrameEstimate> history;
   std::map<int, TrackEstimate> tracks;
-  std::vector<std::pair<int, int>> splits;  // CalibrationFilter::splits
-  int window_frames = 0;                     // CalibrationFilter::window_frames
-  std::string window_failure;                // CalibrationFilter::window_failure
+  std::vector<std::pair<int, int>> splits;    // CalibrationFilter::splits
+  int window_frames = 0;                      // CalibrationFilter::window_frames
+  std::string window_failure;                 // CalibrationFilter::window_failure
   std::vector<std::pair<int, int>> guarded;   // CalibrationFilter::guarded
   std::vector<std::pair<int, int>> rejected;  // CalibrationFilter::rejected
   std::vector<std::pair<int, int>> joins;     // CalibrationFilter::joins

@@ -1,0 +1,65 @@
+#pragma once
+// Batch maximum-likelihood refinement of a whole run (Ceres), on the batch formulation of
+// batch_point.hpp.
+
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "omnivert/calib/batch_point.hpp"
+#include "omnivert/calib/diagnostics.hpp"
+#include "omnivert/calib/types.hpp"
+
+namespace omnivert::calib {
+
+struct RefinementResult {
+  bool converged = false;
+  BatchPoint solution;
+  Extrinsics extrinsics;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  bool covariance_ok = false;  // false when the problem is rank deficient (not observable)
+  double initial_cost = 0.0;
+  double final_cost = 0.0;
+  int iterations = 0;
+  int num_bearings = 0;  // bearings used
+  int num_rejected = 0;  // bearings removed as outliers (|residual| > the filter's gate)
+  int num_features = 0;  // tracks in the problem (after splitting)
+  int num_splits = 0;    // tracks split in two (BatchOptions::split_chi2)
+  // (track id, first frame of the new part): the tracker's id, or with merges the id of the
+  // line's first piece.
+  std::vector<std::pair<int, int>> splits;
+  // Pieces of one line joined (BatchOptions::merge_pieces): (earlier track id, later track
+  // id), the later piece's bearings renamed to the line's first piece.
+  std::vector<std::pair<int, int>> merges;
+  // Bearings left out where lines cross (Options::crossing_guard): (track id of the solved
+  // run, i.e. of solved_run when tracks were split or merged, frame).
+  std::vector<std::pair<int, int>> guarded;
+  // Bearings removed as outliers (the gate) or with a feature left with too few bearings:
+  // (track id of the solved run, frame). With `guarded`, what the solution did not use; the
+  // bound of Sec. 8.1 for this run is computed without them (calibrate()).
+  std::vector<std::pair<int, int>> rejected;
+  // With splits or merges (renamed()): the run `solution` refers to (split parts and merged
+  // pieces renamed); otherwise empty, and `solution` refers to the run given.
+  CalibrationRun solved_run;
+  bool renamed() const { return num_splits > 0 || !merges.empty(); }
+  // Scale of the bearing residuals at the solution, outliers removed [rad]: 1.4826 x median
+  // |residual| x sqrt(bearings / (bearings - 2 features - 3)); the bearing noise the data
+  // has (infinity without redundancy).
+  double bearing_residual_sigma = std::numeric_limits<double>::infinity();
+  BatchNoiseCheck noise;  // at the solution (outliers removed, splits made)
+  std::string report;     // Ceres' brief report
+};
+
+// Batch maximum-likelihood refinement over the whole run (Ceres, Levenberg-Marquardt),
+// started from `start`, with the covariance of (phi, rho, psi) from ceres::Covariance.
+// Bearings whose residual exceeds the filter's chi-square gate (options.gate_probability)
+// at the solution are removed and the problem solved again (up to three rounds).
+RefinementResult refine_batch(const CalibrationRun& run,
+                              const Options& options,
+                              const BatchPoint& start,
+                              const BatchOptions& batch = {});
+
+}  // namespace omnivert::calib

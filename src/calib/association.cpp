@@ -1,0 +1,180 @@
+#include "calib/association.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "omnivert/calib/model.hpp"
+#include "omnivert/calib/track_ids.hpp"
+#include "omnivert/calib/updater.hpp"
+
+namespace omnivert::calib::internal {
+
+CalibrationRun split_round(const CalibrationRun& original,
+                           const CalibrationRun& current,
+                           const std::map<int, int>& found,
+                           std::vector<std::pair<int, int>>* splits,
+                           std::map<int, int>* origin,
+                           BatchPoint* at) {
+  for (const auto& [id, frame] : found) {
+    const auto it = origin->find(id);
+    splits->emplace_back(it != origin->end() ? it->second : id, frame);
+  }
+  std::map<int, int> next_origin;
+  CalibrationRun next = split_tracks(original, *splits, &next_origin);
+  // split_tracks only renames: observation i of frame k is the same bearing in both runs.
+  std::map<int, Eigen::Vector2d> features;
+  for (std::size_t k = 0; k < next.frames.size() && k < current.frames.size(); ++k) {
+    const auto& a = next.frames[k].observations;
+    const auto& c = current.frames[k].observations;
+    for (std::size_t i = 0; i < a.size() && i < c.size(); ++i) {
+      if (features.count(a[i].track_id)) continue;
+      const auto f = at->features.find(c[i].track_id);
+      if (f != at->features.end()) features[a[i].track_id] = f->second;
+    }
+  }
+  at->features = std::move(features);
+  *origin = std::move(next_origin);
+  return next;
+}
+
+bool merge_round(Built* b,
+                 const Options& options,
+                 CalibrationRun* run,
+                 BatchPoint* at,
+                 std::vector<std::pair<int, int>>* joins) {
+  const std::vector<std::pair<int, int>> found =
+      find_merges(b, options.max_missed_frames, chi2_quantile(options.gate_probability, 2));
+  if (found.empty()) return false;
+  *at = point_of(*b);
+  std::map<int, int> renamed;
+  *run = join_tracks(*run, found, &renamed);
+  for (const auto& [id, into] : renamed) at->features.erase(id);
+  joins->insert(joins->end(), found.begin(), found.end());
+  return true;
+}
+
+Options association_options(const Options& options) {
+  Options a = options;
+  a.bearing_sigma = std::hypot(options.bearing_sigma, options.track_bias_sigma);
+  a.track_bias_sigma = 0.0;
+  return a;
+}
+
+Built final_with_bias(const CalibrationRun& run,
+                      const Built& b,
+                      const Options& options,
+                      const BatchOptions& batch,
+                      bool robust,
+                      int min_track_length) {
+  const std::set<std::pair<int, int>> keep(b.bearing_keys.begin(), b.bearing_keys.end());
+  CalibrationRun kept = run;
+  for (std::size_t k = 0; k < kept.frames.size(); ++k) {
+    auto& obs = kept.frames[k].observations;
+    obs.erase(std::remove_if(obs.begin(),
+                             obs.end(),
+                             [&](const BearingObservation& o) {
+                               return !keep.count({o.track_id, static_cast<int>(k)});
+                             }),
+              obs.end());
+  }
+  Options o = options;
+  o.min_track_length = min_track_length;
+  Built f = build(kept, o, point_of(b), batch, robust);
+  f.guarded = b.guarded;
+  return f;
+}
+
+std::map<int, int> tracker_ids(const std::map<int, int>& base, const std::map<int, int>& origin) {
+  std::map<int, int> m = base;
+  for (const auto& [id, o] : origin) m[id] = base.count(o) ? base.at(o) : o;
+  return m;
+}
+
+namespace {
+
+bool out_of_features(const Built& b, const AssociationSetup& setup) {
+  return setup.stop_when_empty && b.features.empty();
+}
+
+// The crossing guard, the features collapsed onto the camera, the outliers, each followed by
+// a solve. *rejected: the outliers. false: no feature left (AssociationSetup::stop_when_empty).
+bool reject_and_solve(Built* b,
+                      const AssociationSetup& setup,
+                      const std::map<int, int>& tracker,
+                      int* rejected) {
+  const Options& options = *setup.options;
+  // Bearings where lines cross out first (the outliers are judged without them).
+  if (reject_crossings(b,
+                       options.crossing_guard,
+                       options.max_missed_frames,
+                       setup.min_bearings,
+                       tracker,
+                       chi2_quantile(options.gate_probability, 2)) > 0) {
+    if (out_of_features(*b, setup)) return false;
+    setup.solve(b);
+  }
+  *rejected = 0;
+  if (drop_collapsed_features(b, options.min_feature_range) > 0) {
+    if (out_of_features(*b, setup)) return false;
+    setup.solve(b);
+  }
+  const double gate = std::sqrt(chi2_quantile(options.gate_probability, 1));
+  for (int round = 0; round < 3; ++round) {
+    const int n = reject_outliers(b, gate, setup.min_bearings);
+    *rejected += n;
+    if (n == 0) break;
+    setup.solve(b);
+  }
+  return !out_of_features(*b, setup);
+}
+
+// The problem of the renamed run `run` from `at`, solved, and judged again.
+AssociationEnd rebuild_and_judge(Built* b,
+                                 const CalibrationRun& run,
+                                 const BatchPoint& at,
+                                 const AssociationSetup& setup,
+                                 Association* out) {
+  *b = setup.rebuild(run, at);
+  if (out_of_features(*b, setup)) return AssociationEnd::kNoTrack;
+  setup.solve(b);
+  if (!reject_and_solve(b, setup, tracker_ids(setup.base_origin, out->origin), &out->num_rejected))
+    return AssociationEnd::kNoTrackLeft;
+  return AssociationEnd::kDone;
+}
+
+}  // namespace
+
+AssociationEnd associate(Built* b,
+                         const CalibrationRun& run,
+                         const AssociationSetup& setup,
+                         Association* out) {
+  out->merged = run;
+  if (!reject_and_solve(b, setup, tracker_ids(setup.base_origin, out->origin), &out->num_rejected))
+    return AssociationEnd::kNoTrackLeft;
+  // Pieces of one line joined (the tracker lost the line and found it again under a new id),
+  // each line starting at its first piece's point.
+  for (int round = 0; setup.join_pieces && round < kMergeRounds; ++round) {
+    BatchPoint at;
+    if (!merge_round(b, *setup.options, &out->merged, &at, &out->merges)) break;
+    if (const AssociationEnd end = rebuild_and_judge(b, out->merged, at, setup, out);
+        end != AssociationEnd::kDone)
+      return end;
+  }
+  // Tracks that slipped onto a neighbouring line split in two, from the current solution (all
+  // bearings back in, outliers judged again).
+  for (int round = 0; setup.split.split_chi2 > 0.0 && round < setup.split.split_rounds; ++round) {
+    const std::map<int, int> found = find_splits(*b, setup.split);
+    if (found.empty()) break;
+    BatchPoint at = point_of(*b);
+    out->split = split_round(
+        out->merged, round == 0 ? out->merged : out->split, found, &out->splits, &out->origin, &at);
+    out->num_splits += static_cast<int>(found.size());
+    if (const AssociationEnd end = rebuild_and_judge(b, out->split, at, setup, out);
+        end != AssociationEnd::kDone)
+      return end;
+  }
+  return AssociationEnd::kDone;
+}
+
+}  // namespace omnivert::calib::internal

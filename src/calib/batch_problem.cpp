@@ -1,0 +1,202 @@
+#include "calib/batch_problem.hpp"
+
+#include <cmath>
+#include <string>
+
+#include <Eigen/Cholesky>
+
+#include "calib/batch_factors.hpp"
+#include "omnivert/calib/model.hpp"
+#include "omnivert/core/angles.hpp"
+#include "omnivert/core/error.hpp"
+
+namespace omnivert::calib::internal {
+
+int remove_features(Built* b, const std::set<int>& drop) {
+  if (drop.empty()) return 0;
+  filter_bearings(b, [&](ceres::ResidualBlockId, const std::pair<int, int>& key) {
+    return !drop.count(key.first);
+  });
+  for (int id : drop) {
+    if (auto it = b->biases.find(id); it != b->biases.end()) {
+      b->problem->RemoveParameterBlock(&it->second);  // and its prior
+      b->biases.erase(it);
+      b->bias_priors.erase(id);
+    }
+    b->problem->RemoveParameterBlock(b->features.at(id).data());  // and its residual blocks
+    b->features.erase(id);
+  }
+  return static_cast<int>(drop.size());
+}
+
+int drop_unobserved_features(Built* b, int min_bearings) {
+  std::map<int, int> count;
+  for (const auto& [id, frame] : b->bearing_keys) ++count[id];
+  std::set<int> drop;
+  for (const auto& [id, f] : b->features)
+    if (count[id] < min_bearings) drop.insert(id);
+  return remove_features(b, drop);
+}
+
+int drop_collapsed_features(Built* b, double min_range) {
+  std::set<int> drop;
+  for (const auto& [id, k] : b->bearing_keys) {
+    const auto& p = b->poses[static_cast<std::size_t>(k)];
+    const auto& f = b->features.at(id);
+    const double a = p[2] + b->ex[0];
+    const double range =
+        std::hypot(f[0] - p[0] - b->ex[1] * std::cos(a), f[1] - p[1] - b->ex[1] * std::sin(a));
+    if (!(range >= min_range)) drop.insert(id);
+  }
+  return remove_features(b, drop);
+}
+
+int reject_outliers(Built* b, double threshold, int min_bearings) {
+  const int n = filter_bearings(b, [&](ceres::ResidualBlockId id, const std::pair<int, int>&) {
+    double r = 0.0, cost = 0.0;
+    b->problem->EvaluateResidualBlock(id, /*apply_loss_function=*/false, &cost, &r, nullptr);
+    if (std::abs(r) <= threshold) return true;  // (false for NaN)
+    b->problem->RemoveResidualBlock(id);
+    return false;
+  });
+  if (n > 0) drop_unobserved_features(b, min_bearings);
+  return n;
+}
+
+Eigen::SparseMatrix<double> information_with_ridge(const Eigen::SparseMatrix<double>& J) {
+  Eigen::SparseMatrix<double> F = J.transpose() * J;
+  for (int i = 0; i < F.rows(); ++i) {
+    double& d = F.coeffRef(i, i);
+    d = d > 0.0 ? d * (1.0 + 1e-10) : 1.0;
+  }
+  return F;
+}
+
+Eigen::SparseMatrix<double> sparse_jacobian(const ceres::CRSMatrix& crs) {
+  std::vector<Eigen::Triplet<double>> t;
+  t.reserve(crs.values.size());
+  for (int r = 0; r < crs.num_rows; ++r)
+    for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k)
+      t.emplace_back(r, crs.cols[k], crs.values[k]);
+  Eigen::SparseMatrix<double> J(crs.num_rows, crs.num_cols);
+  J.setFromTriplets(t.begin(), t.end());
+  return J;
+}
+
+Eigen::MatrixXd information_from_jacobian(const ceres::CRSMatrix& crs) {
+  const Eigen::SparseMatrix<double> J = sparse_jacobian(crs);
+  const Eigen::SparseMatrix<double> F = J.transpose() * J;
+  return Eigen::MatrixXd(F);
+}
+
+std::vector<double*> variable_blocks(Built& b) {
+  std::vector<double*> v;
+  for (std::size_t k = 1; k < b.poses.size(); ++k) v.push_back(b.poses[k].data());
+  for (auto& [id, f] : b.features) v.push_back(f.data());
+  for (auto& [id, bias] : b.biases) v.push_back(&bias);
+  v.push_back(b.ex.data());
+  return v;
+}
+
+Built build(const CalibrationRun& run,
+            const Options& options,
+            const BatchPoint& at,
+            const BatchOptions& batch,
+            bool robust) {
+  if (at.poses.size() != run.frames.size())
+    throw InputError("batch: the starting point has " + std::to_string(at.poses.size()) +
+                     " poses for " + std::to_string(run.frames.size()) + " frames");
+  Built b;
+  ceres::Problem::Options po;
+  b.problem = std::make_unique<ceres::Problem>(po);
+  b.poses.resize(at.poses.size());
+  for (std::size_t k = 0; k < at.poses.size(); ++k)
+    b.poses[k] = {at.poses[k](0), at.poses[k](1), at.poses[k](2)};
+  b.ex = {at.extrinsics.phi, at.extrinsics.rho, at.extrinsics.psi};
+
+  // Track lengths: only tracks long enough (and with a starting point) enter.
+  std::map<int, int> length;
+  for (const FrameInput& f : run.frames)
+    for (const BearingObservation& o : f.observations) ++length[o.track_id];
+  for (const auto& [id, n] : length) {
+    auto it = at.features.find(id);
+    if (n >= options.min_track_length && it != at.features.end() && it->second.allFinite())
+      b.features[id] = {it->second(0), it->second(1)};
+  }
+
+  for (auto& p : b.poses) b.problem->AddParameterBlock(p.data(), 3);
+  b.problem->SetParameterBlockConstant(b.poses[0].data());  // gauge: frame 0 is the origin
+  b.problem->AddParameterBlock(b.ex.data(), 3);
+
+  const double K = options.odometry_K * batch.odometry_inflation;
+  for (std::size_t k = 1; k < run.frames.size(); ++k) {
+    const FrameInput& f = run.frames[k];
+    // Covariance of (d_right, d_left, lateral): eq. (31) over the frame's wheel samples
+    // (compose_wheel_steps), or over the frame as one step; with the side slip allowed
+    // (lateral_sigma) and the floor.
+    Eigen::Matrix3d S = Eigen::Matrix3d::Zero();
+    if (!f.covariance_per_K.isZero()) {
+      S = K * f.covariance_per_K;
+      S(0, 0) += options.odometry_variance_floor;
+      S(1, 1) += options.odometry_variance_floor;
+    } else {
+      S.topLeftCorner<2, 2>() =
+          chong_kleeman_covariance(f.d_right, f.d_left, K, options.odometry_variance_floor);
+    }
+    S(2, 2) += batch.lateral_sigma * batch.lateral_sigma;
+    // W = L^-1 with S = L L^T: W^T W = S^-1.
+    const Eigen::LLT<Eigen::Matrix3d> llt(S);
+    const Eigen::Matrix3d W = llt.matrixL().solve(Eigen::Matrix3d::Identity());
+    auto* cost = new ceres::AutoDiffCostFunction<OdometryResidual, 3, 3, 3>(
+        new OdometryResidual{f.d_right, f.d_left, f.lateral, options.wheel_base, W});
+    b.odometry_blocks.push_back(
+        b.problem->AddResidualBlock(cost, nullptr, b.poses[k - 1].data(), b.poses[k].data()));
+  }
+  if (options.track_bias_sigma > 0.0)
+    for (const auto& [id, f] : b.features) {
+      double* bias = &(b.biases[id] = 0.0);
+      b.bias_priors[id] =
+          b.problem->AddResidualBlock(new ceres::AutoDiffCostFunction<BiasPrior, 1, 1>(
+                                          new BiasPrior{1.0 / options.track_bias_sigma}),
+                                      nullptr,
+                                      bias);
+    }
+  for (std::size_t k = 0; k < run.frames.size(); ++k) {
+    for (const BearingObservation& o : run.frames[k].observations) {
+      auto it = b.features.find(o.track_id);
+      if (it == b.features.end()) continue;
+      const double inv_sigma = 1.0 / (options.bearing_sigma * o.sigma_scale);
+      ceres::LossFunction* loss = robust ? new ceres::HuberLoss(batch.huber_sigmas) : nullptr;
+      if (auto bias = b.biases.find(o.track_id); bias != b.biases.end())
+        b.bearing_blocks.push_back(b.problem->AddResidualBlock(
+            new ceres::AutoDiffCostFunction<BiasedBearingResidual, 1, 3, 2, 3, 1>(
+                new BiasedBearingResidual{o.beta, inv_sigma}),
+            loss,
+            b.poses[k].data(),
+            it->second.data(),
+            b.ex.data(),
+            &bias->second));
+      else
+        b.bearing_blocks.push_back(b.problem->AddResidualBlock(
+            new ceres::AutoDiffCostFunction<BearingResidual, 1, 3, 2, 3>(
+                new BearingResidual{o.beta, inv_sigma}),
+            loss,
+            b.poses[k].data(),
+            it->second.data(),
+            b.ex.data()));
+      b.bearing_keys.emplace_back(o.track_id, static_cast<int>(k));
+      ++b.num_bearings;
+    }
+  }
+  return b;
+}
+
+BatchPoint point_of(const Built& b) {
+  BatchPoint p;
+  for (const auto& q : b.poses) p.poses.emplace_back(q[0], q[1], q[2]);
+  for (const auto& [id, f] : b.features) p.features[id] = Eigen::Vector2d(f[0], f[1]);
+  p.extrinsics = {wrap_angle(b.ex[0]), b.ex[1], wrap_angle(b.ex[2])};
+  return p;
+}
+
+}  // namespace omnivert::calib::internal
