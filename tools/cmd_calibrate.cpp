@@ -62,7 +62,8 @@ void read_prior_file(const std::string& path, calib::Options* o) {
   if (auto v = yaml::optional_number(y, "sigma_psi", path, true)) o->prior_sigma(2) = *v;
   if (auto v = yaml::optional_number(y, "bearing_sigma", path, true)) o->bearing_sigma = *v;
   if (auto v = yaml::optional_number(y, "track_bias_sigma", path)) o->track_bias_sigma = *v;
-  if (auto v = yaml::optional_number(y, "odometry_inflation", path, true)) o->odometry_inflation = *v;
+  if (auto v = yaml::optional_number(y, "odometry_inflation", path, true))
+    o->odometry_inflation = *v;
 }
 
 calib::BatchOptions batch_options(const CalibrateArgs& a) {
@@ -147,25 +148,31 @@ void add_calibrate_command(CLI::App& app) {
   cmd->add_option("DATASET", a->dataset, "Dataset folder (cam0/, wheel0/, optional ground_truth/)")
       ->required();
   cmd->add_option("--out", a->out, "Output folder")->required();
-  cmd->add_flag("--refine", a->refine,
-                "Refine the filter's result by batch maximum likelihood over the whole run (Ceres)");
-  cmd->add_option("--split-chi2", a->split_chi2,
+  cmd->add_flag(
+      "--refine",
+      a->refine,
+      "Refine the filter's result by batch maximum likelihood over the whole run (Ceres)");
+  cmd->add_option("--split-chi2",
+                  a->split_chi2,
                   "Filter's window and refinement: split a track in two where two features "
                   "explain its bearings better than one by this likelihood-ratio statistic (a "
                   "track that slipped onto a neighbouring line); 0 turns splitting off")
       ->check(kNonNegative)
       ->capture_default_str();
-  cmd->add_flag("--no-join", a->no_join,
+  cmd->add_flag("--no-join",
+                a->no_join,
                 "Filter (window and after) and refinement: keep a track that starts where a line "
                 "the tracker lost is predicted as a line of its own, instead of joining it to that "
                 "line (docs/theory/association.md#pieces-of-one-line)");
-  cmd->add_option("--crossing-guard", a->crossing_guard_deg,
+  cmd->add_option("--crossing-guard",
+                  a->crossing_guard_deg,
                   "Leave out a track's bearings while another line is predicted within this "
                   "angle [degrees] of it (the extractor merges lines that close, and the "
                   "bearing is pulled; docs/theory/association.md#lines-that-cross); 0 turns it off")
       ->check(CLI::Range(0.0, 20.0))
       ->capture_default_str();
-  cmd->add_flag("!--no-noise-check", a->noise_check,
+  cmd->add_flag("!--no-noise-check",
+                a->noise_check,
                 "Report the model's covariances as they are, without the data's check of the "
                 "bearing noise (errors summed along each track; docs/theory/noise-check.md)");
   cmd->add_option("--noise-check-lower-level",
@@ -176,15 +183,18 @@ void add_calibrate_command(CLI::App& app) {
                   "lines (docs/theory/noise-check.md); 0 turns this side off")
       ->check(kTestLevel)
       ->capture_default_str();
-  cmd->add_option("--tracks", a->tracks_file,
+  cmd->add_option("--tracks",
+                  a->tracks_file,
                   "Calibrate from this tracks.csv (of `omnivert track` or an earlier calibrate "
                   "on the same dataset) instead of extracting and tracking the images")
       ->check(CLI::ExistingFile);
-  cmd->add_flag("--force", a->force,
+  cmd->add_flag("--force",
+                a->force,
                 "Write extrinsics.yaml (and exit 0) even when the run does not determine every "
                 "parameter");
   const std::string g = "Prior (the initial guess; default: the paper's hand measurement)";
-  cmd->add_option("--prior", a->prior_file,
+  cmd->add_option("--prior",
+                  a->prior_file,
                   "YAML file with phi, rho, psi, sigma_phi, sigma_rho, sigma_psi [rad, m] (an "
                   "extrinsics.yaml works), optional bearing_sigma [rad], odometry_inflation; "
                   "flags override it")
@@ -203,19 +213,22 @@ void add_calibrate_command(CLI::App& app) {
       ->check(kPositive)
       ->group(g);
   const std::string gm = "Models";
-  cmd->add_option("--bearing-sigma", a->bearing_sigma_deg,
+  cmd->add_option("--bearing-sigma",
+                  a->bearing_sigma_deg,
                   "Bearing noise sigma [degrees] of the observation model, eq. (30). The default "
                   "(0.025) is what makes the estimate consistent (NEES) on rendered images with "
                   "our extractor (docs/validation.md); the paper used 0.3")
       ->check(kPositive)
       ->group(gm);
-  cmd->add_option("--odometry-inflation", a->odometry_inflation,
+  cmd->add_option("--odometry-inflation",
+                  a->odometry_inflation,
                   "Factor on the Chong-Kleeman K of wheel0/sensor.yaml, eq. (31), in the filter "
                   "(default 1: K as given; the paper used 5, which costs efficiency when K is "
                   "right and helps when the wheels are off: docs/theory/filter.md#odometry-noise)")
       ->check(kPositive)
       ->group(gm);
-  cmd->add_option("--track-bias-sigma", a->track_bias_sigma_deg,
+  cmd->add_option("--track-bias-sigma",
+                  a->track_bias_sigma_deg,
                   "A constant bearing error per track [degrees], in the filter, the refinement "
                   "and the bounds (default 0: none; --bearing-sigma is then the error that "
                   "changes from frame to frame; measured from pixels it does not make our "
@@ -223,20 +236,23 @@ void add_calibrate_command(CLI::App& app) {
                   "docs/theory/filter.md#per-track-bias)")
       ->check(kNonNegative)
       ->group(gm);
-  cmd->add_option("--lateral-sigma", a->lateral_sigma,
+  cmd->add_option("--lateral-sigma",
+                  a->lateral_sigma,
                   "Sideways slip per image step [m] allowed by the batch problems (the filter's "
                   "window and the refinement); eq. (14) has none. Raise it for a robot that "
                   "slips sideways (docs/theory/refinement.md#odometry-factor)")
       ->check(kPositive)
       ->capture_default_str()
       ->group(gm);
-  cmd->add_option("--crowded-sigma", a->crowded_sigma,
+  cmd->add_option("--crowded-sigma",
+                  a->crowded_sigma,
                   "The bearing sigma of a crowded line (tracks.csv's crowded column: another edge "
                   "within a few pixels all along it) is --bearing-sigma times this")
       ->check(kPositive)
       ->capture_default_str()
       ->group(gm);
-  cmd->add_option("--max-wheel-gap", a->max_wheel_gap,
+  cmd->add_option("--max-wheel-gap",
+                  a->max_wheel_gap,
                   "Wheel samples further apart than this [s] are a gap: the bearings of the "
                   "images inside it are not used")
       ->check(kPositive)
@@ -248,8 +264,9 @@ void add_calibrate_command(CLI::App& app) {
     // Extraction and tracking flags given with --tracks do nothing: say so.
     a->unused_with_tracks.clear();
     for (const CLI::Option* o : cmd->get_options())
-      if (o->count() > 0 && (o->get_group() == kExtractionGroup ||
-                             o->get_group() == kDescriptorGroup || o->get_group() == kTrackingGroup))
+      if (o->count() > 0 &&
+          (o->get_group() == kExtractionGroup || o->get_group() == kDescriptorGroup ||
+           o->get_group() == kTrackingGroup))
         a->unused_with_tracks.push_back(o->get_name());
     run_calibrate(*a);
   });

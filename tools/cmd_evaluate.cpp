@@ -7,9 +7,9 @@
 
 #include "commands.hpp"
 #include "omnivert/core/error.hpp"
-#include "omnivert/image/image_io.hpp"
 #include "omnivert/dataset/dataset.hpp"
 #include "omnivert/eval/tracking_eval.hpp"
+#include "omnivert/image/image_io.hpp"
 
 namespace omnivert::cli {
 
@@ -30,15 +30,18 @@ void add_evaluate_command(CLI::App& app) {
     const auto data = dataset::Dataset::load(a->dataset, lo);
     const auto& gt = data.ground_truth();
     if (!gt || !gt->has_lines)
-      throw InputError((fs::path(a->dataset) / "ground_truth/lines.csv").string(), 0,
+      throw InputError((fs::path(a->dataset) / "ground_truth/lines.csv").string(),
+                       0,
                        "file not found: evaluation needs the ground-truth lines");
     const auto& cam = data.camera();
     if (!cam.r_min || !cam.r_max)
-      throw InputError((fs::path(a->dataset) / "cam0/sensor.yaml").string(), 0,
+      throw InputError((fs::path(a->dataset) / "cam0/sensor.yaml").string(),
+                       0,
                        "r_min and r_max are needed to tell long lines (>= 60% of the annulus)");
     std::vector<GroundTruthLine> truth;
     truth.reserve(gt->lines.size());
-    for (const auto& l : gt->lines) truth.push_back({l.frame, l.line_id, l.bearing, l.r_inner, l.r_outer});
+    for (const auto& l : gt->lines)
+      truth.push_back({l.frame, l.line_id, l.bearing, l.r_inner, l.r_outer});
     const auto rows = read_tracks_csv(fs::path(a->dir) / "tracks.csv");
     TrackingEvalOptions o;
     o.annulus_r_min = *cam.r_min;

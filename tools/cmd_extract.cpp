@@ -10,8 +10,8 @@
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/camera_geometry.hpp"
 #include "omnivert/core/error.hpp"
-#include "omnivert/image/image_io.hpp"
 #include "omnivert/describe/feature_pipeline.hpp"
+#include "omnivert/image/image_io.hpp"
 #include "omnivert/viz/overlay.hpp"
 #include "pipeline_options.hpp"
 
@@ -63,14 +63,33 @@ void run_extract(const ExtractArgs& a) {
     std::printf("%s\n", j.dump().c_str());
   } else {
     std::printf("%s: %dx%d, centre (%.2f, %.2f) px, annulus %.1f..%.1f px, %zu vertical lines\n",
-                a.image.c_str(), image.cols, image.rows, f.circle.center.x(), f.circle.center.y(),
-                f.circle.r_min, f.circle.r_max, f.lines.size());
-    std::printf("%4s %12s %16s %11s %9s %9s %8s %8s\n", "line", "bearing[deg]",
-                "image_angle[deg]", "edge_pixels", "r_inner", "r_outer", "fit[px]", "crowded");
+                a.image.c_str(),
+                image.cols,
+                image.rows,
+                f.circle.center.x(),
+                f.circle.center.y(),
+                f.circle.r_min,
+                f.circle.r_max,
+                f.lines.size());
+    std::printf("%4s %12s %16s %11s %9s %9s %8s %8s\n",
+                "line",
+                "bearing[deg]",
+                "image_angle[deg]",
+                "edge_pixels",
+                "r_inner",
+                "r_outer",
+                "fit[px]",
+                "crowded");
     for (std::size_t i = 0; i < f.lines.size(); ++i) {
       const auto& l = f.lines[i];
-      std::printf("%4zu %12.3f %16.3f %11d %9.1f %9.1f %8.2f %8s\n", i, rad2deg(l.bearing),
-                  rad2deg(l.image_angle), l.edge_pixels, l.r_inner, l.r_outer, l.fit_rms_px,
+      std::printf("%4zu %12.3f %16.3f %11d %9.1f %9.1f %8.2f %8s\n",
+                  i,
+                  rad2deg(l.bearing),
+                  rad2deg(l.image_angle),
+                  l.edge_pixels,
+                  l.r_inner,
+                  l.r_outer,
+                  l.fit_rms_px,
                   l.crowded ? "yes" : "");
     }
   }
@@ -87,11 +106,16 @@ void add_extract_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "extract", "Vertical lines of one catadioptric image: centre, lines, bearings, descriptors");
   cmd->add_option("IMAGE", args->image, "Image file (PNG, JPEG, ...; grey or colour)")->required();
-  cmd->add_option("--sensor", args->sensor,
+  cmd->add_option("--sensor",
+                  args->sensor,
                   "cam0/sensor.yaml: resolution, optional center, r_min, r_max, bearing_sign");
   cmd->add_flag("--json", args->json, "Print one JSON object instead of a table");
-  cmd->add_option("--overlay", args->overlay, "Write a picture of the centre, annulus, lines and one line's descriptor areas");
-  cmd->add_option("--highlight", args->highlight, "Line whose descriptor areas the overlay draws (default: the longest)");
+  cmd->add_option("--overlay",
+                  args->overlay,
+                  "Write a picture of the centre, annulus, lines and one line's descriptor areas");
+  cmd->add_option("--highlight",
+                  args->highlight,
+                  "Line whose descriptor areas the overlay draws (default: the longest)");
   add_pipeline_options(cmd, args->pipeline);
   cmd->callback([args] { run_extract(*args); });
 }

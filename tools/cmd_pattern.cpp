@@ -21,7 +21,9 @@ void add_pattern_command(CLI::App& app) {
       "pattern", "Draw a test image with radial edges at known angles (+ sensor.yaml, truth.csv)");
   cmd->add_option("--out", *out, "Output folder")->required();
   cmd->add_option("--seed", o->seed, "Random seed")->capture_default_str();
-  cmd->add_option("--noise", o->noise_sigma, "Gaussian noise, grey levels")->check(CLI::Range(0.0, 100.0))->capture_default_str();
+  cmd->add_option("--noise", o->noise_sigma, "Gaussian noise, grey levels")
+      ->check(CLI::Range(0.0, 100.0))
+      ->capture_default_str();
   cmd->callback([o, out] {
     namespace fs = std::filesystem;
     std::error_code ec;
@@ -38,10 +40,14 @@ void add_pattern_command(CLI::App& app) {
     t << "# true centre " << p.circle.center.x() << " " << p.circle.center.y() << "\n";
     t << "image_angle_deg,r_from,r_to,full\n";
     for (const auto& e : p.edges)
-      t << rad2deg(e.image_angle) << "," << e.r_from << "," << e.r_to << "," << (e.full ? 1 : 0) << "\n";
+      t << rad2deg(e.image_angle) << "," << e.r_from << "," << e.r_to << "," << (e.full ? 1 : 0)
+        << "\n";
     write_text_atomic((fs::path(*out) / "truth.csv").string(), t.str());
     std::printf("wrote %s/pattern.png, sensor.yaml, truth.csv (%zu edges, centre %.2f %.2f)\n",
-                out->c_str(), p.edges.size(), p.circle.center.x(), p.circle.center.y());
+                out->c_str(),
+                p.edges.size(),
+                p.circle.center.x(),
+                p.circle.center.y());
   });
 }
 

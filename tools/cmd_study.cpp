@@ -16,16 +16,16 @@
 #include <opencv2/imgproc.hpp>
 
 #include "commands.hpp"
+#include "core/progress.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
-#include "omnivert/image/image_io.hpp"
-#include "core/progress.hpp"
 #include "omnivert/dataset/dataset.hpp"
 #include "omnivert/eval/descriptor_study.hpp"
 #include "omnivert/eval/sensitivity_study.hpp"
 #include "omnivert/eval/similarity_study.hpp"
-#include "omnivert/viz/plot.hpp"
+#include "omnivert/image/image_io.hpp"
 #include "omnivert/match/matcher.hpp"
+#include "omnivert/viz/plot.hpp"
 #include "pipeline_options.hpp"
 
 namespace omnivert::cli {

@@ -7,9 +7,9 @@
 #include <spdlog/spdlog.h>
 
 #include "commands.hpp"
+#include "core/progress.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
-#include "core/progress.hpp"
 #include "omnivert/pipeline/track_dataset.hpp"
 #include "omnivert/viz/tracks_plot.hpp"
 #include "pipeline_options.hpp"
@@ -51,8 +51,11 @@ void run_track(const TrackArgs& a) {
   write_tracks_csv(csv, r.rows);
   write_tracks_png(png, r.rows);
   std::printf("%lld frames (%lld skipped), %zu detections, %lld tracks\n%s\n",
-              static_cast<long long>(r.frames), static_cast<long long>(r.frames_skipped), r.rows.size(),
-              static_cast<long long>(r.stats.new_tracks), r.stats.BriefReport().c_str());
+              static_cast<long long>(r.frames),
+              static_cast<long long>(r.frames_skipped),
+              r.rows.size(),
+              static_cast<long long>(r.stats.new_tracks),
+              r.stats.BriefReport().c_str());
   std::printf("wrote %s and %s\n", csv.c_str(), png.c_str());
 }
 
@@ -60,7 +63,8 @@ void run_track(const TrackArgs& a) {
 
 void add_track_command(CLI::App& app) {
   auto a = std::make_shared<TrackArgs>();
-  CLI::App* cmd = app.add_subcommand("track", "Track vertical lines through a dataset (tracks.csv, tracks.png)");
+  CLI::App* cmd = app.add_subcommand(
+      "track", "Track vertical lines through a dataset (tracks.csv, tracks.png)");
   cmd->add_option("DATASET", a->dataset, "Dataset folder (cam0/, optional wheel0/)")->required();
   cmd->add_option("--out", a->out, "Output folder")->required();
   add_pipeline_options(cmd, a->pipeline);

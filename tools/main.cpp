@@ -31,12 +31,15 @@ const std::string& command_line() { return g_command_line; }
 int main(int argc, char** argv) {
   // Warnings and log lines go to stderr: stdout carries results (tables, summaries).
   spdlog::set_default_logger(spdlog::stderr_color_mt("omnivert"));
-  CLI::App app{"omnivert: vertical lines in omnidirectional images (extraction, description, "
-               "tracking, camera-odometry self-calibration)"};
+  CLI::App app{
+      "omnivert: vertical lines in omnidirectional images (extraction, description, "
+      "tracking, camera-odometry self-calibration)"};
   app.require_subcommand(1);
   // Set while parsing, before the subcommand's callback runs.
-  app.add_flag_callback("-v,--verbose", [] { spdlog::set_level(spdlog::level::debug); },
-                        "More log output (each calibration stage's time, for one)")
+  app.add_flag_callback(
+         "-v,--verbose",
+         [] { spdlog::set_level(spdlog::level::debug); },
+         "More log output (each calibration stage's time, for one)")
       ->trigger_on_parse();
   app.set_version_flag("--version", "omnivert 0.1.0");
 

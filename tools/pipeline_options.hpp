@@ -23,7 +23,8 @@ inline void add_pipeline_options(CLI::App* cmd, FeaturePipelineOptions& o) {
       {"fraction", LineThreshold::kFractionOfAnnulus},
       {"adaptive", LineThreshold::kAdaptive},
       {"topk", LineThreshold::kTopK}};
-  cmd->add_option("--line-threshold", o.lines.threshold,
+  cmd->add_option("--line-threshold",
+                  o.lines.threshold,
                   "Which lines to keep: fraction (>= --length-fraction of R_max - R_min, the "
                   "paper's), adaptive (mean + 3 sigma of candidate lengths), topk")
       ->transform(CLI::CheckedTransformer(kThreshold, CLI::ignore_case))
@@ -41,7 +42,9 @@ inline void add_pipeline_options(CLI::App* cmd, FeaturePipelineOptions& o) {
       ->check(CLI::Range(1, 10))
       ->capture_default_str()
       ->group(g);
-  cmd->add_option("--length-fraction", o.lines.length_fraction, "Line length threshold as a fraction of the annulus")
+  cmd->add_option("--length-fraction",
+                  o.lines.length_fraction,
+                  "Line length threshold as a fraction of the annulus")
       ->check(CLI::Range(0.01, 1.0))
       ->capture_default_str()
       ->group(g);
@@ -49,36 +52,46 @@ inline void add_pipeline_options(CLI::App* cmd, FeaturePipelineOptions& o) {
       ->check(kPositive)
       ->capture_default_str()
       ->group(g);
-  cmd->add_option("--gradient-threshold", o.lines.gradient_threshold,
+  cmd->add_option("--gradient-threshold",
+                  o.lines.gradient_threshold,
                   "Sobel magnitude of an edge pixel (4x the grey-level step)")
       ->check(kPositive)
       ->capture_default_str()
       ->group(g);
-  cmd->add_flag("!--fixed-center", o.track_center, "Keep the first frame's centre instead of detecting it on every frame")
+  cmd->add_flag("!--fixed-center",
+                o.track_center,
+                "Keep the first frame's centre instead of detecting it on every frame")
       ->group(g);
-  cmd->add_flag("--refine-center", o.refine_given_center,
+  cmd->add_flag("--refine-center",
+                o.refine_given_center,
                 "Fit the mirror centre to the rim (and track it, unless --fixed-center) even when "
                 "cam0/sensor.yaml gives it; by default a given centre is used as it is")
       ->group(g);
 
   const std::string d = kDescriptorGroup;
   static const std::map<std::string, DescriptorSmoothing> kSmoothing{
-      {"blur", DescriptorSmoothing::kGaussianBlur}, {"weight", DescriptorSmoothing::kGaussianWeight}};
+      {"blur", DescriptorSmoothing::kGaussianBlur},
+      {"weight", DescriptorSmoothing::kGaussianWeight}};
   static const std::map<std::string, DescriptorNormalization> kNorm{
       {"pair", DescriptorNormalization::kPerPair}, {"half", DescriptorNormalization::kPerHalf}};
-  cmd->add_option("--smoothing", o.descriptor.smoothing,
-                  "Gaussian window sigma_G = r_a/3 as an image blur (blur) or a vote weight (weight)")
+  cmd->add_option(
+         "--smoothing",
+         o.descriptor.smoothing,
+         "Gaussian window sigma_G = r_a/3 as an image blur (blur) or a vote weight (weight)")
       ->transform(CLI::CheckedTransformer(kSmoothing, CLI::ignore_case))
       ->group(d);
-  cmd->add_option("--normalization", o.descriptor.normalization,
-                  "Unit for normalisation and clipping: each left/right pair (pair) or each half (half)")
+  cmd->add_option(
+         "--normalization",
+         o.descriptor.normalization,
+         "Unit for normalisation and clipping: each left/right pair (pair) or each half (half)")
       ->transform(CLI::CheckedTransformer(kNorm, CLI::ignore_case))
       ->group(d);
   cmd->add_option("--bins", o.descriptor.bins, "Orientation bins per histogram")
       ->check(CLI::Range(4, 256))
       ->capture_default_str()
       ->group(d);
-  cmd->add_option("--areas", o.descriptor.areas, "Circular areas per line: 3 (touching) or 5 (overlapping)")
+  cmd->add_option(
+         "--areas", o.descriptor.areas, "Circular areas per line: 3 (touching) or 5 (overlapping)")
       ->check(CLI::IsMember({3, 5}))
       ->capture_default_str()
       ->group(d);

@@ -18,7 +18,7 @@ struct TrackerFlags {
   bool no_mutual = false;
   bool no_gate = false;
   int look_back = 20;
-  double f1 = -1.0, f2 = -1.0, f3 = -1.0;  // < 0: the rule set's
+  double f1 = -1.0, f2 = -1.0, f3 = -1.0;                      // < 0: the rule set's
   std::string gate_candidates = "default";                     // on|off|default (the rule set's)
   double gate_min_distance = -1.0, gate_tolerance_deg = -1.0;  // < 0: the default
   std::string same_polarity = "default";                       // on|off|default (the rule set's)
@@ -160,9 +160,18 @@ inline void add_tracker_options(CLI::App* cmd, TrackerFlags& t) {
                   "Odometry gate: bearing detection tolerance [degrees] (default 2)")
       ->check(CLI::Range(0.0, 179.0))
       ->group(g);
-  cmd->add_option("--f1", t.f1, "Test 1, eq. (8): min distance <= F1 (default: the rule set's: paper 1.05, recommended 0.6)")->check(kPositive)->group(g);
-  cmd->add_option("--f2", t.f2, "Test 2, eq. (9): min <= F2 * mean (default 0.75)")->check(CLI::Range(0.0, 1.0))->group(g);
-  cmd->add_option("--f3", t.f3, "Test 3, eq. (10): min <= F3 * second min (default 0.8)")->check(CLI::Range(0.0, 1.0))->group(g);
+  cmd->add_option("--f1",
+                  t.f1,
+                  "Test 1, eq. (8): min distance <= F1 (default: the rule set's: paper 1.05, "
+                  "recommended 0.6)")
+      ->check(kPositive)
+      ->group(g);
+  cmd->add_option("--f2", t.f2, "Test 2, eq. (9): min <= F2 * mean (default 0.75)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->group(g);
+  cmd->add_option("--f3", t.f3, "Test 3, eq. (10): min <= F3 * second min (default 0.8)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->group(g);
 }
 
 }  // namespace omnivert::cli

@@ -38,16 +38,16 @@
 #include <string>
 #include <vector>
 
+#include "calib/synthetic_run.hpp"
+#include "core/progress.hpp"
 #include "omnivert/calib/batch_point.hpp"
 #include "omnivert/calib/calibrate.hpp"
 #include "omnivert/calib/calibration_filter.hpp"
 #include "omnivert/calib/observability.hpp"
 #include "omnivert/calib/refinement.hpp"
 #include "omnivert/calib/track_ids.hpp"
-#include "calib/synthetic_run.hpp"
 #include "omnivert/calib/updater.hpp"
 #include "omnivert/core/angles.hpp"
-#include "core/progress.hpp"
 
 using namespace omnivert;
 using namespace omnivert::calib;

@@ -1,6 +1,6 @@
-// The study behind the descriptor defaults (docs/theory/descriptor.md): both readings of the Gaussian
-// window (vote weight / image blur) and both normalisation units (pair / half), measured by
-// nearest-neighbour matching of lines between an image and its rotated or re-lit copy.
+// The study behind the descriptor defaults (docs/theory/descriptor.md): both readings of the
+// Gaussian window (vote weight / image blur) and both normalisation units (pair / half), measured
+// by nearest-neighbour matching of lines between an image and its rotated or re-lit copy.
 //
 // Usage: descriptor_choice [REAL_IMAGE_DIR]
 // Prints one table row per configuration and transform family.
@@ -68,7 +68,8 @@ int main(int argc, char** argv) {
   for (const char* f : {"VMRImage0.jpg", "imgMei_001.jpg", "KaidanOmni1.jpg"}) {
     const auto path = std::filesystem::path(real_dir) / f;
     if (real_dir.empty() || !std::filesystem::exists(path)) continue;
-    inputs.push_back({f, cv::imread(path.string(), cv::IMREAD_GRAYSCALE), CameraGeometry{}, true, {}});
+    inputs.push_back(
+        {f, cv::imread(path.string(), cv::IMREAD_GRAYSCALE), CameraGeometry{}, true, {}});
   }
 
   struct Config {
@@ -79,23 +80,65 @@ int main(int argc, char** argv) {
     double offset = 1.0;
   };
   const Config configs[] = {
-      {"log1/blur/pair", DescriptorSmoothing::kGaussianBlur, DescriptorNormalization::kPerPair, true, 1.0},
-      {"log2/blur/pair", DescriptorSmoothing::kGaussianBlur, DescriptorNormalization::kPerPair, true, 2.0},
-      {"log4/blur/pair", DescriptorSmoothing::kGaussianBlur, DescriptorNormalization::kPerPair, true, 4.0},
-      {"log8/blur/pair", DescriptorSmoothing::kGaussianBlur, DescriptorNormalization::kPerPair, true, 8.0},
-      {"log16/blur/pair", DescriptorSmoothing::kGaussianBlur, DescriptorNormalization::kPerPair, true, 16.0},
-      {"log32/blur/pair", DescriptorSmoothing::kGaussianBlur, DescriptorNormalization::kPerPair, true, 32.0},
-      {"log/blur/half", DescriptorSmoothing::kGaussianBlur, DescriptorNormalization::kPerHalf, true},
+      {"log1/blur/pair",
+       DescriptorSmoothing::kGaussianBlur,
+       DescriptorNormalization::kPerPair,
+       true,
+       1.0},
+      {"log2/blur/pair",
+       DescriptorSmoothing::kGaussianBlur,
+       DescriptorNormalization::kPerPair,
+       true,
+       2.0},
+      {"log4/blur/pair",
+       DescriptorSmoothing::kGaussianBlur,
+       DescriptorNormalization::kPerPair,
+       true,
+       4.0},
+      {"log8/blur/pair",
+       DescriptorSmoothing::kGaussianBlur,
+       DescriptorNormalization::kPerPair,
+       true,
+       8.0},
+      {"log16/blur/pair",
+       DescriptorSmoothing::kGaussianBlur,
+       DescriptorNormalization::kPerPair,
+       true,
+       16.0},
+      {"log32/blur/pair",
+       DescriptorSmoothing::kGaussianBlur,
+       DescriptorNormalization::kPerPair,
+       true,
+       32.0},
+      {"log/blur/half",
+       DescriptorSmoothing::kGaussianBlur,
+       DescriptorNormalization::kPerHalf,
+       true},
       {"blur/pair", DescriptorSmoothing::kGaussianBlur, DescriptorNormalization::kPerPair, false},
       {"blur/half", DescriptorSmoothing::kGaussianBlur, DescriptorNormalization::kPerHalf, false},
-      {"weight/pair", DescriptorSmoothing::kGaussianWeight, DescriptorNormalization::kPerPair, false},
-      {"weight/half", DescriptorSmoothing::kGaussianWeight, DescriptorNormalization::kPerHalf, false}};
+      {"weight/pair",
+       DescriptorSmoothing::kGaussianWeight,
+       DescriptorNormalization::kPerPair,
+       false},
+      {"weight/half",
+       DescriptorSmoothing::kGaussianWeight,
+       DescriptorNormalization::kPerHalf,
+       false}};
   const double rotations[] = {17, 43, 71, 137, 251};
   const double gains[] = {0.6, 0.8, 1.25, 1.5};  // 1.25 and 1.5 saturate bright regions
   const double gammas[] = {0.7, 0.85, 1.2, 1.4};
 
-  std::printf("%-12s %-6s %-9s %6s %7s %9s %9s %9s %9s %9s\n", "config", "data", "transform", "pairs",
-              "NN[%]", "med.dist", "p90.dist", "max.dist", "med.ratio", "p90.ratio");
+  std::printf("%-12s %-6s %-9s %6s %7s %9s %9s %9s %9s %9s\n",
+              "config",
+              "data",
+              "transform",
+              "pairs",
+              "NN[%]",
+              "med.dist",
+              "p90.dist",
+              "max.dist",
+              "med.ratio",
+              "p90.ratio");
   for (const Config& c : configs) {
     for (int real = 0; real <= 1; ++real) {
       Acc acc[4];  // rotation, gain, gamma, noise
@@ -116,7 +159,9 @@ int main(int argc, char** argv) {
         if (in.real) geo.center = f0.circle.center;
         geo.r_min = f0.circle.r_min;
         // Real images: the annulus ends where a rotation brings no new content into a descriptor.
-        geo.r_max = in.real ? std::min(f0.circle.r_max, rotation_safe_r_max(f0.circle.center, gray.cols, gray.rows, f0.circle.r_min))
+        geo.r_max = in.real ? std::min(f0.circle.r_max,
+                                       rotation_safe_r_max(
+                                           f0.circle.center, gray.cols, gray.rows, f0.circle.r_min))
                             : f0.circle.r_max;
         FeaturePipeline base(geo, po);
         if (!base.process(gray, f0)) continue;
@@ -150,9 +195,17 @@ int main(int argc, char** argv) {
       for (int k = 0; k < 4; ++k) {
         const Acc& a = acc[k];
         if (!a.pairs) continue;
-        std::printf("%-12s %-6s %-9s %6d %7.1f %9.3f %9.3f %9.3f %9.3f %9.3f\n", c.name, real ? "real" : "drawn", fam[k],
-                    a.pairs, 100.0 * a.nn_correct / a.pairs, median(a.dist), pct(a.dist, 0.9), pct(a.dist, 1.0),
-                    median(a.ratio), pct(a.ratio, 0.9));
+        std::printf("%-12s %-6s %-9s %6d %7.1f %9.3f %9.3f %9.3f %9.3f %9.3f\n",
+                    c.name,
+                    real ? "real" : "drawn",
+                    fam[k],
+                    a.pairs,
+                    100.0 * a.nn_correct / a.pairs,
+                    median(a.dist),
+                    pct(a.dist, 0.9),
+                    pct(a.dist, 1.0),
+                    median(a.ratio),
+                    pct(a.ratio, 0.9));
       }
     }
   }

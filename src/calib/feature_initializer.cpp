@@ -7,11 +7,8 @@
 
 namespace omnivert::calib {
 
-int FeatureInitializer::initialize(int track_id,
-                                   double beta,
-                                   int frame,
-                                   FilterState* state,
-                                   double sigma_scale) const {
+int FeatureInitializer::initialize(
+    int track_id, double beta, int frame, FilterState* state, double sigma_scale) const {
   const Extrinsics ex = state->extrinsics();
   const int n = state->dim();
   const int e = state->extrinsics_index();

@@ -23,11 +23,8 @@ Eigen::Vector3d integrate_pose(const Eigen::Vector3d& pose,
   return {pose(0) + s(0) * std::cos(mid), pose(1) + s(0) * std::sin(mid), pose(2) + s(1)};
 }
 
-Eigen::Vector3d integrate_pose_lateral(const Eigen::Vector3d& pose,
-                                       double d_right,
-                                       double d_left,
-                                       double lateral,
-                                       double wheel_base) {
+Eigen::Vector3d integrate_pose_lateral(
+    const Eigen::Vector3d& pose, double d_right, double d_left, double lateral, double wheel_base) {
   Eigen::Vector3d p = integrate_pose(pose, d_right, d_left, wheel_base);
   const double mid = pose(2) + 0.5 * (d_right - d_left) / wheel_base;
   p(0) -= lateral * std::sin(mid);
@@ -65,7 +62,8 @@ Eigen::Vector3d compose_wheel_steps(const std::vector<Eigen::Vector2d>& travel,
         std::vector<Eigen::Vector2d> a = steps, b = steps;
         a[i](w) += h;
         b[i](w) -= h;
-        const Eigen::Vector3d J = (compose_steps(a, wheel_base) - compose_steps(b, wheel_base)) / (2 * h);
+        const Eigen::Vector3d J =
+            (compose_steps(a, wheel_base) - compose_steps(b, wheel_base)) / (2 * h);
         C += std::abs(d) * J * J.transpose();
       }
     *covariance_per_K = C;

@@ -32,8 +32,8 @@ SyntheticRun make_synthetic_run(const SyntheticRunOptions& o) {
   if (!(o.straight_length > 0.0) || !(o.step > 0.0) || !(o.turn_step > 0.0) ||
       !(o.wheel_base > 0.0) || o.num_features < 1 || !(o.min_distance > o.truth.rho) ||
       !(o.max_distance > o.min_distance) || !(o.bearing_sigma >= 0.0) ||
-      !(o.track_bias_sigma >= 0.0) || !(o.odometry_K >= 0.0) ||
-      o.zigzag_legs < 1 || !(o.bearing_correlation >= 0.0 && o.bearing_correlation < 1.0))
+      !(o.track_bias_sigma >= 0.0) || !(o.odometry_K >= 0.0) || o.zigzag_legs < 1 ||
+      !(o.bearing_correlation >= 0.0 && o.bearing_correlation < 1.0))
     throw InputError("synthetic run: invalid options");
   std::mt19937_64 rng(o.seed);
   std::normal_distribution<double> normal(0.0, 1.0);
@@ -108,7 +108,8 @@ SyntheticRun make_synthetic_run(const SyntheticRunOptions& o) {
       }
       const double n = normal(rng);
       error[j] = k == 0 ? o.bearing_sigma * n : a * error[j] + innovation * o.bearing_sigma * n;
-      const double beta = bearing_from_geometry(out.true_poses[k], out.features[j], o.truth) + error[j] + bias[j];
+      const double beta =
+          bearing_from_geometry(out.true_poses[k], out.features[j], o.truth) + error[j] + bias[j];
       f.observations.push_back({track_of[j], wrap_angle(beta)});
     }
     out.run.frames.push_back(std::move(f));

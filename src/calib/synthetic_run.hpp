@@ -39,8 +39,8 @@ struct SyntheticRunOptions {
   double bearing_correlation = 0.0;
   // A constant bearing error per line, N(0, track_bias_sigma^2), added to all its bearings
   // (Options::track_bias_sigma); drawn from its own generator, so 0 leaves the run as before.
-  double track_bias_sigma = 0.0;  // [rad]
-  Extrinsics truth{-0.34, 0.23, 0.33};                          // the paper's estimate (Sec. 9.2)
+  double track_bias_sigma = 0.0;        // [rad]
+  Extrinsics truth{-0.34, 0.23, 0.33};  // the paper's estimate (Sec. 9.2)
   // Each track is cut into pieces (new track ids) with this probability per frame; 0: every
   // feature is one track over the whole run (the camera sees all around).
   double break_probability = 0.0;

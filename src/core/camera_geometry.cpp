@@ -4,9 +4,9 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "core/yaml_fields.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
-#include "core/yaml_fields.hpp"
 
 namespace omnivert {
 
@@ -48,15 +48,13 @@ CameraGeometry load_camera_geometry(const std::string& path) {
     throw InputError(path, yaml::line_of(root["r_max"]), "field 'r_max' must be positive");
   }
   if (g.r_min && g.r_max && *g.r_min >= *g.r_max) {
-    throw InputError(path,
-                     yaml::line_of(root["r_min"]),
-                     "field 'r_min' must be smaller than 'r_max'");
+    throw InputError(
+        path, yaml::line_of(root["r_min"]), "field 'r_min' must be smaller than 'r_max'");
   }
   if (const auto s = yaml::optional_number(root, "bearing_sign", path)) {
     if (*s != 1.0 && *s != -1.0) {
-      throw InputError(path,
-                       yaml::line_of(root["bearing_sign"]),
-                       "field 'bearing_sign' must be 1 or -1");
+      throw InputError(
+          path, yaml::line_of(root["bearing_sign"]), "field 'bearing_sign' must be 1 or -1");
     }
     g.bearing_sign = static_cast<int>(*s);
   }

@@ -41,13 +41,7 @@ void Progress::draw(std::size_t done) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   std::string bar(static_cast<std::size_t>(filled), '#');
   bar.resize(width, '.');
-  std::fprintf(stderr,
-               "\r%s [%s] %zu/%zu %5.1fs",
-               label_.c_str(),
-               bar.c_str(),
-               done,
-               total_,
-               secs);
+  std::fprintf(stderr, "\r%s [%s] %zu/%zu %5.1fs", label_.c_str(), bar.c_str(), done, total_, secs);
   std::fflush(stderr);
 }
 

@@ -39,9 +39,8 @@ double parse_number(const YAML::Node& node, const std::string& key, const std::s
   try {
     v = node.as<double>();
   } catch (const YAML::Exception&) {
-    throw InputError(file,
-                     line_of(node),
-                     "field '" + key + "' must be a number, got '" + node.Scalar() + "'");
+    throw InputError(
+        file, line_of(node), "field '" + key + "' must be a number, got '" + node.Scalar() + "'");
   }
   if (!std::isfinite(v)) {
     throw InputError(file, line_of(node), "field '" + key + "' must be finite");
@@ -59,7 +58,8 @@ std::optional<double> optional_number(const YAML::Node& map,
   if (!node || node.IsNull()) return std::nullopt;
   const double v = parse_number(node, key, file);
   if (non_negative && v < 0.0) {
-    throw InputError(file, line_of(node), "field '" + key + "' must not be negative, got " + node.Scalar());
+    throw InputError(
+        file, line_of(node), "field '" + key + "' must not be negative, got " + node.Scalar());
   }
   return v;
 }

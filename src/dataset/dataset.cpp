@@ -12,8 +12,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "omnivert/core/error.hpp"
 #include "core/yaml_fields.hpp"
+#include "omnivert/core/error.hpp"
 
 namespace omnivert::dataset {
 
@@ -346,7 +346,8 @@ GroundTruth load_ground_truth(const std::string& dir, const std::vector<ImageRec
     }
     gt.line_offsets.assign(images.size() + 1, 0);
     for (const LineRecord& l : gt.lines) ++gt.line_offsets[static_cast<std::size_t>(l.frame) + 1];
-    for (std::size_t k = 1; k < gt.line_offsets.size(); ++k) gt.line_offsets[k] += gt.line_offsets[k - 1];
+    for (std::size_t k = 1; k < gt.line_offsets.size(); ++k)
+      gt.line_offsets[k] += gt.line_offsets[k - 1];
   }
   return gt;
 }

@@ -15,9 +15,10 @@ inline float fast_atan2(float y, float x) {
   if (mx == 0.0f) return 0.0f;
   const float z = mn / mx;
   const float z2 = z * z;
-  float r = z * (0.99997726f +
-                 z2 * (-0.33262347f +
-                       z2 * (0.19354346f + z2 * (-0.11643287f + z2 * (0.05265332f - 0.01172120f * z2)))));
+  float r =
+      z * (0.99997726f +
+           z2 * (-0.33262347f +
+                 z2 * (0.19354346f + z2 * (-0.11643287f + z2 * (0.05265332f - 0.01172120f * z2)))));
   if (ay > ax) r = 1.57079637f - r;
   if (x < 0) r = 3.14159274f - r;
   if (y < 0) r = -r;

@@ -23,17 +23,31 @@ bool FeaturePipeline::to_gray8(const cv::Mat& image, cv::Mat& gray) {
   if (image.empty() || image.dims != 2) return false;
   cv::Mat g;
   switch (image.channels()) {
-    case 1: g = image; break;
-    case 3: cv::cvtColor(image, g, cv::COLOR_BGR2GRAY); break;
-    case 4: cv::cvtColor(image, g, cv::COLOR_BGRA2GRAY); break;
-    default: return false;
+    case 1:
+      g = image;
+      break;
+    case 3:
+      cv::cvtColor(image, g, cv::COLOR_BGR2GRAY);
+      break;
+    case 4:
+      cv::cvtColor(image, g, cv::COLOR_BGRA2GRAY);
+      break;
+    default:
+      return false;
   }
   switch (g.depth()) {
-    case CV_8U: gray = g.isContinuous() ? g : g.clone(); return true;
-    case CV_16U: g.convertTo(gray, CV_8U, 1.0 / 257.0); return true;
+    case CV_8U:
+      gray = g.isContinuous() ? g : g.clone();
+      return true;
+    case CV_16U:
+      g.convertTo(gray, CV_8U, 1.0 / 257.0);
+      return true;
     case CV_32F:
-    case CV_64F: g.convertTo(gray, CV_8U, 255.0); return true;
-    default: return false;
+    case CV_64F:
+      g.convertTo(gray, CV_8U, 255.0);
+      return true;
+    default:
+      return false;
   }
 }
 

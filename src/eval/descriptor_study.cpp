@@ -9,8 +9,8 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/line_descriptor.hpp>
 
-#include "omnivert/core/error.hpp"
 #include "core/progress.hpp"
+#include "omnivert/core/error.hpp"
 #include "omnivert/eval/panorama.hpp"
 
 namespace omnivert {
@@ -243,7 +243,8 @@ MethodFeatures describe_lbd_segments(const StudySet& set,
   std::vector<std::vector<int>> ids;
   std::vector<cv::Mat> descs;
   if (!data.ground_truth() || !data.ground_truth()->has_lines)
-    throw InputError(data.root() + "/ground_truth/lines.csv", 0,
+    throw InputError(data.root() + "/ground_truth/lines.csv",
+                     0,
                      "file not found: the LBD baseline needs the ground-truth lines");
   const auto& gt = *data.ground_truth();
   for (const auto& fr : set.frames) {

@@ -12,9 +12,10 @@ namespace omnivert {
 cv::Mat rotate_about(const cv::Mat& image, const Eigen::Vector2d& center, double angle_rad) {
   // getRotationMatrix2D(+t) maps an offset at image angle a to a - t (v points down), so
   // rotate by -angle to add +angle to every image angle.
-  const cv::Mat M = cv::getRotationMatrix2D(cv::Point2f(static_cast<float>(center.x()),
-                                                        static_cast<float>(center.y())),
-                                            -rad2deg(angle_rad), 1.0);
+  const cv::Mat M = cv::getRotationMatrix2D(
+      cv::Point2f(static_cast<float>(center.x()), static_cast<float>(center.y())),
+      -rad2deg(angle_rad),
+      1.0);
   cv::Mat out;
   cv::warpAffine(image, out, M, image.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0));
   return out;
@@ -47,7 +48,8 @@ std::vector<LinePairing> pair_lines(const FrameFeatures& a,
     double best_err = tolerance_rad;
     for (int j = 0; j < static_cast<int>(b.lines.size()); ++j) {
       if (a.lines[i].polarity != b.lines[j].polarity) continue;
-      const double e = std::abs(angle_diff(b.lines[j].image_angle, a.lines[i].image_angle + shift_rad));
+      const double e =
+          std::abs(angle_diff(b.lines[j].image_angle, a.lines[i].image_angle + shift_rad));
       if (e <= best_err) best_err = e, best = j;
     }
     if (best < 0) continue;
@@ -59,7 +61,8 @@ std::vector<LinePairing> pair_lines(const FrameFeatures& a,
     double wrong = std::numeric_limits<double>::infinity();
     for (int k = 0; k < static_cast<int>(a.lines.size()); ++k) {
       if (k == i) continue;
-      wrong = std::min(wrong, static_cast<double>((a.descriptors.row(k) - b.descriptors.row(best)).norm()));
+      wrong = std::min(
+          wrong, static_cast<double>((a.descriptors.row(k) - b.descriptors.row(best)).norm()));
     }
     p.nearest_wrong_distance = wrong;
     p.nearest_is_correct = p.descriptor_distance < wrong;

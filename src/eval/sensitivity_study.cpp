@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "omnivert/image/image_io.hpp"
-#include "omnivert/viz/plot.hpp"
 #include "omnivert/match/matcher.hpp"
+#include "omnivert/viz/plot.hpp"
 
 namespace omnivert {
 

@@ -45,7 +45,8 @@ inline bool sample(const cv::Mat& img, double x, double y, double& out) {
   const double fy = y - y0;
   const uchar* r0 = img.ptr<uchar>(y0);
   const uchar* r1 = img.ptr<uchar>(y0 + 1);
-  out = (1 - fy) * ((1 - fx) * r0[x0] + fx * r0[x0 + 1]) + fy * ((1 - fx) * r1[x0] + fx * r1[x0 + 1]);
+  out =
+      (1 - fy) * ((1 - fx) * r0[x0] + fx * r0[x0 + 1]) + fy * ((1 - fx) * r1[x0] + fx * r1[x0 + 1]);
   return true;
 }
 
@@ -308,7 +309,8 @@ std::optional<MirrorCircle> MirrorCenterDetector::estimate(const cv::Mat& gray,
   MirrorCircle circle;
   circle.center = center;
   circle.rim_radius = rim_radius;
-  circle.r_max = geometry.r_max ? *geometry.r_max : rim_radius * (1.0 - options_.rim_margin_fraction);
+  circle.r_max =
+      geometry.r_max ? *geometry.r_max : rim_radius * (1.0 - options_.rim_margin_fraction);
   if (geometry.r_min) {
     circle.r_min = *geometry.r_min;
   } else {
@@ -318,8 +320,8 @@ std::optional<MirrorCircle> MirrorCenterDetector::estimate(const cv::Mat& gray,
     int disc = 0;
     for (int r = static_cast<int>(0.05 * rim); r <= static_cast<int>(0.5 * rim); ++r)
       if (inner[r] > best) best = inner[r], disc = r;
-    circle.r_min = best >= 0.3 ? (disc / scale) * (1.0 + options_.inner_margin_fraction)
-                               : 0.25 * circle.r_max;
+    circle.r_min =
+        best >= 0.3 ? (disc / scale) * (1.0 + options_.inner_margin_fraction) : 0.25 * circle.r_max;
   }
   if (!(circle.r_min < circle.r_max)) {
     set_why(why, "estimated r_min is not below r_max; give r_min and r_max in sensor.yaml");

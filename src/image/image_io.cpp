@@ -14,7 +14,8 @@ namespace fs = std::filesystem;
 cv::Mat read_image(const std::string& path) {
   std::error_code ec;
   if (!fs::exists(path, ec)) throw InputError(path, 0, "file not found");
-  if (fs::is_directory(path, ec)) throw InputError(path, 0, "is a directory, expected an image file");
+  if (fs::is_directory(path, ec))
+    throw InputError(path, 0, "is a directory, expected an image file");
   {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError(path, 0, "cannot be opened for reading (permissions?)");
@@ -63,6 +64,5 @@ void write_image_atomic(const std::string& path, const cv::Mat& image) {
     throw InputError(path, 0, "cannot write the image: " + ec.message());
   }
 }
-
 
 }  // namespace omnivert

@@ -10,9 +10,9 @@
 #include <system_error>
 #include <unordered_map>
 
-#include "omnivert/core/file_io.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
+#include "omnivert/core/file_io.hpp"
 
 namespace omnivert {
 namespace {

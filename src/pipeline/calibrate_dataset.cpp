@@ -32,8 +32,12 @@ constexpr int kFewTracks = 15;
 
 // The output files of a run; those of an earlier run are removed first, so that none of them
 // passes for this run's.
-constexpr const char* kOutputs[] = {"extrinsics.yaml", "summary.json", "report.html",
-                                    "states.csv",      "convergence.png", "tracks.csv",
+constexpr const char* kOutputs[] = {"extrinsics.yaml",
+                                    "summary.json",
+                                    "report.html",
+                                    "states.csv",
+                                    "convergence.png",
+                                    "tracks.csv",
                                     "tracks.png"};
 
 std::string few_tracks_warning(int tracks, const FeaturePipelineOptions& features) {
@@ -48,7 +52,8 @@ std::string few_tracks_warning(int tracks, const FeaturePipelineOptions& feature
 }
 
 // Step 1: the tracks, of the images or of an earlier tracks.csv.
-TrackDatasetResult tracks_of(const dataset::Dataset& data, const CalibrateDatasetOptions& o,
+TrackDatasetResult tracks_of(const dataset::Dataset& data,
+                             const CalibrateDatasetOptions& o,
                              std::optional<TrackDatasetResult> given) {
   if (given) return std::move(*given);
   TrackDatasetOptions to;
@@ -68,7 +73,8 @@ void prepare_out_dir(const std::string& out_dir) {
 
 }  // namespace
 
-CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir, const std::string& out_dir,
+CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
+                                         const std::string& out_dir,
                                          const CalibrateDatasetOptions& o) {
   std::string why;
   if (!o.features.IsValid(&why)) throw InputError("invalid extraction options: " + why);
@@ -101,7 +107,8 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir, const s
   // Step 2: the calibration's input; step 3: filter, observability, refinement (Sec. 8).
   r.input = calib::calibration_run_from_tracks(data, tracked.rows, o.input);
   r.warnings.insert(r.warnings.end(), r.input.warnings.begin(), r.input.warnings.end());
-  if (r.input.tracks < kFewTracks) r.warnings.push_back(few_tracks_warning(r.input.tracks, o.features));
+  if (r.input.tracks < kFewTracks)
+    r.warnings.push_back(few_tracks_warning(r.input.tracks, o.features));
   r.warnings.insert(r.warnings.end(), o.notes.begin(), o.notes.end());
   for (const auto& w : r.warnings) spdlog::warn("{}", w);
   if (o.progress) o.progress("calibrate", 0, 0);
@@ -163,10 +170,16 @@ std::string truth_lines(const CalibrateDatasetResult& r, bool refined) {
   std::string s;
   auto show = [&](const char* name, const calib::Extrinsics& est, const Eigen::Matrix3d& cov) {
     const auto er = calib::errors_vs_truth(est, cov, *r.truth);
-    s += format("error vs ground truth (%s): phi %.3f deg, rho %.2f mm, psi %.3f deg, "
-                "position %.2f mm, yaw %.3f deg, NEES %.2f\n",
-                name, rad2deg(er.phi), er.rho * 1e3, rad2deg(er.psi), er.position * 1e3,
-                rad2deg(er.yaw), er.nees);
+    s += format(
+        "error vs ground truth (%s): phi %.3f deg, rho %.2f mm, psi %.3f deg, "
+        "position %.2f mm, yaw %.3f deg, NEES %.2f\n",
+        name,
+        rad2deg(er.phi),
+        er.rho * 1e3,
+        rad2deg(er.psi),
+        er.position * 1e3,
+        rad2deg(er.yaw),
+        er.nees);
   };
   const auto& c = r.calibration;
   show("filter", c.filter.extrinsics, c.filter.covariance);
@@ -185,15 +198,26 @@ std::string CalibrateDatasetResult::BriefReport() const {
   std::string s = format(
       "%lld frames (%lld skipped), %lld detections, %d tracks used, %d bearings; "
       "%.2f m driven, %.0f deg turned\n",
-      static_cast<long long>(frames), static_cast<long long>(frames_skipped),
-      static_cast<long long>(detections), input.tracks, input.observations, input.path_length,
+      static_cast<long long>(frames),
+      static_cast<long long>(frames_skipped),
+      static_cast<long long>(detections),
+      input.tracks,
+      input.observations,
+      input.path_length,
       rad2deg(input.rotation));
   s += format("%s estimate:  phi %.3f +- %.3f deg   rho %.2f +- %.2f mm   psi %.3f +- %.3f deg\n",
-              refined ? "refined" : "filter", rad2deg(e.phi), rad2deg(std::sqrt(C(0, 0))),
-              e.rho * 1e3, std::sqrt(C(1, 1)) * 1e3, rad2deg(e.psi), rad2deg(std::sqrt(C(2, 2))));
+              refined ? "refined" : "filter",
+              rad2deg(e.phi),
+              rad2deg(std::sqrt(C(0, 0))),
+              e.rho * 1e3,
+              std::sqrt(C(1, 1)) * 1e3,
+              rad2deg(e.psi),
+              rad2deg(std::sqrt(C(2, 2))));
   const Eigen::Vector2d p = e.position();
-  s += format("camera in the robot frame: x %.2f mm, y %.2f mm, yaw %.3f deg\n", p(0) * 1e3,
-              p(1) * 1e3, rad2deg(e.yaw()));
+  s += format("camera in the robot frame: x %.2f mm, y %.2f mm, yaw %.3f deg\n",
+              p(0) * 1e3,
+              p(1) * 1e3,
+              rad2deg(e.yaw()));
   const std::string noise = calib::bearing_noise_text(c.bearing_sigma, c.track_bias_sigma);
   if (c.noise_checked)
     s += "bearing sigma " + noise + "; " + calib::noise_check_line(c) + "\n";
@@ -208,11 +232,14 @@ std::string CalibrateDatasetResult::BriefReport() const {
     s += format("filter: %zu tracks joined to the line they continue after the tracker lost it\n",
                 c.filter.joins.size());
   if (c.refined && !c.refinement.merges.empty())
-    s += format("refinement: %zu tracks joined to the line they continue after the tracker lost "
-                "it (summary.json lists them)\n",
-                c.refinement.merges.size());
+    s += format(
+        "refinement: %zu tracks joined to the line they continue after the tracker lost "
+        "it (summary.json lists them)\n",
+        c.refinement.merges.size());
   s += format("Cramer-Rao bound of this run: phi %.3f deg, rho %.2f mm, psi %.3f deg\n",
-              rad2deg(o.phi.crlb), o.rho.crlb * 1e3, rad2deg(o.psi.crlb));
+              rad2deg(o.phi.crlb),
+              o.rho.crlb * 1e3,
+              rad2deg(o.psi.crlb));
   if (truth) s += truth_lines(*this, refined);
   s += o.message + "\n";
   s += "results in " + out_dir + ": " + (wrote_extrinsics ? "extrinsics.yaml, " : "") +

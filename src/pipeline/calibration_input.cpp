@@ -17,9 +17,10 @@ std::string wheel_csv(const dataset::Dataset& d) { return d.root() + "/wheel0/da
 // Index of the last wheel sample at or before t (the wheel data covers every image: the
 // dataset reader checks it).
 std::size_t sample_before(const std::vector<dataset::WheelRecord>& w, std::int64_t t) {
-  auto it = std::upper_bound(w.begin(), w.end(), t, [](std::int64_t v, const dataset::WheelRecord& r) {
-    return v < r.timestamp_ns;
-  });
+  auto it =
+      std::upper_bound(w.begin(), w.end(), t, [](std::int64_t v, const dataset::WheelRecord& r) {
+        return v < r.timestamp_ns;
+      });
   return it == w.begin() ? 0 : static_cast<std::size_t>(it - w.begin()) - 1;
 }
 
@@ -45,8 +46,11 @@ void add_frame_motion(const dataset::Dataset& data, DatasetRun& out) {
     FrameInput& f = out.run.frames[i];
     const std::int64_t t0 = images[i - 1].timestamp_ns, t1 = images[i].timestamp_ns;
     steps.assign(1, Eigen::Vector2d(travel[i - 1].left, travel[i - 1].right));
-    for (std::size_t k = sample_before(wheel, t0) + 1; k < wheel.size() && wheel[k].timestamp_ns < t1; ++k)
-      if (wheel[k].timestamp_ns > t0) steps.emplace_back(wheel[k].travel.left, wheel[k].travel.right);
+    for (std::size_t k = sample_before(wheel, t0) + 1;
+         k < wheel.size() && wheel[k].timestamp_ns < t1;
+         ++k)
+      if (wheel[k].timestamp_ns > t0)
+        steps.emplace_back(wheel[k].travel.left, wheel[k].travel.right);
     steps.emplace_back(travel[i].left, travel[i].right);
     if (e > 0) {
       const Eigen::Vector3d m = compose_wheel_steps(steps, e, &f.covariance_per_K);
@@ -60,12 +64,12 @@ void add_frame_motion(const dataset::Dataset& data, DatasetRun& out) {
     out.path_length += std::abs(0.5 * (f.d_left + f.d_right));
     if (e > 0) out.rotation += std::abs((f.d_right - f.d_left) / e);
   }
-
 }
 
 // Wheel gaps: an image whose bracketing wheel samples are further apart than the limit.
 // Returns, per frame, whether its bearings are left out.
-std::vector<char> wheel_gaps(const dataset::Dataset& data, const DatasetRunOptions& opt,
+std::vector<char> wheel_gaps(const dataset::Dataset& data,
+                             const DatasetRunOptions& opt,
                              DatasetRun& out) {
   const auto& images = data.images();
   const auto& wheel = data.wheel();
@@ -79,13 +83,19 @@ std::vector<char> wheel_gaps(const dataset::Dataset& data, const DatasetRunOptio
       const auto& a = wheel[gap_sample];
       const auto& b = wheel[std::min(gap_sample + 1, wheel.size() - 1)];
       char buf[400];
-      std::snprintf(buf, sizeof buf,
+      std::snprintf(buf,
+                    sizeof buf,
                     "%s: lines %d-%d: no wheel sample for %.3g s (limit %.3g s); the bearings "
                     "of frames %d-%d (cam0/data.csv lines %d-%d) are not used, their poses "
                     "being unknown; the travel across the gap is kept",
-                    wheel_csv(data).c_str(), a.line, b.line,
+                    wheel_csv(data).c_str(),
+                    a.line,
+                    b.line,
                     static_cast<double>(b.timestamp_ns - a.timestamp_ns) * 1e-9,
-                    opt.max_wheel_gap_s, gap_first, gap_last, images[gap_first].line,
+                    opt.max_wheel_gap_s,
+                    gap_first,
+                    gap_last,
+                    images[gap_first].line,
                     images[gap_last].line);
       out.warnings.emplace_back(buf);
       gap_first = gap_last = -1;
@@ -94,7 +104,8 @@ std::vector<char> wheel_gaps(const dataset::Dataset& data, const DatasetRunOptio
       const std::size_t k = sample_before(wheel, images[i].timestamp_ns);
       bool is_gap = false;
       if (wheel[k].timestamp_ns != images[i].timestamp_ns && k + 1 < wheel.size()) {
-        const double dt = static_cast<double>(wheel[k + 1].timestamp_ns - wheel[k].timestamp_ns) * 1e-9;
+        const double dt =
+            static_cast<double>(wheel[k + 1].timestamp_ns - wheel[k].timestamp_ns) * 1e-9;
         is_gap = dt > opt.max_wheel_gap_s;
       }
       if (is_gap) {
@@ -117,8 +128,10 @@ std::vector<char> wheel_gaps(const dataset::Dataset& data, const DatasetRunOptio
 }
 
 // Track lengths (short tracks carry no parallax) and double claims; the bearings used.
-void add_bearings(const std::vector<TrackRow>& rows, const std::vector<char>& gap,
-                  const DatasetRunOptions& opt, DatasetRun& out) {
+void add_bearings(const std::vector<TrackRow>& rows,
+                  const std::vector<char>& gap,
+                  const DatasetRunOptions& opt,
+                  DatasetRun& out) {
   const std::size_t n = out.run.frames.size();
   std::map<std::int64_t, int> length;
   std::map<std::pair<std::int64_t, std::int64_t>, int> per_frame;  // (frame, track) -> count
@@ -151,7 +164,6 @@ void add_bearings(const std::vector<TrackRow>& rows, const std::vector<char>& ga
                            " times a track held two lines of one frame (the paper's rules allow "
                            "it); those bearings were not used (the recommended rules prevent it)");
   }
-
 }
 
 // Starved stretches: too few lines for too long (a warning); no frame with lines at all is
@@ -163,14 +175,20 @@ void check_starved(const dataset::Dataset& data, const DatasetRunOptions& opt, D
   auto starved_flush = [&](std::size_t end) {  // [starved_first, end)
     if (starved_first < 0) return;
     const double dt =
-        static_cast<double>(images[end - 1].timestamp_ns - images[starved_first].timestamp_ns) * 1e-9;
+        static_cast<double>(images[end - 1].timestamp_ns - images[starved_first].timestamp_ns) *
+        1e-9;
     if (dt > opt.max_starved_s) {
       char buf[300];
-      std::snprintf(buf, sizeof buf,
+      std::snprintf(buf,
+                    sizeof buf,
                     "frames %d-%zu (cam0/data.csv lines %d-%d, %.1f s): fewer than %d tracked "
                     "lines; the filter dead-reckons through them and the extrinsics learn "
                     "nothing there",
-                    starved_first, end - 1, images[starved_first].line, images[end - 1].line, dt,
+                    starved_first,
+                    end - 1,
+                    images[starved_first].line,
+                    images[end - 1].line,
+                    dt,
                     opt.min_lines);
       out.warnings.emplace_back(buf);
     }
@@ -187,7 +205,8 @@ void check_starved(const dataset::Dataset& data, const DatasetRunOptions& opt, D
   }
   starved_flush(n);
   if (frames_with_lines == 0) {
-    throw InputError(data.root(), 0,
+    throw InputError(data.root(),
+                     0,
                      "no frame has " + std::to_string(opt.min_lines) +
                          " or more tracked lines: nothing to calibrate from (check the images "
                          "with `omnivert extract`, or the annulus in cam0/sensor.yaml)");
@@ -200,7 +219,8 @@ DatasetRun calibration_run_from_tracks(const dataset::Dataset& data,
                                        const std::vector<TrackRow>& rows,
                                        const DatasetRunOptions& opt) {
   if (!data.has_wheel())
-    throw InputError(data.root() + "/wheel0", 0,
+    throw InputError(data.root() + "/wheel0",
+                     0,
                      "calibration needs wheel odometry (wheel0/data.csv and wheel0/sensor.yaml)");
   DatasetRun out;
   out.run.frames.resize(data.images().size());

@@ -12,7 +12,9 @@
 
 namespace omnivert::calib {
 
-ErrorsVsTruth errors_vs_truth(const Extrinsics& est, const Eigen::Matrix3d& C, const Extrinsics& truth) {
+ErrorsVsTruth errors_vs_truth(const Extrinsics& est,
+                              const Eigen::Matrix3d& C,
+                              const Extrinsics& truth) {
   ErrorsVsTruth e;
   e.phi = wrap_angle(est.phi - truth.phi);
   e.rho = est.rho - truth.rho;
@@ -55,10 +57,14 @@ json extrinsics_json(const Extrinsics& e, const Eigen::Matrix3d& C) {
 }
 
 json errors_json(const ErrorsVsTruth& e) {
-  return {{"phi_deg", num(rad2deg(e.phi))},   {"rho_mm", num(e.rho * 1e3)},
-          {"psi_deg", num(rad2deg(e.psi))},   {"x_mm", num(e.x * 1e3)},
-          {"y_mm", num(e.y * 1e3)},           {"position_mm", num(e.position * 1e3)},
-          {"yaw_deg", num(rad2deg(e.yaw))},   {"nees", num(e.nees)}};
+  return {{"phi_deg", num(rad2deg(e.phi))},
+          {"rho_mm", num(e.rho * 1e3)},
+          {"psi_deg", num(rad2deg(e.psi))},
+          {"x_mm", num(e.x * 1e3)},
+          {"y_mm", num(e.y * 1e3)},
+          {"position_mm", num(e.position * 1e3)},
+          {"yaw_deg", num(rad2deg(e.yaw))},
+          {"nees", num(e.nees)}};
 }
 
 json verdict_json(const ParameterVerdict& v) {
@@ -69,11 +75,20 @@ std::string html_escape(const std::string& s) {
   std::string o;
   for (char c : s) {
     switch (c) {
-      case '&': o += "&amp;"; break;
-      case '<': o += "&lt;"; break;
-      case '>': o += "&gt;"; break;
-      case '"': o += "&quot;"; break;
-      default: o += c;
+      case '&':
+        o += "&amp;";
+        break;
+      case '<':
+        o += "&lt;";
+        break;
+      case '>':
+        o += "&gt;";
+        break;
+      case '"':
+        o += "&quot;";
+        break;
+      default:
+        o += c;
     }
   }
   return o;
@@ -88,9 +103,12 @@ std::string f(const char* format, double v) {
 
 const char* verdict_name(NoiseVerdict v) {
   switch (v) {
-    case NoiseVerdict::kMoreNoise: return "more noise";
-    case NoiseVerdict::kLessNoise: return "less noise";
-    case NoiseVerdict::kAgrees: break;
+    case NoiseVerdict::kMoreNoise:
+      return "more noise";
+    case NoiseVerdict::kLessNoise:
+      return "less noise";
+    case NoiseVerdict::kAgrees:
+      break;
   }
   return "agrees";
 }
@@ -149,12 +167,16 @@ std::string noise_check_line(const CalibrationResult& r) {
                                                           : r.filter.joins.size(),
                   noise_check_flags(r).c_str());
   char buf[640];
-  std::snprintf(buf, sizeof(buf),
-                "noise check over %d tracks: the errors along the tracks act as %s of "
-                "%s (variance x%.2f; %s)",
-                r.noise.clusters,
-                bearing_noise_text(effective_bearing_sigma(r), effective_track_bias_sigma(r)).c_str(),
-                r.track_bias_sigma > 0.0 ? "noise" : "independent noise", r.noise.scale, verdict);
+  std::snprintf(
+      buf,
+      sizeof(buf),
+      "noise check over %d tracks: the errors along the tracks act as %s of "
+      "%s (variance x%.2f; %s)",
+      r.noise.clusters,
+      bearing_noise_text(effective_bearing_sigma(r), effective_track_bias_sigma(r)).c_str(),
+      r.track_bias_sigma > 0.0 ? "noise" : "independent noise",
+      r.noise.scale,
+      verdict);
   return buf;
 }
 
@@ -162,11 +184,17 @@ std::string wheel_check_line(const CalibrationResult& r) {
   const WheelCheck& w = wheel_check_of(r);
   if (!w.ok) return {};
   char buf[320];
-  std::snprintf(buf, sizeof(buf),
+  std::snprintf(buf,
+                sizeof(buf),
                 "wheel check over %d frames: the wheels' turns x%.4f (+-%.4f) of the robot's, "
                 "%+.3f deg/m (+-%.3f) of drift; chi-square %.1f (99.9%% limit %.1f): %s",
-                w.frames, 1.0 + w.rotation_scale, w.sigma_rotation_scale, rad2deg(w.drift_per_m),
-                rad2deg(w.sigma_drift_per_m), w.chi2, chi2_quantile(0.999, 2),
+                w.frames,
+                1.0 + w.rotation_scale,
+                w.sigma_rotation_scale,
+                rad2deg(w.drift_per_m),
+                rad2deg(w.sigma_drift_per_m),
+                w.chi2,
+                chi2_quantile(0.999, 2),
                 wheel_check_rejects_model(w) ? "a systematic wheel error (see the warning)"
                                              : "as the odometry model allows");
   return buf;
@@ -207,22 +235,22 @@ json inputs_json(const CalibrationResult& r, const ReportInputs& in) {
 
 json observability_json(const ObservabilityReport& o) {
   return {{"observable", o.all_determined()},
-                        {"phi", verdict_json(o.phi)},
-                        {"rho", verdict_json(o.rho)},
-                        {"psi", verdict_json(o.psi)},
-                        {"yaw", verdict_json(o.yaw)},
-                        {"x", verdict_json(o.x)},
-                        {"y", verdict_json(o.y)},
-                        {"rank", o.rank},
-                        {"condition", num(o.condition)},
-                        {"heading_range_deg", num(rad2deg(o.heading_range))},
-                        {"heading_noise_deg", num(rad2deg(o.heading_noise))},
-                        {"message", o.message}};
+          {"phi", verdict_json(o.phi)},
+          {"rho", verdict_json(o.rho)},
+          {"psi", verdict_json(o.psi)},
+          {"yaw", verdict_json(o.yaw)},
+          {"x", verdict_json(o.x)},
+          {"y", verdict_json(o.y)},
+          {"rank", o.rank},
+          {"condition", num(o.condition)},
+          {"heading_range_deg", num(rad2deg(o.heading_range))},
+          {"heading_noise_deg", num(rad2deg(o.heading_noise))},
+          {"message", o.message}};
 }
 
 json filter_json(const FilterResult& f) {
   json j = extrinsics_json(f.extrinsics, f.covariance);
-    // Tracks split in the filter's bootstrap window (they slipped onto a neighbouring line).
+  // Tracks split in the filter's bootstrap window (they slipped onto a neighbouring line).
   j["tracks_split"] = f.splits.size();
   j["tracks_joined"] = f.joins.size();
   j["joins"] = joins_json(f.joins);
@@ -288,7 +316,8 @@ json noise_check_json(const CalibrationResult& r) {
   // The Cramer-Rao bounds at the noise the check found: each bound times the square root of
   // the checked over the model variance of that parameter.
   auto checked = [&](double crlb, int i) {
-    return num(r.noise_checked ? crlb * std::sqrt(n.covariance(i, i) / n.model_covariance(i, i)) : NAN);
+    return num(r.noise_checked ? crlb * std::sqrt(n.covariance(i, i) / n.model_covariance(i, i))
+                               : NAN);
   };
   {
     const WheelCheck& w = wheel_check_of(r);
@@ -325,15 +354,18 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
   j["result"] = extrinsics_json(r.extrinsics, r.covariance);
   j["result"]["source"] = r.refined && r.refinement.covariance_ok ? "refinement" : "filter";
   if (in.truth) {
-    j["ground_truth"] = {{"phi", num(in.truth->phi)}, {"rho", num(in.truth->rho)}, {"psi", num(in.truth->psi)}};
+    j["ground_truth"] = {
+        {"phi", num(in.truth->phi)}, {"rho", num(in.truth->rho)}, {"psi", num(in.truth->psi)}};
     json err;
-    err["filter"] = errors_json(errors_vs_truth(r.filter.extrinsics, r.filter.covariance, *in.truth));
+    err["filter"] =
+        errors_json(errors_vs_truth(r.filter.extrinsics, r.filter.covariance, *in.truth));
     if (r.refined && r.refinement.covariance_ok)
       err["refinement"] =
           errors_json(errors_vs_truth(r.refinement.extrinsics, r.refinement.covariance, *in.truth));
     j["errors_vs_ground_truth"] = err;
   }
-  j["seconds"] = {{"tracking", num(in.seconds_tracking)}, {"calibration", num(in.seconds_calibration)}};
+  j["seconds"] = {{"tracking", num(in.seconds_tracking)},
+                  {"calibration", num(in.seconds_calibration)}};
   j["warnings"] = in.warnings;
   return j.dump(2) + "\n";
 }
@@ -344,7 +376,8 @@ namespace {
 // errors against the truth when known.
 void html_estimates(std::ostringstream& h, const CalibrationResult& r, const ReportInputs& in) {
   const ObservabilityReport& o = r.observability;
-  h << "<h2>Estimates</h2>\n<table><tr><th></th><th>phi [deg]</th><th>rho [mm]</th><th>psi [deg]</th>"
+  h << "<h2>Estimates</h2>\n<table><tr><th></th><th>phi [deg]</th><th>rho [mm]</th><th>psi "
+       "[deg]</th>"
        "<th>camera x [mm]</th><th>camera y [mm]</th><th>camera yaw [deg]</th></tr>\n";
   auto row = [&](const std::string& name, const Extrinsics& e, const Eigen::Matrix3d* C) {
     const Eigen::Vector2d p = e.position();
@@ -364,13 +397,15 @@ void html_estimates(std::ostringstream& h, const CalibrationResult& r, const Rep
   if (in.truth) row("ground truth", *in.truth, nullptr);
   h << "</table>\n";
   h << "<table><tr><th>Cram&eacute;r-Rao bound (this run)</th><th>phi [deg]</th><th>rho [mm]</th>"
-       "<th>psi [deg]</th><th>camera x [mm]</th><th>camera y [mm]</th><th>camera yaw [deg]</th></tr>\n"
+       "<th>psi [deg]</th><th>camera x [mm]</th><th>camera y [mm]</th><th>camera yaw "
+       "[deg]</th></tr>\n"
     << "<tr><td>sigma</td><td>" << f("%.3f", rad2deg(o.phi.crlb)) << "</td><td>"
     << f("%.2f", o.rho.crlb * 1e3) << "</td><td>" << f("%.3f", rad2deg(o.psi.crlb)) << "</td><td>"
     << f("%.2f", o.x.crlb * 1e3) << "</td><td>" << f("%.2f", o.y.crlb * 1e3) << "</td><td>"
     << f("%.3f", rad2deg(o.yaw.crlb)) << "</td></tr></table>\n";
   if (in.truth) {
-    h << "<table><tr><th>error vs ground truth</th><th>phi [deg]</th><th>rho [mm]</th><th>psi [deg]</th>"
+    h << "<table><tr><th>error vs ground truth</th><th>phi [deg]</th><th>rho [mm]</th><th>psi "
+         "[deg]</th>"
          "<th>position [mm]</th><th>yaw [deg]</th><th>NEES (3 dof)</th></tr>\n";
     auto erow = [&](const std::string& name, const ErrorsVsTruth& e) {
       h << "<tr><td>" << name << "</td><td>" << f("%.3f", rad2deg(e.phi)) << "</td><td>"
@@ -380,10 +415,10 @@ void html_estimates(std::ostringstream& h, const CalibrationResult& r, const Rep
     };
     erow("filter", errors_vs_truth(r.filter.extrinsics, r.filter.covariance, *in.truth));
     if (r.refined && r.refinement.covariance_ok)
-      erow("refinement", errors_vs_truth(r.refinement.extrinsics, r.refinement.covariance, *in.truth));
+      erow("refinement",
+           errors_vs_truth(r.refinement.extrinsics, r.refinement.covariance, *in.truth));
     h << "</table>\n";
   }
-
 }
 
 // The run's inputs and what each stage did with them.
@@ -393,13 +428,16 @@ void html_inputs(std::ostringstream& h, const CalibrationResult& r, const Report
     h << "<tr><td>" << k << "</td><td>" << html_escape(v) << "</td></tr>\n";
   };
   kv("images", std::to_string(in.frames) + " (" + std::to_string(in.frames_skipped) + " skipped)");
-  kv("line detections / tracks", std::to_string(in.detections) + " / " + std::to_string(in.tracks_total));
+  kv("line detections / tracks",
+     std::to_string(in.detections) + " / " + std::to_string(in.tracks_total));
   if (in.run) {
-    kv("tracks / bearings used", std::to_string(in.run->tracks) + " / " + std::to_string(in.run->observations));
+    kv("tracks / bearings used",
+       std::to_string(in.run->tracks) + " / " + std::to_string(in.run->observations));
     kv("path driven / total rotation",
        f("%.2f m", in.run->path_length) + " / " + f("%.0f deg", rad2deg(in.run->rotation)));
-    kv("bearings of crowded lines (sigma x)", std::to_string(in.run->crowded_bearings) + " (x" +
-                                                    f("%g", in.run->crowded_sigma_scale) + ")");
+    kv("bearings of crowded lines (sigma x)",
+       std::to_string(in.run->crowded_bearings) + " (x" + f("%g", in.run->crowded_sigma_scale) +
+           ")");
     kv("frames with too few lines", std::to_string(in.run->starved_frames));
     kv("frames dropped for wheel gaps", std::to_string(in.run->frames_dropped_for_gaps));
   }
@@ -426,16 +464,17 @@ void html_inputs(std::ostringstream& h, const CalibrationResult& r, const Report
                     : std::string(": could not be solved (") + r.filter.window_failure +
                           "), the filter ran over it from the prior"));
   if (r.refined)
-    kv("refinement", std::string(r.refinement.converged ? "converged" : "did not converge") + ", " +
-                         std::to_string(r.refinement.iterations) + " iterations, " +
-                         std::to_string(r.refinement.num_bearings) + " bearings (" +
-                         std::to_string(r.refinement.num_rejected) + " rejected as outliers, " +
-                         std::to_string(r.refinement.guarded.size()) +
-                         " left out where lines cross), " +
-                         std::to_string(r.refinement.num_splits) + " tracks split where they " +
-                         "changed line, " + std::to_string(r.refinement.merges.size()) +
-                         " joined to the line they continue");
-  kv("time: tracking / calibration", f("%.1f s", in.seconds_tracking) + " / " + f("%.1f s", in.seconds_calibration));
+    kv("refinement",
+       std::string(r.refinement.converged ? "converged" : "did not converge") + ", " +
+           std::to_string(r.refinement.iterations) + " iterations, " +
+           std::to_string(r.refinement.num_bearings) + " bearings (" +
+           std::to_string(r.refinement.num_rejected) + " rejected as outliers, " +
+           std::to_string(r.refinement.guarded.size()) + " left out where lines cross), " +
+           std::to_string(r.refinement.num_splits) + " tracks split where they " +
+           "changed line, " + std::to_string(r.refinement.merges.size()) +
+           " joined to the line they continue");
+  kv("time: tracking / calibration",
+     f("%.1f s", in.seconds_tracking) + " / " + f("%.1f s", in.seconds_calibration));
   h << "</table>\n";
 }
 
@@ -445,7 +484,8 @@ std::string report_html(const CalibrationResult& r, const ReportInputs& in) {
   std::ostringstream h;
   const ObservabilityReport& o = r.observability;
   h << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>omnivert calibrate: "
-    << html_escape(in.dataset) << "</title>\n<style>body{font-family:sans-serif;max-width:1700px;"
+    << html_escape(in.dataset)
+    << "</title>\n<style>body{font-family:sans-serif;max-width:1700px;"
        "margin:1em auto;padding:0 1em}table{border-collapse:collapse;margin:0.5em 0}"
        "td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}th{background:#eee}"
        "td:first-child,th:first-child{text-align:left}.ok{color:#060}.bad{color:#a00}"
@@ -455,11 +495,11 @@ std::string report_html(const CalibrationResult& r, const ReportInputs& in) {
     << html_escape(in.command) << "</code>.</p>\n";
   const bool obs = o.all_determined();
   h << "<h2>Verdict</h2>\n<p class=\"" << (obs ? "ok" : "bad") << "\"><b>"
-    << (obs ? "Determined." : "Not determined.") << "</b> " << html_escape(o.message)
-    << "</p>\n";
+    << (obs ? "Determined." : "Not determined.") << "</b> " << html_escape(o.message) << "</p>\n";
   if (!obs)
-    h << "<p>" << (in.force ? "--force was given: extrinsics.yaml was written anyway."
-                            : "extrinsics.yaml was not written (exit code 3); --force writes it.")
+    h << "<p>"
+      << (in.force ? "--force was given: extrinsics.yaml was written anyway."
+                   : "extrinsics.yaml was not written (exit code 3); --force writes it.")
       << "</p>\n";
 
   html_estimates(h, r, in);

@@ -52,7 +52,8 @@ TrackDatasetResult track_dataset(const dataset::Dataset& data,
     if (odometry && to.gate.enabled) {
       const WheelIncrement inc =
           i == 0 ? WheelIncrement{}
-                 : increment_between(travel[i - 1].left, travel[i - 1].right, travel[i].left, travel[i].right);
+                 : increment_between(
+                       travel[i - 1].left, travel[i - 1].right, travel[i].left, travel[i].right);
       tracker.add_frame(f, inc, &assignments);
     } else {
       tracker.add_frame(f, &assignments);
@@ -63,7 +64,8 @@ TrackDatasetResult track_dataset(const dataset::Dataset& data,
     if (progress) progress(i + 1, data.size());
   }
   if (out.frames_skipped == out.frames) {
-    throw InputError(csv, 0,
+    throw InputError(csv,
+                     0,
                      "no frame could be processed (" +
                          (out.warnings.empty() ? std::string("?") : out.warnings.front()) + ")");
   }
@@ -79,12 +81,14 @@ TrackDatasetResult read_tracks_for_dataset(const std::string& file, const datase
   for (const TrackRow& r : t.rows) {
     const int line = r.source_line;
     if (r.frame >= static_cast<std::int64_t>(images.size()))
-      throw InputError(file, line,
+      throw InputError(file,
+                       line,
                        "frame " + std::to_string(r.frame) + " is not an image of " + data.root() +
                            " (it has " + std::to_string(images.size()) + ")");
     const auto& im = images[static_cast<std::size_t>(r.frame)];
     if (r.timestamp_ns != im.timestamp_ns)
-      throw InputError(file, line,
+      throw InputError(file,
+                       line,
                        "frame " + std::to_string(r.frame) + " has timestamp " +
                            std::to_string(r.timestamp_ns) + " but cam0/data.csv line " +
                            std::to_string(im.line) + " has " + std::to_string(im.timestamp_ns) +

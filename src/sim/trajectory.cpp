@@ -5,9 +5,9 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "core/yaml_fields.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
-#include "core/yaml_fields.hpp"
 
 namespace omnivert::sim {
 

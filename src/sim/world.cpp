@@ -9,9 +9,9 @@
 #include <yaml-cpp/yaml.h>
 #include <opencv2/imgproc.hpp>
 
+#include "core/yaml_fields.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
-#include "core/yaml_fields.hpp"
 
 namespace omnivert::sim {
 

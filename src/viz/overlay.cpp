@@ -23,13 +23,43 @@ cv::Mat draw_overlay(const cv::Mat& image,
     return cv::Point(static_cast<int>(std::lround(x * 16)), static_cast<int>(std::lround(y * 16)));
   };
   const auto& c = f.circle;
-  cv::circle(bgr, P(c.center.x(), c.center.y()), static_cast<int>(c.r_min * 16), {255, 160, 0}, thick, cv::LINE_AA, shift);
-  cv::circle(bgr, P(c.center.x(), c.center.y()), static_cast<int>(c.r_max * 16), {255, 160, 0}, thick, cv::LINE_AA, shift);
+  cv::circle(bgr,
+             P(c.center.x(), c.center.y()),
+             static_cast<int>(c.r_min * 16),
+             {255, 160, 0},
+             thick,
+             cv::LINE_AA,
+             shift);
+  cv::circle(bgr,
+             P(c.center.x(), c.center.y()),
+             static_cast<int>(c.r_max * 16),
+             {255, 160, 0},
+             thick,
+             cv::LINE_AA,
+             shift);
   if (c.rim_radius > 0)
-    cv::circle(bgr, P(c.center.x(), c.center.y()), static_cast<int>(c.rim_radius * 16), {0, 200, 255}, thick, cv::LINE_AA, shift);
+    cv::circle(bgr,
+               P(c.center.x(), c.center.y()),
+               static_cast<int>(c.rim_radius * 16),
+               {0, 200, 255},
+               thick,
+               cv::LINE_AA,
+               shift);
   const double m = 6 * scale;
-  cv::line(bgr, P(c.center.x() - m, c.center.y()), P(c.center.x() + m, c.center.y()), {0, 0, 255}, thick, cv::LINE_AA, shift);
-  cv::line(bgr, P(c.center.x(), c.center.y() - m), P(c.center.x(), c.center.y() + m), {0, 0, 255}, thick, cv::LINE_AA, shift);
+  cv::line(bgr,
+           P(c.center.x() - m, c.center.y()),
+           P(c.center.x() + m, c.center.y()),
+           {0, 0, 255},
+           thick,
+           cv::LINE_AA,
+           shift);
+  cv::line(bgr,
+           P(c.center.x(), c.center.y() - m),
+           P(c.center.x(), c.center.y() + m),
+           {0, 0, 255},
+           thick,
+           cv::LINE_AA,
+           shift);
 
   if (highlight < 0 && !f.lines.empty()) {
     highlight = 0;
@@ -43,18 +73,26 @@ cv::Mat draw_overlay(const cv::Mat& image,
     cv::line(bgr,
              P(c.center.x() + l.r_inner * ca, c.center.y() + l.r_inner * sa),
              P(c.center.x() + l.r_outer * ca, c.center.y() + l.r_outer * sa),
-             col, thick + 1, cv::LINE_AA, shift);
+             col,
+             thick + 1,
+             cv::LINE_AA,
+             shift);
     const double rt = c.r_max + 10 * scale;
-    cv::putText(bgr, std::to_string(i),
+    cv::putText(bgr,
+                std::to_string(i),
                 cv::Point(static_cast<int>(c.center.x() + rt * ca - 6 * scale),
                           static_cast<int>(c.center.y() + rt * sa + 4 * scale)),
-                cv::FONT_HERSHEY_SIMPLEX, 0.4 * scale,
-                l.crowded ? cv::Scalar(0, 0, 255) : cv::Scalar(0, 255, 255), thick, cv::LINE_AA);
+                cv::FONT_HERSHEY_SIMPLEX,
+                0.4 * scale,
+                l.crowded ? cv::Scalar(0, 0, 255) : cv::Scalar(0, 255, 255),
+                thick,
+                cv::LINE_AA);
   }
   if (highlight >= 0 && highlight < static_cast<int>(f.lines.size())) {
     const double ra = descriptor.area_radius(c);
     for (const auto& p : descriptor.area_centers(c, f.lines[highlight].image_angle))
-      cv::circle(bgr, P(p.x, p.y), static_cast<int>(ra * 16), {0, 128, 255}, thick, cv::LINE_AA, shift);
+      cv::circle(
+          bgr, P(p.x, p.y), static_cast<int>(ra * 16), {0, 128, 255}, thick, cv::LINE_AA, shift);
   }
   return bgr;
 }

@@ -8,9 +8,9 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "omnivert/image/image_io.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
+#include "omnivert/image/image_io.hpp"
 
 namespace omnivert {
 

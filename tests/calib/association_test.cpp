@@ -13,12 +13,12 @@
 
 #include <Eigen/Dense>
 
+#include "calib/synthetic_run.hpp"
 #include "omnivert/calib/batch_point.hpp"
 #include "omnivert/calib/calibrate.hpp"
 #include "omnivert/calib/calibration_filter.hpp"
 #include "omnivert/calib/model.hpp"
 #include "omnivert/calib/refinement.hpp"
-#include "calib/synthetic_run.hpp"
 #include "omnivert/calib/track_ids.hpp"
 #include "omnivert/core/angles.hpp"
 #include "synthetic_support.hpp"

@@ -11,13 +11,13 @@
 #include <Eigen/Dense>
 #include <string>
 
+#include "calib/synthetic_run.hpp"
 #include "omnivert/calib/batch_point.hpp"
 #include "omnivert/calib/calibrate.hpp"
 #include "omnivert/calib/diagnostics.hpp"
 #include "omnivert/calib/refinement.hpp"
-#include "omnivert/pipeline/calibration_report.hpp"
-#include "calib/synthetic_run.hpp"
 #include "omnivert/core/angles.hpp"
+#include "omnivert/pipeline/calibration_report.hpp"
 #include "synthetic_support.hpp"
 
 namespace omnivert::calib {

@@ -10,15 +10,15 @@
 #include <map>
 #include <set>
 
+#include "calib/synthetic_run.hpp"
 #include "omnivert/calib/batch_point.hpp"
-#include "omnivert/calib/observability.hpp"
-#include "omnivert/calib/refinement.hpp"
-#include "omnivert/calib/track_ids.hpp"
 #include "omnivert/calib/calibrate.hpp"
 #include "omnivert/calib/calibration_filter.hpp"
 #include "omnivert/calib/feature_initializer.hpp"
 #include "omnivert/calib/model.hpp"
-#include "calib/synthetic_run.hpp"
+#include "omnivert/calib/observability.hpp"
+#include "omnivert/calib/refinement.hpp"
+#include "omnivert/calib/track_ids.hpp"
 #include "omnivert/calib/updater.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
@@ -239,8 +239,13 @@ TEST(CalibrationFilter, OutlierBearingIsGated) {
   const Eigen::Matrix3d C = f.covariance();
   for (int i = 0; i < 3; ++i) EXPECT_LT(std::abs(e(i)), 3.5 * std::sqrt(C(i, i))) << i;
   // The refinement drops the three as well.
-  const FilterResult fr{f.extrinsics(), f.covariance(), f.history(), f.tracks(), f.splits(),
-                        f.window_frames(), f.window_failure()};
+  const FilterResult fr{f.extrinsics(),
+                        f.covariance(),
+                        f.history(),
+                        f.tracks(),
+                        f.splits(),
+                        f.window_frames(),
+                        f.window_failure()};
   const RefinementResult rr = refine_batch(run.run, o, batch_point_from_filter(run.run, o, fr));
   EXPECT_GE(rr.num_rejected, 3);
   const Eigen::Vector3d er = error(rr.extrinsics, run.truth);
@@ -291,7 +296,8 @@ TEST(CalibrationFilter, BearingSigmaScaleWeighsLikeALargerSigma) {
   EXPECT_LT((a.extrinsics.vec() - b.extrinsics.vec()).norm(), 1e-9);
   EXPECT_LT((a.covariance - b.covariance).norm(), 1e-9 * b.covariance.norm());
   const RefinementResult ra = refine_batch(scaled, o, batch_point_from_filter(scaled, o, a));
-  const RefinementResult rb = refine_batch(run.run, wide, batch_point_from_filter(run.run, wide, b));
+  const RefinementResult rb =
+      refine_batch(run.run, wide, batch_point_from_filter(run.run, wide, b));
   ASSERT_TRUE(ra.covariance_ok && rb.covariance_ok);
   EXPECT_LT((ra.extrinsics.vec() - rb.extrinsics.vec()).norm(), 1e-7);
   EXPECT_LT((ra.covariance - rb.covariance).norm(), 1e-6 * rb.covariance.norm());
@@ -341,7 +347,8 @@ TEST(CalibrationFilter, RefusedBearingsAreListedAndLeftOutOfTheBound) {
   out.insert(r.filter.guarded.begin(), r.filter.guarded.end());
   for (std::size_t k = 0; k < used.frames.size(); ++k) {
     auto& obs = used.frames[k].observations;
-    obs.erase(std::remove_if(obs.begin(), obs.end(),
+    obs.erase(std::remove_if(obs.begin(),
+                             obs.end(),
                              [&](const BearingObservation& b) {
                                return out.count({b.track_id, static_cast<int>(k)}) > 0;
                              }),
@@ -451,7 +458,8 @@ TEST(CalibrationFilter, AJoinedTrackThatComesBackAfterItsFeatureLeftIsOneFeature
     for (BearingObservation& b : renamed.frames[static_cast<std::size_t>(k)].observations)
       b.track_id += 1000;
   // Every new id goes unseen over [gap_from, gap_to).
-  for (int k = gap_from; k < gap_to; ++k) renamed.frames[static_cast<std::size_t>(k)].observations.clear();
+  for (int k = gap_from; k < gap_to; ++k)
+    renamed.frames[static_cast<std::size_t>(k)].observations.clear();
   CalibrationFilter filter(o);
   std::vector<std::set<int>> seen(static_cast<std::size_t>(n));
   for (int k = 0; k < n; ++k) {
@@ -490,8 +498,12 @@ TEST(CalibrationFilter, PiecesOfOneLineAreOneFeature) {
       wrong += run.track_feature.at(a) != run.track_feature.at(c);
     }
     const double s = std::sqrt(r.covariance(1, 1)), sa = std::sqrt(apart.covariance(1, 1));
-    std::printf("seed %d: %zu joins, sigma rho %.2f mm (apart %.2f), NEES %.2f (apart %.2f)\n", seed,
-                r.joins.size(), 1e3 * s, 1e3 * sa, nees(r.extrinsics, r.covariance, run.truth),
+    std::printf("seed %d: %zu joins, sigma rho %.2f mm (apart %.2f), NEES %.2f (apart %.2f)\n",
+                seed,
+                r.joins.size(),
+                1e3 * s,
+                1e3 * sa,
+                nees(r.extrinsics, r.covariance, run.truth),
                 nees(apart.extrinsics, apart.covariance, run.truth));
     EXPECT_LT(s, 0.5 * sa) << "seed " << seed;
     EXPECT_LT(nees(r.extrinsics, r.covariance, run.truth), 16.3) << "seed " << seed;

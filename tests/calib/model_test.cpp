@@ -5,8 +5,8 @@
 
 #include <Eigen/Geometry>
 #include <functional>
-#include <set>
 #include <random>
+#include <set>
 
 #include "omnivert/calib/model.hpp"
 #include "omnivert/calib/propagator.hpp"
@@ -282,15 +282,18 @@ TEST(Odometry, WheelStepAndChongKleeman) {
 // +-pi, a chain counted pair by pair, two parts of one line not a crossing.
 TEST(CrowdedDirections, FindsTheDirectionsWithANeighbourWithinTheGuard) {
   const double g = deg2rad(1.0);
-  const std::vector<std::pair<double, int>> v = {
-      {deg2rad(10.0), 1}, {deg2rad(10.9), 2},    // a pair
-      {deg2rad(50.0), 3},                        // alone
-      {deg2rad(179.7), 4}, {deg2rad(-179.8), 5},  // across +-180
-      {deg2rad(90.0), 6}, {deg2rad(90.6), 7}, {deg2rad(91.2), 8},  // a chain: 6-7, 7-8
-      {deg2rad(-30.0), 9}, {deg2rad(-29.5), 10}};                  // one split line
-  const std::set<int> out = crowded_directions(v, g, [](int a, int b) {
-    return std::min(a, b) == 9 && std::max(a, b) == 10;
-  });
+  const std::vector<std::pair<double, int>> v = {{deg2rad(10.0), 1},
+                                                 {deg2rad(10.9), 2},  // a pair
+                                                 {deg2rad(50.0), 3},  // alone
+                                                 {deg2rad(179.7), 4},
+                                                 {deg2rad(-179.8), 5},  // across +-180
+                                                 {deg2rad(90.0), 6},
+                                                 {deg2rad(90.6), 7},
+                                                 {deg2rad(91.2), 8},  // a chain: 6-7, 7-8
+                                                 {deg2rad(-30.0), 9},
+                                                 {deg2rad(-29.5), 10}};  // one split line
+  const std::set<int> out = crowded_directions(
+      v, g, [](int a, int b) { return std::min(a, b) == 9 && std::max(a, b) == 10; });
   EXPECT_EQ(out, (std::set<int>{1, 2, 4, 5, 6, 7, 8}));
   EXPECT_EQ(crowded_directions(v, g).count(9), 1u);
   EXPECT_TRUE(crowded_directions(v, 0.0).empty());
@@ -311,15 +314,16 @@ TEST(FrameMotion, ComposedWheelStepsAndTheFiltersTwoStepsGiveThePose) {
     const bool straight_then_turn = trial % 2 == 0;
     const double v = 0.003 * u(rng), w = 0.006 * u(rng);
     for (int i = 0; i < 17; ++i) {
-      Eigen::Vector2d d = straight_then_turn ? (i < 9 ? Eigen::Vector2d(v, v) : Eigen::Vector2d(w, -w))
-                                             : Eigen::Vector2d(0.003 * u(rng), 0.003 * u(rng));
+      Eigen::Vector2d d = straight_then_turn
+                              ? (i < 9 ? Eigen::Vector2d(v, v) : Eigen::Vector2d(w, -w))
+                              : Eigen::Vector2d(0.003 * u(rng), 0.003 * u(rng));
       travel.push_back(travel.back() + d);  // (left, right)
     }
     Eigen::Vector3d direct = Eigen::Vector3d(0.3, -0.2, 0.7);
     const Eigen::Vector3d start = direct;
     for (std::size_t i = 1; i < travel.size(); ++i)
-      direct = integrate_pose(direct, travel[i](1) - travel[i - 1](1),
-                              travel[i](0) - travel[i - 1](0), e);
+      direct = integrate_pose(
+          direct, travel[i](1) - travel[i - 1](1), travel[i](0) - travel[i - 1](0), e);
     const Eigen::Vector3d m = compose_wheel_steps(travel, e);
     const Eigen::Vector3d composed = integrate_pose_lateral(start, m(0), m(1), m(2), e);
     EXPECT_LT((composed - direct).norm(), 1e-12) << "trial " << trial;

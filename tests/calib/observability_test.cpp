@@ -4,11 +4,11 @@
 
 #include <cmath>
 
+#include "calib/synthetic_run.hpp"
 #include "omnivert/calib/batch_point.hpp"
+#include "omnivert/calib/calibrate.hpp"
 #include "omnivert/calib/observability.hpp"
 #include "omnivert/calib/refinement.hpp"
-#include "omnivert/calib/calibrate.hpp"
-#include "calib/synthetic_run.hpp"
 #include "omnivert/core/angles.hpp"
 #include "synthetic_support.hpp"
 
@@ -113,9 +113,9 @@ TEST(Observability, BoundIsTheMarginalOfTheFullInverseOfTheSolvedProblem) {
     const Eigen::Matrix3d& fast = r.observability.crlb_covariance;
     const Eigen::Matrix3d& plain = r.refinement.noise.model_covariance;
     for (const Eigen::Vector3d& v : {Eigen::Vector3d(1, 0, 0),
-                                    Eigen::Vector3d(0, 1, 0),
-                                    Eigen::Vector3d(0, 0, 1),
-                                    Eigen::Vector3d(1, 0, 1)}) {
+                                     Eigen::Vector3d(0, 1, 0),
+                                     Eigen::Vector3d(0, 0, 1),
+                                     Eigen::Vector3d(1, 0, 1)}) {
       const double a = std::sqrt(v.dot(fast * v)), b = std::sqrt(v.dot(plain * v));
       EXPECT_NEAR(a / b, 1.0, 1e-3) << "seed " << seed << ", direction " << v.transpose();
     }

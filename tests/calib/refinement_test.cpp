@@ -9,9 +9,9 @@
 
 #include <Eigen/Dense>
 
+#include "calib/synthetic_run.hpp"
 #include "omnivert/calib/batch_point.hpp"
 #include "omnivert/calib/refinement.hpp"
-#include "calib/synthetic_run.hpp"
 #include "omnivert/core/angles.hpp"
 #include "synthetic_support.hpp"
 

@@ -4,10 +4,10 @@
 #include <Eigen/Cholesky>
 #include <cmath>
 
+#include "calib/synthetic_run.hpp"
 #include "omnivert/calib/batch_point.hpp"
 #include "omnivert/calib/model.hpp"
 #include "omnivert/calib/refinement.hpp"
-#include "calib/synthetic_run.hpp"
 #include "omnivert/core/angles.hpp"
 
 namespace omnivert::calib::test_support {

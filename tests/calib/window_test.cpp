@@ -12,6 +12,7 @@
 #include <Eigen/Dense>
 #include <string>
 
+#include "calib/synthetic_run.hpp"
 #include "calib/window.hpp"
 #include "omnivert/calib/batch_point.hpp"
 #include "omnivert/calib/calibrate.hpp"
@@ -19,7 +20,6 @@
 #include "omnivert/calib/flow_yaw.hpp"
 #include "omnivert/calib/model.hpp"
 #include "omnivert/calib/refinement.hpp"
-#include "calib/synthetic_run.hpp"
 #include "omnivert/calib/updater.hpp"
 #include "omnivert/core/angles.hpp"
 #include "synthetic_support.hpp"

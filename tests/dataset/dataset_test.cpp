@@ -177,7 +177,8 @@ TEST_F(DatasetTest, FileThatIsNotAnImage) {
 }
 
 TEST_F(DatasetTest, WindowsLineEndingsAndSpacesAreAccepted) {
-  write("cam0/data.csv", "#timestamp [ns],filename\r\n1000000000, a.png\r\n2000000000 ,b.png\r\n\r\n");
+  write("cam0/data.csv",
+        "#timestamp [ns],filename\r\n1000000000, a.png\r\n2000000000 ,b.png\r\n\r\n");
   const Dataset d = Dataset::load(root.string());
   ASSERT_EQ(d.size(), 2u);
   EXPECT_EQ(d.images()[0].filename, "a.png");

@@ -117,7 +117,8 @@ TEST(Descriptor, SampledFastPathStaysCloseToTheFullResolutionReference) {
   fast.compute_at_angles(img, c, angles, a);
   ref.compute_at_angles(img, c, angles, b);
   double worst = 0;
-  for (int i = 0; i < a.rows(); ++i) worst = std::max(worst, static_cast<double>((a.row(i) - b.row(i)).norm()));
+  for (int i = 0; i < a.rows(); ++i)
+    worst = std::max(worst, static_cast<double>((a.row(i) - b.row(i)).norm()));
   EXPECT_LT(worst, 0.1);
 }
 

@@ -17,7 +17,9 @@
 namespace omnivert {
 namespace {
 
-FrameFeatures features_of(const cv::Mat& img, const CameraGeometry& g, const FeaturePipelineOptions& o = {}) {
+FrameFeatures features_of(const cv::Mat& img,
+                          const CameraGeometry& g,
+                          const FeaturePipelineOptions& o = {}) {
   FeaturePipeline p(g, o);
   FrameFeatures f;
   std::string why;
@@ -59,8 +61,11 @@ TEST(Invariance, RotatedSceneGivesTheSameLinesShiftedAndTheSameDescriptors) {
       }
     }
   }
-  std::printf("rotation: %d line pairs, worst shift error %.4f deg, worst descriptor distance %.3f\n",
-              pairs, worst_shift, worst_dist);
+  std::printf(
+      "rotation: %d line pairs, worst shift error %.4f deg, worst descriptor distance %.3f\n",
+      pairs,
+      worst_shift,
+      worst_dist);
   EXPECT_LE(worst_shift, 0.1);
   EXPECT_LE(worst_dist, 0.25);
 }
@@ -88,7 +93,9 @@ TEST(Invariance, GainAndGammaChangeDescriptorsLittle) {
       }
     }
   }
-  std::printf("gain x0.6..x1.5, gamma 0.7..1.4: %d line pairs, worst descriptor distance %.3f\n", pairs, worst);
+  std::printf("gain x0.6..x1.5, gamma 0.7..1.4: %d line pairs, worst descriptor distance %.3f\n",
+              pairs,
+              worst);
   EXPECT_GT(pairs, 100);
   EXPECT_LE(worst, 0.3);
 }
@@ -120,15 +127,17 @@ TEST_P(RealImages, CentreLinesAndInvariances) {
   CameraGeometry geo;
   geo.center = probe.circle.center;
   geo.r_min = probe.circle.r_min;
-  geo.r_max = std::min(probe.circle.r_max,
-                       rotation_safe_r_max(probe.circle.center, gray.cols, gray.rows, probe.circle.r_min));
+  geo.r_max =
+      std::min(probe.circle.r_max,
+               rotation_safe_r_max(probe.circle.center, gray.cols, gray.rows, probe.circle.r_min));
   const FrameFeatures f0 = features_of(img, geo, po);
   ASSERT_GE(f0.lines.size(), 2u);
 
   std::vector<double> rot_dist, rot_shift, light_dist;
   int found = 0, expected = 0;
   for (double deg : {17.0, 71.0, 199.0}) {
-    const FrameFeatures f1 = features_of(rotate_about(img, f0.circle.center, deg2rad(deg)), geo, po);
+    const FrameFeatures f1 =
+        features_of(rotate_about(img, f0.circle.center, deg2rad(deg)), geo, po);
     const auto pr = pair_lines(f0, f1, deg2rad(deg), deg2rad(0.3));
     expected += static_cast<int>(f0.lines.size());
     found += static_cast<int>(pr.size());
@@ -140,15 +149,28 @@ TEST_P(RealImages, CentreLinesAndInvariances) {
   for (double gain : {0.6, 0.8}) {
     for (double gamma : {0.7, 1.4}) {
       const FrameFeatures f1 = features_of(relight(img, gain, gamma), geo, po);
-      for (const auto& p : pair_lines(f0, f1, 0.0, deg2rad(0.3))) light_dist.push_back(p.descriptor_distance);
+      for (const auto& p : pair_lines(f0, f1, 0.0, deg2rad(0.3)))
+        light_dist.push_back(p.descriptor_distance);
     }
   }
-  std::printf("%s: centre (%.2f, %.2f), %zu lines; rotation: %d/%d lines again, shift median %.3f p90 %.3f deg, "
-              "descriptor distance median %.3f p90 %.3f max %.3f; light: median %.3f p90 %.3f max %.3f\n",
-              GetParam().file, f0.circle.center.x(), f0.circle.center.y(), f0.lines.size(), found, expected,
-              percentile(rot_shift, 0.5), percentile(rot_shift, 0.9), percentile(rot_dist, 0.5),
-              percentile(rot_dist, 0.9), percentile(rot_dist, 1.0), percentile(light_dist, 0.5),
-              percentile(light_dist, 0.9), percentile(light_dist, 1.0));
+  std::printf(
+      "%s: centre (%.2f, %.2f), %zu lines; rotation: %d/%d lines again, shift median %.3f p90 %.3f "
+      "deg, "
+      "descriptor distance median %.3f p90 %.3f max %.3f; light: median %.3f p90 %.3f max %.3f\n",
+      GetParam().file,
+      f0.circle.center.x(),
+      f0.circle.center.y(),
+      f0.lines.size(),
+      found,
+      expected,
+      percentile(rot_shift, 0.5),
+      percentile(rot_shift, 0.9),
+      percentile(rot_dist, 0.5),
+      percentile(rot_dist, 0.9),
+      percentile(rot_dist, 1.0),
+      percentile(light_dist, 0.5),
+      percentile(light_dist, 0.9),
+      percentile(light_dist, 1.0));
   EXPECT_GE(found, 0.8 * expected);
   // Real lines are weaker and less straight than drawn ones (KaidanOmni1 is hand-held, its
   // axis tilted): the median shift error must meet the drawn images' 0.1 degree, the tail
@@ -159,7 +181,8 @@ TEST_P(RealImages, CentreLinesAndInvariances) {
   EXPECT_LE(percentile(light_dist, 0.9), 0.3);
 }
 
-INSTANTIATE_TEST_SUITE_P(Shared, RealImages,
+INSTANTIATE_TEST_SUITE_P(Shared,
+                         RealImages,
                          ::testing::Values(RealCase{"VMRImage0.jpg", 516.7, 384.1},
                                            RealCase{"imgMei_001.jpg", 641.4, 521.3},
                                            RealCase{"KaidanOmni1.jpg", 325.1, 246.6}),

@@ -15,9 +15,9 @@
 #include "omnivert/eval/descriptor_study.hpp"
 #include "omnivert/eval/panorama.hpp"
 #include "omnivert/eval/similarity_study.hpp"
-#include "omnivert/viz/plot.hpp"
 #include "omnivert/sim/radial_pattern.hpp"
 #include "omnivert/sim/simulator.hpp"
+#include "omnivert/viz/plot.hpp"
 
 namespace omnivert {
 namespace {

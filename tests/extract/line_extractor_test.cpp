@@ -28,7 +28,8 @@ void score_frame(const sim::RadialPattern& p, const FrameFeatures& f, Score& s) 
     if (e.r_to - e.r_from < 0.6 * L) continue;
     ++s.long_edges;
     double best = 1e9;
-    for (const auto& l : f.lines) best = std::min(best, std::abs(angle_diff(l.image_angle, e.image_angle)));
+    for (const auto& l : f.lines)
+      best = std::min(best, std::abs(angle_diff(l.image_angle, e.image_angle)));
     if (best <= deg2rad(0.3)) {
       ++s.long_found;
       s.errors_deg.push_back(rad2deg(best));
@@ -36,7 +37,8 @@ void score_frame(const sim::RadialPattern& p, const FrameFeatures& f, Score& s) 
   }
   for (const auto& l : f.lines) {
     double best = 1e9;
-    for (const auto& e : p.edges) best = std::min(best, std::abs(angle_diff(l.image_angle, e.image_angle)));
+    for (const auto& e : p.edges)
+      best = std::min(best, std::abs(angle_diff(l.image_angle, e.image_angle)));
     if (best > deg2rad(0.3)) ++s.invented;
   }
 }
@@ -65,7 +67,11 @@ TEST(LineExtractor, FindsEveryLongEdgeAtItsAngleAndInventsNone) {
   }
   const double center_rms = rms(s.center_errors);
   std::printf("long edges %d found %d invented %d bearing RMS %.4f deg centre RMS %.3f px\n",
-              s.long_edges, s.long_found, s.invented, rms(s.errors_deg), center_rms);
+              s.long_edges,
+              s.long_found,
+              s.invented,
+              rms(s.errors_deg),
+              center_rms);
   EXPECT_EQ(s.long_found, s.long_edges);
   EXPECT_EQ(s.invented, 0);
   EXPECT_LE(rms(s.errors_deg), 0.05);
@@ -106,9 +112,16 @@ TEST(LineExtractor, ResolvesEdgesLittleMoreThanADegreeApart) {
   int pairs = 0;
   run(0, 1, &fine, &pairs);
   run(1, 2, &coarse, nullptr);  // the same patterns
-  std::printf("close pairs %d; default: %d of %d long edges, %d invented, RMS %.4f deg; coarse: %d, %d invented\n",
-              pairs, fine.long_found, fine.long_edges, fine.invented, rms(fine.errors_deg),
-              coarse.long_found, coarse.invented);
+  std::printf(
+      "close pairs %d; default: %d of %d long edges, %d invented, RMS %.4f deg; coarse: %d, %d "
+      "invented\n",
+      pairs,
+      fine.long_found,
+      fine.long_edges,
+      fine.invented,
+      rms(fine.errors_deg),
+      coarse.long_found,
+      coarse.invented);
   ASSERT_GE(pairs, 10);  // the patterns do hold close pairs
   EXPECT_EQ(fine.long_found, fine.long_edges);
   EXPECT_EQ(fine.invented, 0);
@@ -140,7 +153,8 @@ cv::Mat1b draw_bar(double a1, double width, const Eigen::Vector2d& c, std::mt199
       if (near_edge) {
         val = 0;
         for (int i = 0; i < S; ++i)
-          for (int j = 0; j < S; ++j) val += value(x + (i + 0.5) / S - 0.5, y + (j + 0.5) / S - 0.5);
+          for (int j = 0; j < S; ++j)
+            val += value(x + (i + 0.5) / S - 0.5, y + (j + 0.5) / S - 0.5);
         val /= S * S;
       }
       img(v, u) = cv::saturate_cast<uchar>(val + noise(rng));
@@ -188,7 +202,8 @@ TEST(LineExtractor, TheEdgesOfAThinBarAreNotPushedApart) {
   };
   const double full = mean_outward_shift(0.0), isolated = mean_outward_shift(3.0);
   std::printf("thin bar 1.2 deg: mean outward shift %.4f deg (full support), %.4f deg (isolated)\n",
-              full, isolated);
+              full,
+              isolated);
   EXPECT_GT(full, 0.007);  // the bias is there to remove
   EXPECT_LT(std::abs(isolated), 0.004);
 }
@@ -219,8 +234,11 @@ TEST(LineExtractor, EdgesTooCloseToRefitAreMarkedCrowded) {
       }
     }
   }
-  std::printf("bar 0.8 deg: %d of %d edges crowded; bar 1.5 deg: %d of %d\n", crowded_thin,
-              lines_thin, crowded_wide, lines_wide);
+  std::printf("bar 0.8 deg: %d of %d edges crowded; bar 1.5 deg: %d of %d\n",
+              crowded_thin,
+              lines_thin,
+              crowded_wide,
+              lines_wide);
   EXPECT_EQ(lines_thin, 8);
   EXPECT_EQ(crowded_thin, 8);
   EXPECT_EQ(lines_wide, 8);

@@ -6,8 +6,8 @@
 
 #include <gtest/gtest.h>
 
-#include "omnivert/match/tracker.hpp"
 #include "../support/alloc_counter.hpp"
+#include "omnivert/match/tracker.hpp"
 
 namespace omnivert {
 namespace {

@@ -46,7 +46,8 @@ TEST(GivenCenter, IsUsedAsGivenOnEveryFrameAndFittedOnlyOnRequest) {
     ++frames;
   }
   std::printf("rim fit: centre %.4f px from the true one on average, %.4f at most\n",
-              sum_fit_offset / frames, max_fit_offset);
+              sum_fit_offset / frames,
+              max_fit_offset);
   EXPECT_GT(max_fit_offset, 0.0);   // the fit did run
   EXPECT_LT(max_fit_offset, 0.05);  // and is close (mirror_center_test holds its accuracy)
 }

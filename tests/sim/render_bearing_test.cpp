@@ -1,8 +1,8 @@
 // Rendered geometry against an independent computation: a vertical
 // edge at a known world position must appear at its predicted bearing within 0.05 degree.
 //
-// The prediction uses docs/theory/conventions.md directly (camera centre at rho (cos phi, sin phi) in the
-// robot frame, beta = atan2(y_f - y_C, x_f - x_C) - (theta_R + phi + psi)). The measurement
+// The prediction uses docs/theory/conventions.md directly (camera centre at rho (cos phi, sin phi)
+// in the robot frame, beta = atan2(y_f - y_C, x_f - x_C) - (theta_R + phi + psi)). The measurement
 // does not use the renderer's code: it fits the edge's image angle to the rendered
 // intensities. For any anti-aliasing that integrates a footprint symmetric about the pixel
 // centre, the normalised intensity f of a pixel crossed by a straight edge is 0.5 plus a

@@ -1,7 +1,8 @@
 // End to end: simulate, read back with the dataset reader, and check the ground truth is
 // self-consistent: the wheel travel integrated with eq. (14)-(15) reproduces
 // ground_truth/poses.csv, the lines' bearings follow from the edges, the poses and the
-// extrinsics (docs/theory/conventions.md), runs are reproducible, and no partial dataset is left behind.
+// extrinsics (docs/theory/conventions.md), runs are reproducible, and no partial dataset is left
+// behind.
 
 #include <unistd.h>
 
@@ -16,11 +17,11 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "omnivert/calib/batch_point.hpp"
-#include "omnivert/pipeline/calibration_input.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
 #include "omnivert/dataset/dataset.hpp"
 #include "omnivert/match/tracks_io.hpp"
+#include "omnivert/pipeline/calibration_input.hpp"
 #include "omnivert/sim/simulator.hpp"
 
 namespace omnivert::sim {
@@ -157,8 +158,12 @@ TEST_F(SimulatorTest, WheelTravelIntegratesToTheGroundTruthPoses) {
     max_one = std::max(max_one, (dr1[i].head<2>() - g).norm());
     max_lateral = std::max(max_lateral, std::abs(run.run.frames[i].lateral));
   }
-  std::printf("dead reckoning of the calibration's frames: max %.2e m (eq. 14 once per frame: "
-              "%.2e m; largest sideways step %.2e m)\n", max_run, max_one, max_lateral);
+  std::printf(
+      "dead reckoning of the calibration's frames: max %.2e m (eq. 14 once per frame: "
+      "%.2e m; largest sideways step %.2e m)\n",
+      max_run,
+      max_one,
+      max_lateral);
   EXPECT_LT(max_run, 1e-5);
   EXPECT_GT(max_one, 4e-4);
   EXPECT_NEAR(max_lateral, 4.75e-4, 1e-5);

@@ -44,5 +44,4 @@ int posix_memalign(void** out, std::size_t a, std::size_t n) {
 }
 }
 
-
 long omnivert_test_allocations() { return g_allocations.load(std::memory_order_relaxed); }

@@ -64,7 +64,7 @@ struct CalibrationResult {
   // The answer: the refinement's when refined and its covariance exists, else the filter's.
   Extrinsics extrinsics;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  double bearing_sigma = 0.0;  // the bearing sigma used by the models [rad]
+  double bearing_sigma = 0.0;     // the bearing sigma used by the models [rad]
   double track_bias_sigma = 0.0;  // Options::track_bias_sigma used by the models [rad]
   // Refinement only: its covariance came from the Fisher information of the observability
   // analysis (the inverse of the same information) because ceres::Covariance failed.

@@ -1,6 +1,6 @@
 #pragma once
-// How a new track enters the state (the paper leaves it open; docs/theory/filter.md shows it decides
-// the outcome). Both methods are a stochastic augmentation y = g(x_ext, beta, prior): the
+// How a new track enters the state (the paper leaves it open; docs/theory/filter.md shows it
+// decides the outcome). Both methods are a stochastic augmentation y = g(x_ext, beta, prior): the
 // new block gets P_yy = G_x P_xx G_x^T + G_n N G_n^T and P_yx = G_x P_x., so it is correlated
 // with the extrinsics it was computed from.
 //   kNaive: D = D0 +- sigma_D0, theta = pi - beta - phi - psi (far-feature eq. 25).
@@ -18,8 +18,8 @@ class FeatureInitializer {
   explicit FeatureInitializer(const Options& options) : options_(options) {}
   // Adds track `track_id`, first seen at bearing beta (sigma: Options::bearing_sigma x
   // sigma_scale) in frame `frame`. Returns its slot.
-  int initialize(int track_id, double beta, int frame, FilterState* state,
-                 double sigma_scale = 1.0) const;
+  int initialize(
+      int track_id, double beta, int frame, FilterState* state, double sigma_scale = 1.0) const;
 
  private:
   Options options_;

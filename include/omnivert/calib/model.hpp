@@ -40,11 +40,8 @@ Eigen::Vector3d compose_wheel_steps(const std::vector<Eigen::Vector2d>& travel,
                                     Eigen::Matrix3d* covariance_per_K = nullptr);
 
 // Eq. (14) with the sideways displacement of compose_wheel_steps (FrameInput::lateral).
-Eigen::Vector3d integrate_pose_lateral(const Eigen::Vector3d& pose,
-                                       double d_right,
-                                       double d_left,
-                                       double lateral,
-                                       double wheel_base);
+Eigen::Vector3d integrate_pose_lateral(
+    const Eigen::Vector3d& pose, double d_right, double d_left, double lateral, double wheel_base);
 
 // Eq. (14): pose (x, y, theta) after one odometry step (midpoint heading).
 Eigen::Vector3d integrate_pose(const Eigen::Vector3d& pose,
@@ -81,7 +78,8 @@ double predict_bearing_inverse(double q,
                                Row5* J_beta_x = nullptr);
 
 // The same bearing from plain geometry: the robot at pose (x_R, y_R, theta_R), a feature at
-// world point f: beta = atan2(y_f - y_C, x_f - x_C) - (theta_R + phi + psi) (docs/theory/conventions.md).
+// world point f: beta = atan2(y_f - y_C, x_f - x_C) - (theta_R + phi + psi)
+// (docs/theory/conventions.md).
 double bearing_from_geometry(const Eigen::Vector3d& robot_pose,
                              const Vec2& feature,
                              const Extrinsics& ex);

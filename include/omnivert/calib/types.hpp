@@ -1,8 +1,8 @@
 #pragma once
 // Inputs and options of the camera-to-odometry self-calibration (paper Sec. 7-8).
 //
-// Conventions (docs/theory/conventions.md): robot frame x forward, y left, z up; the camera centre is at
-// rho (cos phi, sin phi) in the robot frame and the camera x-axis is rotated by phi + psi
+// Conventions (docs/theory/conventions.md): robot frame x forward, y left, z up; the camera centre
+// is at rho (cos phi, sin phi) in the robot frame and the camera x-axis is rotated by phi + psi
 // from the robot x-axis, so T_base_cam = [Rz(phi + psi) | (rho cos phi, rho sin phi, 0)].
 // A bearing beta is counter-clockwise from the camera x-axis, in radians.
 
@@ -85,7 +85,7 @@ struct Options {
   // Robot.
   double wheel_base = 0.5;  // e of eq. (15) [m]
   // Chong-Kleeman odometry model, eq. (31): var(d) = K |d| (+ variance_floor), per wheel.
-  double odometry_K = 1e-5;                // [m]
+  double odometry_K = 1e-5;  // [m]
   // Factor on K. The paper (Sec. 8.2, before eq. 31) uses 5, "to make the method robust with
   // respect to the system non-linearities"; our feature initialisation already keeps the filter
   // consistent from the rough prior at 1, and 5 costs efficiency when K is right
@@ -118,7 +118,7 @@ struct Options {
   // CalibrationFilter.AFeatureCollapsedOntoTheCameraIsLeftOut). Such a feature is left out
   // with its bearings.
   double min_feature_range = 0.05;  // [m]
-  double convert_ratio = 0.05;         // sigma_D / D below which (q, theta) -> (D, theta); 0: never
+  double convert_ratio = 0.05;      // sigma_D / D below which (q, theta) -> (D, theta); 0: never
   // Delayed initialisation (kAnchoredInverseDepth only): the frames up to the first turn are
   // solved as a batch and the filter starts from that solution (bootstrap_filter_state).
   // While the robot drives straight the camera position is unobservable (Sec. 8.1) and the
@@ -156,7 +156,7 @@ struct Options {
   // that feature. Kept apart, the pieces act as independent features and the filter is
   // overconfident (docs/theory/association.md#pieces-of-one-line). false: off.
   bool join_pieces = true;
-  int min_track_length = 3;         // batch/observability: shorter tracks are ignored
+  int min_track_length = 3;  // batch/observability: shorter tracks are ignored
   // Crossing guard [rad]: a bearing is not used while another feature's predicted bearing
   // is within this angle of its own (filter: features in the state; batches: tracks over
   // their span). The extractor merges two lines that close into one detection, whose

@@ -24,8 +24,8 @@ bool joseph_update(const Eigen::MatrixXd& H,
 double chi2_quantile(double p, int dof);
 
 struct BearingMeasurement {
-  int slot = -1;      // feature slot in the state
-  double beta = 0.0;  // measured bearing [rad]
+  int slot = -1;             // feature slot in the state
+  double beta = 0.0;         // measured bearing [rad]
   double sigma_scale = 1.0;  // its sigma is Options::bearing_sigma x this
 };
 

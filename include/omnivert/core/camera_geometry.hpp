@@ -3,8 +3,8 @@
 // cam0/sensor.yaml: image size, mirror centre, valid annulus R_min..R_max (Sec. 2) and the
 // sign that turns an image angle into a camera bearing (docs/theory/conventions.md).
 //
-// Conventions (docs/theory/conventions.md): pixel (u right, v down); image angle a = atan2(v - cy, u - cx);
-// camera bearing beta = bearing_sign * a, wrapped to (-pi, pi].
+// Conventions (docs/theory/conventions.md): pixel (u right, v down); image angle a = atan2(v - cy,
+// u - cx); camera bearing beta = bearing_sign * a, wrapped to (-pi, pi].
 
 #include <optional>
 #include <string>

@@ -2,12 +2,12 @@
 // The rotation-invariant descriptor of a radial line (Sec. 3).
 //
 // Three circular areas of radius r_a = (R_max - R_min)/6 sit on the line at radii
-// R_min + r_a, R_min + 3 r_a, R_min + 5 r_a (they touch and cover the annulus; docs/theory/descriptor.md).
-// In each area the gradient orientation of every pixel is taken relative to the line's image
-// angle theta (Sec. 3.1: rotation invariance), and the pixel votes, with its gradient
-// magnitude, into the orientation histogram of its side of the line (Sec. 3.2: left/right
-// halves), split between the two nearest of N_b bins (eq. 2, soft binning). The histograms
-// are stacked, eq. (3)-(4):
+// R_min + r_a, R_min + 3 r_a, R_min + 5 r_a (they touch and cover the annulus;
+// docs/theory/descriptor.md). In each area the gradient orientation of every pixel is taken
+// relative to the line's image angle theta (Sec. 3.1: rotation invariance), and the pixel votes,
+// with its gradient magnitude, into the orientation histogram of its side of the line (Sec. 3.2:
+// left/right halves), split between the two nearest of N_b bins (eq. 2, soft binning). The
+// histograms are stacked, eq. (3)-(4):
 //   H = [H_1L, H_1R, H_2L, H_2R, H_3L, H_3R],  N = 3 areas x 2 halves x 32 bins = 192 (eq. 5).
 // "L" is the half on the side of increasing image angle, "R" the other.
 // Illumination (Sec. 3.3): each histogram unit is scaled to unit length, every bin clipped
@@ -28,9 +28,9 @@
 
 #include <opencv2/core.hpp>
 
-#include "omnivert/describe/frame_features.hpp"
 #include "omnivert/core/mirror_circle.hpp"
 #include "omnivert/core/vertical_line.hpp"
+#include "omnivert/describe/frame_features.hpp"
 
 namespace omnivert {
 
@@ -42,7 +42,7 @@ struct DescriptorOptions {
   int areas = 3;  // 3 touching areas, or 5 overlapping by 50% (Sec. 6.0.4)
   DescriptorSmoothing smoothing = DescriptorSmoothing::kGaussianBlur;
   DescriptorNormalization normalization = DescriptorNormalization::kPerPair;
-  double clip = 0.1;             // Sec. 3.3
+  double clip = 0.1;                  // Sec. 3.3
   double sigma_fraction = 1.0 / 3.0;  // sigma_G = sigma_fraction * r_a (Sec. 3.1)
   // Gradients of log(log_offset + I) instead of I (an extension of Sec. 3.3): a gain g and gamma y
   // map log I to const + y log I, so after the blur and unit normalisation the descriptor is
@@ -88,8 +88,8 @@ class DescriptorExtractor {
   void normalize(float* row) const;
 
   DescriptorOptions options_;
-  cv::Rect roi_;   // region of the frame the gradient images cover
-  int step_ = 1;   // one gradient sample every step_ pixels (blur reading)
+  cv::Rect roi_;  // region of the frame the gradient images cover
+  int step_ = 1;  // one gradient sample every step_ pixels (blur reading)
   cv::Mat full_, blurred_, gx_, gy_;
   cv::Mat log_lut_;  // grey level -> log(offset + I) (or I)
   double log_lut_offset_ = -1;

@@ -19,9 +19,9 @@ cv::Mat rotate_about(const cv::Mat& image, const Eigen::Vector2d& center, double
 cv::Mat relight(const cv::Mat& image, double gain, double gamma);
 
 struct LinePairing {
-  int original = -1;        // index into the original frame's lines
-  int transformed = -1;     // index into the transformed frame's lines
-  double angle_error = 0;   // wrapped (transformed - original - expected shift), rad
+  int original = -1;               // index into the original frame's lines
+  int transformed = -1;            // index into the transformed frame's lines
+  double angle_error = 0;          // wrapped (transformed - original - expected shift), rad
   double descriptor_distance = 0;  // Euclidean, eq. (6)
   // Is the transformed line's nearest descriptor among all original lines its own?
   bool nearest_is_correct = false;

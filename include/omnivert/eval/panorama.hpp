@@ -2,8 +2,8 @@
 // The cylindrical panorama of a catadioptric image (the paper's Fig. 10) and the rectangular
 // patterns that SSD and ZNCC compare in Sec. 5.
 //
-// Geometry (docs/theory/conventions.md): column c holds camera bearing beta = 2 pi c / width (c = 0 is
-// bearing 0, bearings grow with c); the image angle is a = bearing_sign * beta. Row i holds
+// Geometry (docs/theory/conventions.md): column c holds camera bearing beta = 2 pi c / width (c = 0
+// is bearing 0, bearings grow with c); the image angle is a = bearing_sign * beta. Row i holds
 // radius r = r_max - i (r_max - r_min) / (rows - 1): the rim (highest elevation for the usual
 // mirror) on top, the camera's reflection at the bottom. Each panorama pixel is the bilinear
 // interpolation of the image at (c_x + r cos a, c_y + r sin a); outside the image it is 0.

@@ -101,7 +101,7 @@ struct TrackingEvaluation {
   double long_line_recall() const {
     return long_lines > 0 ? static_cast<double>(long_lines_detected) / long_lines : 0.0;
   }
-  double bearing_rms = 0.0;  // radians, over associated detections
+  double bearing_rms = 0.0;                  // radians, over associated detections
   std::int64_t off_majority_detections = 0;  // rule 8
 };
 

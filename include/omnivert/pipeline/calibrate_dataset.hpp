@@ -36,12 +36,12 @@ struct CalibrateDatasetOptions {
   // Prior and models. The wheel base and Chong-Kleeman K come from wheel0/sensor.yaml
   // (calib::options_from_dataset); everything else from here.
   calib::Options calibration = calib::recommended_options();
-  calib::CalibrateOptions run;          // refinement, noise check, batch options
-  calib::DatasetRunOptions input;       // wheel gaps, crowded lines
-  std::string tracks_file;              // non-empty: calibrate from this earlier tracks.csv
-  bool force = false;                   // write extrinsics.yaml even when undetermined
-  std::string command;                  // the command line, recorded in the report
-  std::vector<std::string> notes;       // extra warnings of the caller, reported with the rest
+  calib::CalibrateOptions run;     // refinement, noise check, batch options
+  calib::DatasetRunOptions input;  // wheel gaps, crowded lines
+  std::string tracks_file;         // non-empty: calibrate from this earlier tracks.csv
+  bool force = false;              // write extrinsics.yaml even when undetermined
+  std::string command;             // the command line, recorded in the report
+  std::vector<std::string> notes;  // extra warnings of the caller, reported with the rest
   // Called while tracking (stage "track", frames done, frames in all) and once before the
   // calibration (stage "calibrate", 0, 0).
   std::function<void(const std::string& stage, std::size_t done, std::size_t total)> progress;
@@ -49,13 +49,13 @@ struct CalibrateDatasetOptions {
 
 struct CalibrateDatasetResult {
   calib::CalibrationResult calibration;
-  calib::DatasetRun input;                  // what the estimator was given
+  calib::DatasetRun input;  // what the estimator was given
   std::int64_t frames = 0, frames_skipped = 0, detections = 0;
-  std::optional<calib::Extrinsics> truth;   // ground_truth/extrinsics.yaml, when present
-  std::vector<std::string> warnings;        // tracking's, the input's and the estimate's
-  bool wrote_extrinsics = false;            // determined, or forced
+  std::optional<calib::Extrinsics> truth;  // ground_truth/extrinsics.yaml, when present
+  std::vector<std::string> warnings;       // tracking's, the input's and the estimate's
+  bool wrote_extrinsics = false;           // determined, or forced
   std::string out_dir;
-  bool noise_check_requested = true;        // CalibrateOptions::noise_check of the run
+  bool noise_check_requested = true;  // CalibrateOptions::noise_check of the run
 
   // The answer: the refinement's estimate when it ran and its covariance is usable, else the
   // filter's (the same as calibration.extrinsics / calibration.covariance).
@@ -69,7 +69,8 @@ struct CalibrateDatasetResult {
 // Runs the main job on the dataset folder `dataset_dir`, writing into `out_dir` (created when
 // missing). Throws InputError for bad input and std::runtime_error when the estimate is not
 // finite (only tracks.csv and tracks.png are then written).
-CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir, const std::string& out_dir,
+CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
+                                         const std::string& out_dir,
                                          const CalibrateDatasetOptions& options = {});
 
 }  // namespace omnivert::pipeline

@@ -25,10 +25,10 @@
 namespace omnivert::calib {
 
 struct DatasetRunOptions {
-  double max_wheel_gap_s = 0.5;    // a wheel sample interval longer than this is a gap [s]
-  int min_lines = 2;               // fewer tracked lines than this in a frame: starved
-  double max_starved_s = 10.0;     // a starved stretch longer than this is warned about [s]
-  int min_track_length = 2;        // shorter tracks carry no parallax: left out
+  double max_wheel_gap_s = 0.5;  // a wheel sample interval longer than this is a gap [s]
+  int min_lines = 2;             // fewer tracked lines than this in a frame: starved
+  double max_starved_s = 10.0;   // a starved stretch longer than this is warned about [s]
+  int min_track_length = 2;      // shorter tracks carry no parallax: left out
   // A crowded line's bearing (TrackRow::crowded: another edge within a few pixels all along
   // it) has its sigma multiplied by this (BearingObservation::sigma_scale).
   double crowded_sigma_scale = 1.0;
@@ -37,15 +37,15 @@ struct DatasetRunOptions {
 struct DatasetRun {
   CalibrationRun run;
   std::vector<std::string> warnings;
-  int frames_dropped_for_gaps = 0;  // frames whose bearings were dropped (wheel gap)
-  int double_claims = 0;            // (frame, track) pairs dropped
-  int crowded_bearings = 0;         // bearings of crowded lines used
-  double crowded_sigma_scale = 1.0; // their sigma scale (DatasetRunOptions)
-  int starved_frames = 0;           // frames with fewer than min_lines lines
-  int tracks = 0;                   // tracks used
-  int observations = 0;             // bearings used
-  double path_length = 0.0;         // distance driven by the axle midpoint [m]
-  double rotation = 0.0;            // total |heading change| [rad]
+  int frames_dropped_for_gaps = 0;   // frames whose bearings were dropped (wheel gap)
+  int double_claims = 0;             // (frame, track) pairs dropped
+  int crowded_bearings = 0;          // bearings of crowded lines used
+  double crowded_sigma_scale = 1.0;  // their sigma scale (DatasetRunOptions)
+  int starved_frames = 0;            // frames with fewer than min_lines lines
+  int tracks = 0;                    // tracks used
+  int observations = 0;              // bearings used
+  double path_length = 0.0;          // distance driven by the axle midpoint [m]
+  double rotation = 0.0;             // total |heading change| [rad]
 };
 
 // `rows` are tracks.csv rows of this dataset (frame = index into data.images()). The dataset

@@ -12,7 +12,6 @@
 #include <string>
 #include <vector>
 
-
 #include "omnivert/calib/calibrate.hpp"
 #include "omnivert/pipeline/calibration_input.hpp"
 
