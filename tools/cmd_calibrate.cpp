@@ -137,6 +137,80 @@ void run_calibrate(const CalibrateArgs& a) {
   }
 }
 
+// The prior: a file and the flags that override it.
+void add_prior_options(CLI::App* cmd, CalibrateArgs& a) {
+  const std::string g = "Prior (the initial guess; default: the paper's hand measurement)";
+  cmd->add_option("--prior",
+                  a.prior_file,
+                  "YAML file with phi, rho, psi, sigma_phi, sigma_rho, sigma_psi [rad, m] (an "
+                  "extrinsics.yaml works), optional bearing_sigma [rad], odometry_inflation; "
+                  "flags override it")
+      ->check(CLI::ExistingFile)
+      ->group(g);
+  cmd->add_option("--phi", a.phi, "Prior phi [rad] (default 0)")->group(g);
+  cmd->add_option("--rho", a.rho, "Prior rho [m] (default 0.2)")->check(kNonNegative)->group(g);
+  cmd->add_option("--psi", a.psi, "Prior psi [rad] (default 0)")->group(g);
+  cmd->add_option("--sigma-phi", a.sigma_phi, "Prior sigma of phi [rad] (default 0.8)")
+      ->check(kPositive)
+      ->group(g);
+  cmd->add_option("--sigma-rho", a.sigma_rho, "Prior sigma of rho [m] (default 0.1)")
+      ->check(kPositive)
+      ->group(g);
+  cmd->add_option("--sigma-psi", a.sigma_psi, "Prior sigma of psi [rad] (default 0.8)")
+      ->check(kPositive)
+      ->group(g);
+}
+
+// The noise models and the calibration input's limits.
+void add_model_options(CLI::App* cmd, CalibrateArgs& a) {
+  const std::string gm = "Models";
+  cmd->add_option("--bearing-sigma",
+                  a.bearing_sigma_deg,
+                  "Bearing noise sigma [degrees] of the observation model, eq. (30). The default "
+                  "(0.025) is what makes the estimate consistent (NEES) on rendered images with "
+                  "our extractor (docs/validation.md); the paper used 0.3")
+      ->check(kPositive)
+      ->group(gm);
+  cmd->add_option("--odometry-inflation",
+                  a.odometry_inflation,
+                  "Factor on the Chong-Kleeman K of wheel0/sensor.yaml, eq. (31), in the filter "
+                  "(default 1: K as given; the paper used 5, which costs efficiency when K is "
+                  "right and helps when the wheels are off: docs/theory/filter.md#odometry-noise)")
+      ->check(kPositive)
+      ->group(gm);
+  cmd->add_option("--track-bias-sigma",
+                  a.track_bias_sigma_deg,
+                  "A constant bearing error per track [degrees], in the filter, the refinement "
+                  "and the bounds (default 0: none; --bearing-sigma is then the error that "
+                  "changes from frame to frame; measured from pixels it does not make our "
+                  "extractor's sigmas consistent in every row: "
+                  "docs/theory/filter.md#per-track-bias)")
+      ->check(kNonNegative)
+      ->group(gm);
+  cmd->add_option("--lateral-sigma",
+                  a.lateral_sigma,
+                  "Sideways slip per image step [m] allowed by the batch problems (the filter's "
+                  "window and the refinement); eq. (14) has none. Raise it for a robot that "
+                  "slips sideways (docs/theory/refinement.md#odometry-factor)")
+      ->check(kPositive)
+      ->capture_default_str()
+      ->group(gm);
+  cmd->add_option("--crowded-sigma",
+                  a.crowded_sigma,
+                  "The bearing sigma of a crowded line (tracks.csv's crowded column: another edge "
+                  "within a few pixels all along it) is --bearing-sigma times this")
+      ->check(kPositive)
+      ->capture_default_str()
+      ->group(gm);
+  cmd->add_option("--max-wheel-gap",
+                  a.max_wheel_gap,
+                  "Wheel samples further apart than this [s] are a gap: the bearings of the "
+                  "images inside it are not used")
+      ->check(kPositive)
+      ->capture_default_str()
+      ->group(gm);
+}
+
 }  // namespace
 
 void add_calibrate_command(CLI::App& app) {
@@ -192,72 +266,8 @@ void add_calibrate_command(CLI::App& app) {
                 a->force,
                 "Write extrinsics.yaml (and exit 0) even when the run does not determine every "
                 "parameter");
-  const std::string g = "Prior (the initial guess; default: the paper's hand measurement)";
-  cmd->add_option("--prior",
-                  a->prior_file,
-                  "YAML file with phi, rho, psi, sigma_phi, sigma_rho, sigma_psi [rad, m] (an "
-                  "extrinsics.yaml works), optional bearing_sigma [rad], odometry_inflation; "
-                  "flags override it")
-      ->check(CLI::ExistingFile)
-      ->group(g);
-  cmd->add_option("--phi", a->phi, "Prior phi [rad] (default 0)")->group(g);
-  cmd->add_option("--rho", a->rho, "Prior rho [m] (default 0.2)")->check(kNonNegative)->group(g);
-  cmd->add_option("--psi", a->psi, "Prior psi [rad] (default 0)")->group(g);
-  cmd->add_option("--sigma-phi", a->sigma_phi, "Prior sigma of phi [rad] (default 0.8)")
-      ->check(kPositive)
-      ->group(g);
-  cmd->add_option("--sigma-rho", a->sigma_rho, "Prior sigma of rho [m] (default 0.1)")
-      ->check(kPositive)
-      ->group(g);
-  cmd->add_option("--sigma-psi", a->sigma_psi, "Prior sigma of psi [rad] (default 0.8)")
-      ->check(kPositive)
-      ->group(g);
-  const std::string gm = "Models";
-  cmd->add_option("--bearing-sigma",
-                  a->bearing_sigma_deg,
-                  "Bearing noise sigma [degrees] of the observation model, eq. (30). The default "
-                  "(0.025) is what makes the estimate consistent (NEES) on rendered images with "
-                  "our extractor (docs/validation.md); the paper used 0.3")
-      ->check(kPositive)
-      ->group(gm);
-  cmd->add_option("--odometry-inflation",
-                  a->odometry_inflation,
-                  "Factor on the Chong-Kleeman K of wheel0/sensor.yaml, eq. (31), in the filter "
-                  "(default 1: K as given; the paper used 5, which costs efficiency when K is "
-                  "right and helps when the wheels are off: docs/theory/filter.md#odometry-noise)")
-      ->check(kPositive)
-      ->group(gm);
-  cmd->add_option("--track-bias-sigma",
-                  a->track_bias_sigma_deg,
-                  "A constant bearing error per track [degrees], in the filter, the refinement "
-                  "and the bounds (default 0: none; --bearing-sigma is then the error that "
-                  "changes from frame to frame; measured from pixels it does not make our "
-                  "extractor's sigmas consistent in every row: "
-                  "docs/theory/filter.md#per-track-bias)")
-      ->check(kNonNegative)
-      ->group(gm);
-  cmd->add_option("--lateral-sigma",
-                  a->lateral_sigma,
-                  "Sideways slip per image step [m] allowed by the batch problems (the filter's "
-                  "window and the refinement); eq. (14) has none. Raise it for a robot that "
-                  "slips sideways (docs/theory/refinement.md#odometry-factor)")
-      ->check(kPositive)
-      ->capture_default_str()
-      ->group(gm);
-  cmd->add_option("--crowded-sigma",
-                  a->crowded_sigma,
-                  "The bearing sigma of a crowded line (tracks.csv's crowded column: another edge "
-                  "within a few pixels all along it) is --bearing-sigma times this")
-      ->check(kPositive)
-      ->capture_default_str()
-      ->group(gm);
-  cmd->add_option("--max-wheel-gap",
-                  a->max_wheel_gap,
-                  "Wheel samples further apart than this [s] are a gap: the bearings of the "
-                  "images inside it are not used")
-      ->check(kPositive)
-      ->capture_default_str()
-      ->group(gm);
+  add_prior_options(cmd, *a);
+  add_model_options(cmd, *a);
   add_pipeline_options(cmd, a->pipeline);
   add_tracker_options(cmd, a->tracker);
   cmd->callback([a, cmd] {

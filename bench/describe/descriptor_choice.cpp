@@ -52,9 +52,8 @@ double pct(std::vector<double> v, double q) {
   return v[std::min(v.size() - 1, static_cast<std::size_t>(q * v.size()))];
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+// The drawn patterns (seeds 501-508) and, when a folder is given, the real images in it.
+std::vector<Input> load_inputs(int argc, char** argv) {
   std::vector<Input> inputs;
   for (int seed = 1; seed <= 8; ++seed) {
     sim::RadialPatternOptions o;
@@ -72,62 +71,134 @@ int main(int argc, char** argv) {
         {f, cv::imread(path.string(), cv::IMREAD_GRAYSCALE), CameraGeometry{}, true, {}});
   }
 
-  struct Config {
-    const char* name;
-    DescriptorSmoothing s;
-    DescriptorNormalization n;
-    bool log;
-    double offset = 1.0;
-  };
-  const Config configs[] = {
-      {"log1/blur/pair",
-       DescriptorSmoothing::kGaussianBlur,
-       DescriptorNormalization::kPerPair,
-       true,
-       1.0},
-      {"log2/blur/pair",
-       DescriptorSmoothing::kGaussianBlur,
-       DescriptorNormalization::kPerPair,
-       true,
-       2.0},
-      {"log4/blur/pair",
-       DescriptorSmoothing::kGaussianBlur,
-       DescriptorNormalization::kPerPair,
-       true,
-       4.0},
-      {"log8/blur/pair",
-       DescriptorSmoothing::kGaussianBlur,
-       DescriptorNormalization::kPerPair,
-       true,
-       8.0},
-      {"log16/blur/pair",
-       DescriptorSmoothing::kGaussianBlur,
-       DescriptorNormalization::kPerPair,
-       true,
-       16.0},
-      {"log32/blur/pair",
-       DescriptorSmoothing::kGaussianBlur,
-       DescriptorNormalization::kPerPair,
-       true,
-       32.0},
-      {"log/blur/half",
-       DescriptorSmoothing::kGaussianBlur,
-       DescriptorNormalization::kPerHalf,
-       true},
-      {"blur/pair", DescriptorSmoothing::kGaussianBlur, DescriptorNormalization::kPerPair, false},
-      {"blur/half", DescriptorSmoothing::kGaussianBlur, DescriptorNormalization::kPerHalf, false},
-      {"weight/pair",
-       DescriptorSmoothing::kGaussianWeight,
-       DescriptorNormalization::kPerPair,
-       false},
-      {"weight/half",
-       DescriptorSmoothing::kGaussianWeight,
-       DescriptorNormalization::kPerHalf,
-       false}};
-  const double rotations[] = {17, 43, 71, 137, 251};
-  const double gains[] = {0.6, 0.8, 1.25, 1.5};  // 1.25 and 1.5 saturate bright regions
-  const double gammas[] = {0.7, 0.85, 1.2, 1.4};
+  return inputs;
+}
 
+struct Config {
+  const char* name;
+  DescriptorSmoothing s;
+  DescriptorNormalization n;
+  bool log;
+  double offset = 1.0;
+};
+constexpr Config kConfigs[] = {
+    {"log1/blur/pair",
+     DescriptorSmoothing::kGaussianBlur,
+     DescriptorNormalization::kPerPair,
+     true,
+     1.0},
+    {"log2/blur/pair",
+     DescriptorSmoothing::kGaussianBlur,
+     DescriptorNormalization::kPerPair,
+     true,
+     2.0},
+    {"log4/blur/pair",
+     DescriptorSmoothing::kGaussianBlur,
+     DescriptorNormalization::kPerPair,
+     true,
+     4.0},
+    {"log8/blur/pair",
+     DescriptorSmoothing::kGaussianBlur,
+     DescriptorNormalization::kPerPair,
+     true,
+     8.0},
+    {"log16/blur/pair",
+     DescriptorSmoothing::kGaussianBlur,
+     DescriptorNormalization::kPerPair,
+     true,
+     16.0},
+    {"log32/blur/pair",
+     DescriptorSmoothing::kGaussianBlur,
+     DescriptorNormalization::kPerPair,
+     true,
+     32.0},
+    {"log/blur/half", DescriptorSmoothing::kGaussianBlur, DescriptorNormalization::kPerHalf, true},
+    {"blur/pair", DescriptorSmoothing::kGaussianBlur, DescriptorNormalization::kPerPair, false},
+    {"blur/half", DescriptorSmoothing::kGaussianBlur, DescriptorNormalization::kPerHalf, false},
+    {"weight/pair", DescriptorSmoothing::kGaussianWeight, DescriptorNormalization::kPerPair, false},
+    {"weight/half",
+     DescriptorSmoothing::kGaussianWeight,
+     DescriptorNormalization::kPerHalf,
+     false}};
+constexpr double kRotations[] = {17, 43, 71, 137, 251};
+constexpr double kGains[] = {0.6, 0.8, 1.25, 1.5};  // 1.25 and 1.5 saturate bright regions
+constexpr double kGammas[] = {0.7, 0.85, 1.2, 1.4};
+
+// One input under one configuration: its lines found again after each rotation, gain, gamma
+// and noise draw, accumulated in acc (rotation, gain, gamma, noise).
+void measure(const Input& in, const Config& c, Acc acc[4]) {
+  FeaturePipelineOptions po;
+  po.descriptor.smoothing = c.s;
+  po.descriptor.normalization = c.n;
+  po.descriptor.log_intensity = c.log;
+  po.descriptor.log_offset = c.offset;
+  if (in.real) po.lines.threshold = LineThreshold::kTopK, po.lines.top_k = 25;
+  FeaturePipeline probe(in.geometry, po);
+  FrameFeatures f0;
+  if (!probe.process(in.gray, f0)) return;
+  const cv::Mat& gray = in.gray;
+  // The annulus as a user's sensor.yaml would give it, for every transformed copy.
+  CameraGeometry geo = in.geometry;
+  if (in.real) geo.center = f0.circle.center;
+  geo.r_min = f0.circle.r_min;
+  // Real images: the annulus ends where a rotation brings no new content into a descriptor.
+  geo.r_max =
+      in.real
+          ? std::min(f0.circle.r_max,
+                     rotation_safe_r_max(f0.circle.center, gray.cols, gray.rows, f0.circle.r_min))
+          : f0.circle.r_max;
+  FeaturePipeline base(geo, po);
+  if (!base.process(gray, f0)) return;
+  auto run = [&](const cv::Mat& img, double shift, Acc& a) {
+    FeaturePipeline p(geo, po);
+    FrameFeatures f;
+    if (!p.process(img, f)) return;
+    for (const auto& pr : pair_lines(f0, f, shift, deg2rad(0.3))) a.add(pr);
+  };
+  for (double r : kRotations) {
+    if (in.real) {
+      run(rotate_about(gray, f0.circle.center, deg2rad(r)), deg2rad(r), acc[0]);
+    } else {
+      auto o = in.pattern;
+      o.rotation_rad = deg2rad(r);
+      o.noise_seed = 1000 + static_cast<int>(r);
+      run(sim::draw_radial_pattern(o).image, deg2rad(r), acc[0]);
+    }
+  }
+  if (!in.real) {
+    for (int k = 0; k < 3; ++k) {
+      auto o = in.pattern;
+      o.noise_seed = 2000 + k;
+      run(sim::draw_radial_pattern(o).image, 0.0, acc[3]);
+    }
+  }
+  for (double g : kGains) run(relight(gray, g, 1.0), 0.0, acc[1]);
+  for (double g : kGammas) run(relight(gray, 1.0, g), 0.0, acc[2]);
+}
+
+void print_rows(const Config& c, int real, const Acc acc[4]) {
+  const char* fam[] = {"rotation", "gain", "gamma", "noise"};
+  for (int k = 0; k < 4; ++k) {
+    const Acc& a = acc[k];
+    if (!a.pairs) continue;
+    std::printf("%-12s %-6s %-9s %6d %7.1f %9.3f %9.3f %9.3f %9.3f %9.3f\n",
+                c.name,
+                real ? "real" : "drawn",
+                fam[k],
+                a.pairs,
+                100.0 * a.nn_correct / a.pairs,
+                median(a.dist),
+                pct(a.dist, 0.9),
+                pct(a.dist, 1.0),
+                median(a.ratio),
+                pct(a.ratio, 0.9));
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::vector<Input> inputs = load_inputs(argc, argv);
   std::printf("%-12s %-6s %-9s %6s %7s %9s %9s %9s %9s %9s\n",
               "config",
               "data",
@@ -139,74 +210,12 @@ int main(int argc, char** argv) {
               "max.dist",
               "med.ratio",
               "p90.ratio");
-  for (const Config& c : configs) {
+  for (const Config& c : kConfigs) {
     for (int real = 0; real <= 1; ++real) {
       Acc acc[4];  // rotation, gain, gamma, noise
-      for (const Input& in : inputs) {
-        if (in.real != static_cast<bool>(real)) continue;
-        FeaturePipelineOptions po;
-        po.descriptor.smoothing = c.s;
-        po.descriptor.normalization = c.n;
-        po.descriptor.log_intensity = c.log;
-        po.descriptor.log_offset = c.offset;
-        if (in.real) po.lines.threshold = LineThreshold::kTopK, po.lines.top_k = 25;
-        FeaturePipeline probe(in.geometry, po);
-        FrameFeatures f0;
-        if (!probe.process(in.gray, f0)) continue;
-        const cv::Mat& gray = in.gray;
-        // The annulus as a user's sensor.yaml would give it, for every transformed copy.
-        CameraGeometry geo = in.geometry;
-        if (in.real) geo.center = f0.circle.center;
-        geo.r_min = f0.circle.r_min;
-        // Real images: the annulus ends where a rotation brings no new content into a descriptor.
-        geo.r_max = in.real ? std::min(f0.circle.r_max,
-                                       rotation_safe_r_max(
-                                           f0.circle.center, gray.cols, gray.rows, f0.circle.r_min))
-                            : f0.circle.r_max;
-        FeaturePipeline base(geo, po);
-        if (!base.process(gray, f0)) continue;
-        auto run = [&](const cv::Mat& img, double shift, Acc& a) {
-          FeaturePipeline p(geo, po);
-          FrameFeatures f;
-          if (!p.process(img, f)) return;
-          for (const auto& pr : pair_lines(f0, f, shift, deg2rad(0.3))) a.add(pr);
-        };
-        for (double r : rotations) {
-          if (in.real) {
-            run(rotate_about(gray, f0.circle.center, deg2rad(r)), deg2rad(r), acc[0]);
-          } else {
-            auto o = in.pattern;
-            o.rotation_rad = deg2rad(r);
-            o.noise_seed = 1000 + static_cast<int>(r);
-            run(sim::draw_radial_pattern(o).image, deg2rad(r), acc[0]);
-          }
-        }
-        if (!in.real) {
-          for (int k = 0; k < 3; ++k) {
-            auto o = in.pattern;
-            o.noise_seed = 2000 + k;
-            run(sim::draw_radial_pattern(o).image, 0.0, acc[3]);
-          }
-        }
-        for (double g : gains) run(relight(gray, g, 1.0), 0.0, acc[1]);
-        for (double g : gammas) run(relight(gray, 1.0, g), 0.0, acc[2]);
-      }
-      const char* fam[] = {"rotation", "gain", "gamma", "noise"};
-      for (int k = 0; k < 4; ++k) {
-        const Acc& a = acc[k];
-        if (!a.pairs) continue;
-        std::printf("%-12s %-6s %-9s %6d %7.1f %9.3f %9.3f %9.3f %9.3f %9.3f\n",
-                    c.name,
-                    real ? "real" : "drawn",
-                    fam[k],
-                    a.pairs,
-                    100.0 * a.nn_correct / a.pairs,
-                    median(a.dist),
-                    pct(a.dist, 0.9),
-                    pct(a.dist, 1.0),
-                    median(a.ratio),
-                    pct(a.ratio, 0.9));
-      }
+      for (const Input& in : inputs)
+        if (in.real == static_cast<bool>(real)) measure(in, c, acc);
+      print_rows(c, real, acc);
     }
   }
   return 0;

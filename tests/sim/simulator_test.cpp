@@ -47,6 +47,34 @@ std::string slurp(const fs::path& p) {
   return ss.str();
 }
 
+// Every ground-truth line's bearing follows from edges.csv, the pose and the extrinsics.
+void expect_lines_follow_edges(const fs::path& out, const auto& gt, const SimConfig& cfg) {
+  std::map<int, Eigen::Vector2d> edges;
+  {
+    std::ifstream in(fs::path(out) / "ground_truth" / "edges.csv");
+    std::string line;
+    std::getline(in, line);
+    while (std::getline(in, line)) {
+      int id;
+      double ex, ey, z0, z1;
+      ASSERT_EQ(std::sscanf(line.c_str(), "%d,%lf,%lf,%lf,%lf", &id, &ex, &ey, &z0, &z1), 5);
+      edges[id] = {ex, ey};
+    }
+  }
+  ASSERT_FALSE(gt.lines.empty());
+  const auto& X = *gt.extrinsics;
+  for (const auto& l : gt.lines) {
+    const auto& p = gt.poses[static_cast<std::size_t>(l.frame)];
+    const double xc = p.x + X.rho * std::cos(p.theta + X.phi),
+                 yc = p.y + X.rho * std::sin(p.theta + X.phi);
+    const Eigen::Vector2d f = edges.at(l.line_id);
+    const double beta = std::atan2(f.y() - yc, f.x() - xc) - (p.theta + X.phi + X.psi);
+    ASSERT_NEAR(angle_diff(l.bearing, beta), 0.0, 1e-6);
+    ASSERT_GE(l.r_inner, cfg.camera.r_min - 1e-3);
+    ASSERT_LE(l.r_outer, cfg.camera.r_max + 1e-3);
+  }
+}
+
 TEST_F(SimulatorTest, WheelTravelIntegratesToTheGroundTruthPoses) {
   SimConfig cfg;
   cfg.wheel.odometry_k = 0.0;  // ground-truth wheel travel
@@ -103,31 +131,7 @@ TEST_F(SimulatorTest, WheelTravelIntegratesToTheGroundTruthPoses) {
   EXPECT_LT(max_th, 1e-5);
   EXPECT_NEAR(std::abs(gt.poses.back().theta), kPi, 1e-6);  // the paper's 180 degree turn
 
-  // Every ground-truth line's bearing follows from edges.csv, the pose and the extrinsics.
-  std::map<int, Eigen::Vector2d> edges;
-  {
-    std::ifstream in(fs::path(out) / "ground_truth" / "edges.csv");
-    std::string line;
-    std::getline(in, line);
-    while (std::getline(in, line)) {
-      int id;
-      double ex, ey, z0, z1;
-      ASSERT_EQ(std::sscanf(line.c_str(), "%d,%lf,%lf,%lf,%lf", &id, &ex, &ey, &z0, &z1), 5);
-      edges[id] = {ex, ey};
-    }
-  }
-  ASSERT_FALSE(gt.lines.empty());
-  const auto& X = *gt.extrinsics;
-  for (const auto& l : gt.lines) {
-    const auto& p = gt.poses[static_cast<std::size_t>(l.frame)];
-    const double xc = p.x + X.rho * std::cos(p.theta + X.phi),
-                 yc = p.y + X.rho * std::sin(p.theta + X.phi);
-    const Eigen::Vector2d f = edges.at(l.line_id);
-    const double beta = std::atan2(f.y() - yc, f.x() - xc) - (p.theta + X.phi + X.psi);
-    ASSERT_NEAR(angle_diff(l.bearing, beta), 0.0, 1e-6);
-    ASSERT_GE(l.r_inner, cfg.camera.r_min - 1e-3);
-    ASSERT_LE(l.r_outer, cfg.camera.r_max + 1e-3);
-  }
+  expect_lines_follow_edges(fs::path(out), gt, cfg);
 
   // What the calibration sees (calib::calibration_run_from_tracks, the ground truth's lines as
   // tracks): one step per frame, composed from the wheel samples between the images, with its
