@@ -49,7 +49,8 @@ bool one_line(Built* b, int a, int c, double chi2, FeatureCovariance* cache);
 // max_missed_frames, the margin used.) There the extractor
 // sees one line where there are two: the detection is pulled towards the other line, or
 // belongs to it (a track pulled by up to 0.19 degree by lines passing within 1 degree is then
-// split by the slip test although it never left its line; docs/calib.md, "Lines that cross";
+// split by the slip test although it never left its line;
+// docs/theory/association.md#lines-that-cross;
 // CrossingGuard.MergedDetectionsAreLeftOutAndDoNotMoveTheEstimate). The bearings are not
 // independent Gaussian errors about the line there, which is what eq. (30) assumes. Then the
 // features left with fewer than `min_bearings` bearings go (drop_unobserved_features). Returns how
@@ -81,9 +82,9 @@ double one_point_statistic(Built* b, const std::vector<std::size_t>& blocks, int
 // there is one point. Each piece is estimated from its own few bearings, from little
 // parallax; with tracks broken every ~10 frames (synthetic paper runs, calib_monte_carlo
 // --break 0.1) the refinement's NEES is 4.1 over 100 runs unjoined where the unbroken tracks
-// give 2.9 (docs/calib.md, "Broken tracks"). Candidates: two tracks that never share a frame, at
-// most `max_gap` frames apart (or interleaved: a chain of joins can skip a piece, which a later
-// round then joins). They are one line when one point explains both, by two tests that must
+// give 2.9 (docs/theory/association.md#pieces-of-one-line). Candidates: two tracks that never share
+// a frame, at most `max_gap` frames apart (or interleaved: a chain of joins can skip a piece, which
+// a later round then joins). They are one line when one point explains both, by two tests that must
 // agree: one_point_statistic (poses held; keeps its power for a piece without depth) and the
 // Wald statistic of one_line (the whole problem's covariance; poses free, so long pieces of
 // one line are not held apart by pose errors: 7% of them failed the first test alone at

@@ -76,8 +76,7 @@ std::vector<std::pair<int, int>> unused_bearings(const CalibrationRun& run,
 // bearings and any prior on them): their information is singular. A track whose bearings are
 // all outliers in the filter's window would leave the window's information singular, and the
 // filter would fall back on the undelayed initialisation
-// (CalibrationFilter.BootstrapWindowDropsATrackWithOnlyOutliers; docs/calib.md, "The noise
-// check").
+// (CalibrationFilter.BootstrapWindowDropsATrackWithOnlyOutliers; docs/theory/window.md).
 // Returns how many features.
 int drop_unobserved_features(Built* b, int min_bearings);
 

@@ -205,8 +205,8 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
   r.filter_model_covariance = r.filter.covariance;
   r.refinement_model_covariance = r.refinement.covariance;
   if (co.noise_check && r.observability.all_determined()) {
-    // How large the errors really are, measured by the data (docs/calib.md, "The noise
-    // check"): at a batch solution, the errors of each track summed before squaring. The
+    // How large the errors really are, measured by the data (docs/theory/noise-check.md): at a
+    // batch solution, the errors of each track summed before squaring. The
     // filter is checked on its own tracks, the refinement on the problem it solved (tracks
     // split). A covariance is replaced by the checked one only when the check shows more
     // noise than the model allows (noise_check_verdict): with 10-15 tracks one run's scale

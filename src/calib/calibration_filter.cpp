@@ -229,7 +229,7 @@ void CalibrationFilter::step(const FrameInput& frame) {
 
 // The crossing guard (Options::crossing_guard): a feature whose direction is within the
 // guard of another line's is not updated in this frame: the extractor sees the two lines as
-// one there, and the bearings are pulled or pushed (docs/calib.md, "Lines that cross").
+// one there, and the bearings are pulled or pushed (docs/theory/association.md#lines-that-cross).
 // The other line is a feature of the state (its track seen within the last
 // max_missed_frames frames) or a track that starts in this frame. A feature's direction is
 // its bearing in this frame where it has one, else its predicted bearing (eq. 27). A track

@@ -194,7 +194,7 @@ void warn_disagreement(const CalibrationResult& r, std::vector<std::string>* out
                     "under the filter's covariance, 99.9%% limit %.1f; camera yaw %.3f vs %.3f "
                     "deg): the filter is biased or overconfident on this run and the "
                     "refinement's estimate is the one reported (tracks that slip onto a "
-                    "neighbouring line do this; docs/calib.md)",
+                    "neighbouring line do this; docs/theory/association.md)",
                     m2,
                     kChi2_3_999,
                     rad2deg(f.yaw()),

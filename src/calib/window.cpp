@@ -185,7 +185,7 @@ struct WindowProblem {
 };
 
 // Levenberg-Marquardt from the prior alone can end in a local minimum, 15 degrees off in phi,
-// from which the filter never recovers (docs/calib.md, "Window starts"). The window is solved
+// from which the filter never recovers (docs/theory/window.md#starts). The window is solved
 // from the prior and from starts with phi moved by +-0.5 and +-1 rad (psi moved the other
 // way, keeping the camera yaw, which the bearings fix first).
 // A camera mounted far from the prior's yaw (80-110 degrees) leaves every start of the
@@ -285,10 +285,10 @@ std::string association_failure(AssociationEnd end) {
 // Where the window is most of the run (the paper trajectory turns 1.5 rad only at frame 87 of
 // 114; a zigzag never turns 1.5 rad away from its start heading), the filter's estimate is the
 // window's: the window joins the pieces of one line and splits the tracks that slipped onto a
-// neighbouring line as the refinement does (associate; docs/calib.md, "Broken tracks",
-// "Tracks that slipped onto a neighbouring line"). A joined piece takes the id of its line's
-// first piece, the later part of a split track a new id; the filter continues each under the
-// tracker's ids (BootstrapDetails).
+// neighbouring line as the refinement does (associate;
+// docs/theory/association.md#pieces-of-one-line, "Tracks that slipped onto a neighbouring line"). A
+// joined piece takes the id of its line's first piece, the later part of a split track a new id;
+// the filter continues each under the tracker's ids (BootstrapDetails).
 bool bootstrap_filter_state(const CalibrationRun& window_in,
                             const Options& options,
                             FilterState* state,

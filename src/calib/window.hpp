@@ -26,12 +26,12 @@ namespace omnivert::calib {
 // the Fisher information with the priors), carried to the filter's coordinates (camera pose;
 // each track as an anchored inverse-depth point anchored at the camera) through central
 // differences. This removes the early-update inconsistency of docs/theory/filter.md and
-// docs/calib.md: one linearisation per frame while depth and camera yaw are both unknown.
-// Tracks with fewer than 2 bearings in the window are left out (they enter afterwards).
-// Outlying bearings are removed as in refine_batch.
-// Tracks that slipped onto a neighbouring line are split as in refine_batch
-// (options.split_chi2); the later part of such a track enters the state under the tracker's id.
-// Returns false (state untouched, reason in *why) when the window cannot be solved.
+// docs/theory/window.md#why-a-window: one linearisation per frame while depth and camera yaw are
+// both unknown. Tracks with fewer than 2 bearings in the window are left out (they enter
+// afterwards). Outlying bearings are removed as in refine_batch. Tracks that slipped onto a
+// neighbouring line are split as in refine_batch (options.split_chi2); the later part of such a
+// track enters the state under the tracker's id. Returns false (state untouched, reason in *why)
+// when the window cannot be solved.
 struct BootstrapDetails {
   // Every track of the window's solution as (D, theta) from the robot at its last window
   // frame (frame = index in the window), with covariance: tracks that ended inside the window

@@ -57,8 +57,8 @@ TrackerOptions recommended_tracker_options(double wheel_base) {
   TrackerOptions o;
   o.mutual = true;
   o.same_polarity = true;
-  // Measured on the rendered tours (docs/tracking.md Sec. 6): track continuity with the track
-  // model at 0.8 degree, F1 0.6 and 0.5 across a look-back gap.
+  // Measured on the rendered tours (docs/theory/matching.md#the-rule-sets): track continuity with
+  // the track model at 0.8 degree, F1 0.6 and 0.5 across a look-back gap.
   o.continuity_tolerance = deg2rad(0.8);  // used when the gate (odometry) is on
   o.continuity_model = TrackerOptions::ContinuityModel::kTrack;
   o.match.f1 = 0.6;

@@ -1,8 +1,9 @@
 // Which bearings belong together in the batch refinement (association.hpp): a track that
 // slipped onto a neighbouring line (the office's door leaf 6 cm inside its frame,
-// docs/calib.md) is split in two, which removes the bias it puts on the extrinsics, and clean
-// tracks are left whole (BatchOptions::split_chi2); bearings where lines cross are left out
-// (Options::crossing_guard); pieces of one line are joined, and only with their own line.
+// docs/theory/association.md#slipped-tracks) is split in two, which removes the bias it puts on the
+// extrinsics, and clean tracks are left whole (BatchOptions::split_chi2); bearings where lines
+// cross are left out (Options::crossing_guard); pieces of one line are joined, and only with their
+// own line.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -43,7 +44,7 @@ TEST(TrackSplitting, SlippedTracksAreSplitAndTheirBiasRemoved) {
     if (i++ < 3) run = slip(run, track, n / 3 + 7 * i, 0.10);
   // The splitting alone: the crossing guard leaves out other bearings of this run and moves
   // its NEES by chance (the clean run's: 5.3 without the guard, 6.8 with it). Over seeds
-  // 7-46 it changes nothing on average (docs/calib.md, "Lines that cross").
+  // 7-46 it changes nothing on average (docs/theory/association.md#lines-that-cross).
   Options o = options_for(so);
   o.crossing_guard = 0.0;
   BatchOptions off;

@@ -373,7 +373,7 @@ TEST(NoiseCheck, FindsBearingsLessNoisyThanAssumed) {
   RecordProperty("yaw_z2", std::to_string(yaw));
   RecordProperty("yaw_z2_model", std::to_string(yaw_model));
   RecordProperty("less_broken", std::to_string(less_broken));
-  // Measured (session 13): 10 of 12 runs below the limit (chi-square(G) / G's 1% point, 0.26
+  // Measured: 10 of 12 runs below the limit (chi-square(G) / G's 1% point, 0.26
   // for 10 tracks), the filter's check too in 10; scale 0.18 in the mean (the bearings'
   // variance is 1/16 of the model's; the rest is the check's spread over 10 tracks); the
   // yaw's mean squared normalised error 0.21 under the model, 0.99 under the covariance

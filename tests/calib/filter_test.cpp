@@ -205,7 +205,8 @@ TEST(TrackBias, MonteCarloNeesIsConsistentWithBiasedBearings) {
 // Straight motion cannot observe the camera position (Sec. 8.1): a consistent filter keeps
 // sigma_rho at its prior (0.1 m). The invariant parametrisation does, undelayed and without
 // the batch window; the paper's coordinates with per-frame re-linearisation invent
-// information (docs/calib.md), which is why they are not the default.
+// information (docs/theory/filter.md#feature-initialisation), which is why they are not the
+// default.
 TEST(CalibrationFilter, StraightRunGainsNoSpuriousInformation) {
   SyntheticRunOptions so;
   so.trajectory = Trajectory::kStraight;

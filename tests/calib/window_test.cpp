@@ -91,7 +91,7 @@ TEST(WindowStarts, CameraYawFromTheBearingsFlow) {
       const double flow = camera_yaw_from_flow(s.run, o.wheel_base);
       ASSERT_TRUE(std::isfinite(flow)) << "yaw " << yaw;
       // The bound: the window's starts are taken at the flow's yaw when it is more than 0.35
-      // rad from the prior's; off by 0.2 rad they converge (docs/calib.md, "Window starts").
+      // rad from the prior's; off by 0.2 rad they converge (docs/theory/window.md#starts).
       EXPECT_LT(std::abs(wrap_angle(flow - yaw)), 0.2) << "yaw " << yaw << " flow " << flow;
     }
   }
@@ -133,9 +133,8 @@ Eigen::Vector3d error(const Extrinsics& est, const Extrinsics& truth) {
 // A track whose every bearing is an outlier in the bootstrap window (two rays that diverge:
 // no point fits either to the gate) loses all its bearings there; its feature must leave the
 // window's problem, whose information is singular otherwise (the inverse-depth prior alone
-// leaves the point free across the ray: a zero pivot, whose rounded sign decided whether the
-// window was refused, before the window's ridge). Measured: hall zigzag, seed 1; the window
-// was refused and the undelayed fallback ended 124 mm off (docs/calib.md).
+// leaves the point free across the ray: a zero pivot, whose rounded sign would decide whether
+// the window is refused; refused, the undelayed fallback can end far off).
 TEST(CalibrationFilter, BootstrapWindowDropsATrackWithOnlyOutliers) {
   SyntheticRunOptions so;
   so.seed = 3;
@@ -167,7 +166,7 @@ TEST(CalibrationFilter, BootstrapWindowDropsATrackWithOnlyOutliers) {
 // a bearing with its id after such a gap is another track (here one with a single bearing,
 // which the window cannot use), not a long-baseline observation of the first. (From pixels,
 // such a lone bearing where two lines crossed was 0.11 degree off and made the window's phi
-// three times too certain; docs/calib.md, "Session 10".)
+// three times too certain.)
 TEST(CalibrationFilter, BootstrapWindowEndsATrackAfterALongGap) {
   SyntheticRunOptions so;
   so.seed = 3;

@@ -33,7 +33,8 @@ struct BatchOptions {
   // [m] per step. Eq. (14)-(15) (and the filter's eq. 29) have no lateral motion; a small
   // slack keeps the problem well posed. 1e-4 makes every batch conservative (from pixels,
   // zigzag NEES 1.8-1.9; synthetic refinement 1.95 over 50 runs); 1e-5 is consistent on both
-  // (docs/calib.md). A robot that slips sideways needs more: --lateral-sigma.
+  // (docs/theory/refinement.md#odometry-factor). A robot that slips sideways needs more:
+  // --lateral-sigma.
   double lateral_sigma = 1e-5;
   bool robust = false;        // Huber loss on bearings
   double huber_sigmas = 3.0;  // Huber threshold in bearing sigmas
@@ -41,7 +42,8 @@ struct BatchOptions {
   // Track splitting: a track whose bearings are better explained by two features (before
   // and after one frame) than by one, with a likelihood-ratio statistic above split_chi2, is
   // taken to have slipped onto a neighbouring line and is split in two (each part at least
-  // split_min_bearings long); 0 turns it off. docs/calib.md ("The office yaw bias").
+  // split_min_bearings long); 0 turns it off
+  // (docs/theory/association.md#slipped-tracks).
   double split_chi2 = 20.0;
   int split_min_bearings = 5;
   double split_keep_fraction = 0.5;  // a round splits the tracks within this factor of the
@@ -51,7 +53,7 @@ struct BatchOptions {
   // another ended, and whose bearings one point explains with the other's (a Wald test with
   // the whole problem's covariance, chi-square(2) at Options::gate_probability), is taken for
   // the same line, lost and found again by the tracker under a new id, and joined to it
-  // (docs/calib.md, "Broken tracks"). false: off.
+  // (docs/theory/association.md#pieces-of-one-line). false: off.
   bool merge_pieces = true;
   // The noise check (BatchNoiseCheck) inverts the information matrix densely up to this many
   // variables, and uses sparse solves above (the same numbers; tested).

@@ -57,7 +57,7 @@ bool noise_check_rejects_model(const BatchNoiseCheck& check, double level = 0.01
 // quantile of chi-square(G) / G. calibrate() shrinks the bearings' share of the covariance
 // by it only where the tracker kept its lines (CalibrateOptions::noise_check): pieces of one
 // line left apart look like independent tracks to the check, which then reads less noise
-// than there is (docs/calib.md, "The noise check"). false when the check failed, has fewer
+// than there is (docs/theory/noise-check.md). false when the check failed, has fewer
 // than 2 tracks, or level is not in (0, 0.5).
 bool noise_check_finds_less_noise(const BatchNoiseCheck& check, double level = 0.01);
 // The two tests above together, "more noise" at `level`, "less noise" at `lower_level`

@@ -13,8 +13,8 @@ namespace omnivert::calib {
 // when the run has too little translation or flow to tell (fewer than `min_pairs` bearing
 // pairs, or less than `min_explained` of the flow's sum of squares explained).
 // The window starts at this yaw as well where it is far from the prior's: every start at the
-// prior's camera yaw is far off for a camera mounted 80-110 degrees from it (docs/calib.md,
-// "Window starts").
+// prior's camera yaw is far off for a camera mounted 80-110 degrees from it //
+// (docs/theory/window.md#camera-yaw-from-the-bearings-flow).
 double camera_yaw_from_flow(const CalibrationRun& run,
                             double wheel_base,
                             int min_pairs = 20,
