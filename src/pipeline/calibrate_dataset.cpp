@@ -46,8 +46,8 @@ std::string few_tracks_warning(int tracks, const FeaturePipelineOptions& feature
                   "more than its sigma";
   if (features.lines.threshold == LineThreshold::kFractionOfAnnulus &&
       features.lines.length_fraction > 0.3)
-    w += "; shorter lines help (--length-fraction 0.25 with --refine; docs/calib.md, "
-         "\"Shorter lines\")";
+    w += "; shorter lines help (--length-fraction 0.25 with --refine; docs/calibration.md, "
+         "\"Warnings\")";
   return w;
 }
 
