@@ -22,21 +22,13 @@
 #include "omnivert/calib/updater.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
+#include "synthetic_support.hpp"
 
 namespace omnivert::calib {
 namespace {
 
-Options options_for(const SyntheticRunOptions& so) {
-  Options o;
-  o.wheel_base = so.wheel_base;
-  o.odometry_K = so.odometry_K;
-  o.bearing_sigma = deg2rad(0.3);
-  return o;
-}
-
-Eigen::Vector3d error(const Extrinsics& est, const Extrinsics& truth) {
-  return {angle_diff(est.phi, truth.phi), est.rho - truth.rho, angle_diff(est.psi, truth.psi)};
-}
+Options options_for(const SyntheticRunOptions& so) { return test_support::filter_case_options(so); }
+using test_support::error;
 
 double nees(const Extrinsics& est, const Eigen::Matrix3d& cov, const Extrinsics& truth) {
   const Eigen::Vector3d e = error(est, truth);

@@ -59,4 +59,19 @@ inline SyntheticRun slip(SyntheticRun run, int track, int from, double behind) {
   return run;
 }
 
+// The filter tests' models: the run's wheel base and K, the paper's bearing sigma 0.3 degree
+// (whatever the run's noise).
+inline Options filter_case_options(const SyntheticRunOptions& so) {
+  Options o;
+  o.wheel_base = so.wheel_base;
+  o.odometry_K = so.odometry_K;
+  o.bearing_sigma = deg2rad(0.3);
+  return o;
+}
+
+// The error of (phi, rho, psi) against the truth (angles wrapped).
+inline Eigen::Vector3d error(const Extrinsics& est, const Extrinsics& truth) {
+  return {angle_diff(est.phi, truth.phi), est.rho - truth.rho, angle_diff(est.psi, truth.psi)};
+}
+
 }  // namespace omnivert::calib::test_support

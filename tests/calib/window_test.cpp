@@ -118,17 +118,8 @@ TEST(WindowStarts, CameraYawFromTheBearingsFlow) {
 namespace window_filter_cases {
 namespace {
 
-Options options_for(const SyntheticRunOptions& so) {
-  Options o;
-  o.wheel_base = so.wheel_base;
-  o.odometry_K = so.odometry_K;
-  o.bearing_sigma = deg2rad(0.3);
-  return o;
-}
-
-Eigen::Vector3d error(const Extrinsics& est, const Extrinsics& truth) {
-  return {angle_diff(est.phi, truth.phi), est.rho - truth.rho, angle_diff(est.psi, truth.psi)};
-}
+Options options_for(const SyntheticRunOptions& so) { return test_support::filter_case_options(so); }
+using test_support::error;
 
 // A track whose every bearing is an outlier in the bootstrap window (two rays that diverge:
 // no point fits either to the gate) loses all its bearings there; its feature must leave the
