@@ -11,6 +11,7 @@
 #include "omnivert/core/camera_geometry.hpp"
 #include "omnivert/core/error.hpp"
 #include "omnivert/describe/feature_pipeline.hpp"
+#include "omnivert/image/grey.hpp"
 #include "omnivert/image/image_io.hpp"
 #include "omnivert/viz/overlay.hpp"
 #include "pipeline_options.hpp"
@@ -22,6 +23,8 @@ namespace {
 struct ExtractArgs {
   std::string image;
   std::string sensor;
+  std::string bayer;
+  int bit_depth = -1;
   bool json = false;
   std::string overlay;
   int highlight = -1;
@@ -36,6 +39,12 @@ void run_extract(const ExtractArgs& a) {
   if (!a.sensor.empty()) {
     geometry = load_camera_geometry(a.sensor);
   }
+  if (!a.bayer.empty()) {
+    const auto p = parse_bayer_pattern(a.bayer);
+    if (!p) throw InputError("--bayer " + a.bayer + ": expected RGGB, BGGR, GRBG, GBRG or none");
+    geometry.pixel_format.bayer = *p;
+  }
+  if (a.bit_depth >= 0) geometry.pixel_format.bit_depth = a.bit_depth;
   FeaturePipeline pipe(geometry, a.pipeline);
   FrameFeatures f;
   if (!pipe.process(image, f, &why)) throw InputError(a.image, 0, why);
@@ -94,7 +103,9 @@ void run_extract(const ExtractArgs& a) {
     }
   }
   if (!a.overlay.empty()) {
-    write_image_atomic(a.overlay, draw_overlay(image, f, pipe.descriptor_extractor(), a.highlight));
+    cv::Mat grey;  // the picture the lines were found in (a Bayer mosaic demosaiced)
+    to_grey8(image, geometry.pixel_format, grey, nullptr);
+    write_image_atomic(a.overlay, draw_overlay(grey, f, pipe.descriptor_extractor(), a.highlight));
     if (!a.json) std::printf("overlay written to %s\n", a.overlay.c_str());
   }
 }
@@ -105,10 +116,24 @@ void add_extract_command(CLI::App& app) {
   auto args = std::make_shared<ExtractArgs>();
   CLI::App* cmd = app.add_subcommand(
       "extract", "Vertical lines of one catadioptric image: centre, lines, bearings, descriptors");
-  cmd->add_option("IMAGE", args->image, "Image file (PNG, JPEG, ...; grey or colour)")->required();
+  cmd->add_option("IMAGE",
+                  args->image,
+                  "Image file (PNG, JPEG, TIFF, ...; grey or colour, 8 or 16 bits, or a raw "
+                  "Bayer mosaic with --bayer)")
+      ->required();
   cmd->add_option("--sensor",
                   args->sensor,
-                  "cam0/sensor.yaml: resolution, optional center, r_min, r_max, bearing_sign");
+                  "cam0/sensor.yaml: resolution, optional center, r_min, r_max, bearing_sign, "
+                  "bayer, bit_depth");
+  cmd->add_option("--bayer",
+                  args->bayer,
+                  "The image is a raw Bayer mosaic with this pattern (RGGB, BGGR, GRBG, GBRG; "
+                  "none: grey or colour); overrides sensor.yaml's bayer");
+  cmd->add_option("--bit-depth",
+                  args->bit_depth,
+                  "Significant bits of a 16-bit image (e.g. 12 for values 0..4095; 0: the full "
+                  "16 bits); overrides sensor.yaml's bit_depth")
+      ->check(CLI::IsMember({0, 9, 10, 11, 12, 13, 14, 15, 16}));
   cmd->add_flag("--json", args->json, "Print one JSON object instead of a table");
   cmd->add_option("--overlay",
                   args->overlay,

@@ -1,5 +1,7 @@
 #include "omnivert/core/camera_geometry.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 
 #include <yaml-cpp/yaml.h>
@@ -17,6 +19,60 @@ double CameraGeometry::bearing_of_image_angle(double a) const {
 double CameraGeometry::image_angle_of_bearing(double beta) const {
   return wrap_angle(bearing_sign * beta);
 }
+
+std::optional<BayerPattern> parse_bayer_pattern(const std::string& name) {
+  std::string n = name;
+  std::transform(n.begin(), n.end(), n.begin(), [](unsigned char c) { return std::toupper(c); });
+  if (n == "NONE") return BayerPattern::kNone;
+  if (n == "RGGB") return BayerPattern::kRGGB;
+  if (n == "BGGR") return BayerPattern::kBGGR;
+  if (n == "GRBG") return BayerPattern::kGRBG;
+  if (n == "GBRG") return BayerPattern::kGBRG;
+  return std::nullopt;
+}
+
+const char* bayer_pattern_name(BayerPattern pattern) {
+  switch (pattern) {
+    case BayerPattern::kRGGB:
+      return "RGGB";
+    case BayerPattern::kBGGR:
+      return "BGGR";
+    case BayerPattern::kGRBG:
+      return "GRBG";
+    case BayerPattern::kGBRG:
+      return "GBRG";
+    case BayerPattern::kNone:
+      break;
+  }
+  return "none";
+}
+
+namespace {
+
+PixelFormat load_pixel_format(const YAML::Node& root, const std::string& path) {
+  PixelFormat f;
+  if (const auto b = yaml::optional_string(root, "bayer", path)) {
+    const auto p = parse_bayer_pattern(*b);
+    if (!p) {
+      throw InputError(path,
+                       yaml::line_of(root["bayer"]),
+                       "field 'bayer' is '" + *b + "'; expected RGGB, BGGR, GRBG, GBRG or none");
+    }
+    f.bayer = *p;
+  }
+  if (const auto d = yaml::optional_number(root, "bit_depth", path)) {
+    if (*d != std::floor(*d) || *d < 9 || *d > 16) {
+      throw InputError(path,
+                       yaml::line_of(root["bit_depth"]),
+                       "field 'bit_depth' must be a whole number of bits from 9 to 16 (the "
+                       "significant bits of a 16-bit image)");
+    }
+    f.bit_depth = static_cast<int>(*d);
+  }
+  return f;
+}
+
+}  // namespace
 
 CameraGeometry load_camera_geometry(const std::string& path) {
   const YAML::Node root = yaml::load_file(path);
@@ -58,6 +114,7 @@ CameraGeometry load_camera_geometry(const std::string& path) {
     }
     g.bearing_sign = static_cast<int>(*s);
   }
+  g.pixel_format = load_pixel_format(root, path);
   return g;
 }
 

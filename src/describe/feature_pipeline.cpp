@@ -5,6 +5,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "omnivert/core/angles.hpp"
+#include "omnivert/image/grey.hpp"
 
 namespace omnivert {
 
@@ -20,35 +21,7 @@ FeaturePipeline::FeaturePipeline(CameraGeometry geometry, FeaturePipelineOptions
       descriptors_(options_.descriptor) {}
 
 bool FeaturePipeline::to_gray8(const cv::Mat& image, cv::Mat& gray) {
-  if (image.empty() || image.dims != 2) return false;
-  cv::Mat g;
-  switch (image.channels()) {
-    case 1:
-      g = image;
-      break;
-    case 3:
-      cv::cvtColor(image, g, cv::COLOR_BGR2GRAY);
-      break;
-    case 4:
-      cv::cvtColor(image, g, cv::COLOR_BGRA2GRAY);
-      break;
-    default:
-      return false;
-  }
-  switch (g.depth()) {
-    case CV_8U:
-      gray = g.isContinuous() ? g : g.clone();
-      return true;
-    case CV_16U:
-      g.convertTo(gray, CV_8U, 1.0 / 257.0);
-      return true;
-    case CV_32F:
-    case CV_64F:
-      g.convertTo(gray, CV_8U, 255.0);
-      return true;
-    default:
-      return false;
-  }
+  return to_grey8(image, PixelFormat{}, gray, nullptr);
 }
 
 double annulus_fraction_inside(const MirrorCircle& c, int width, int height) {
@@ -68,10 +41,7 @@ double annulus_fraction_inside(const MirrorCircle& c, int width, int height) {
 
 bool FeaturePipeline::process(const cv::Mat& image, FrameFeatures& out, std::string* why) {
   if (why) why->clear();
-  if (!to_gray8(image, gray_)) {
-    if (why) *why = "unsupported image type (expected 8- or 16-bit grey or colour)";
-    return false;
-  }
+  if (!to_grey8(image, geometry_.pixel_format, gray_, why)) return false;
   if (geometry_.width > 0 && (gray_.cols != geometry_.width || gray_.rows != geometry_.height)) {
     if (why)
       *why = "image is " + std::to_string(gray_.cols) + "x" + std::to_string(gray_.rows) +

@@ -37,14 +37,16 @@ class FeaturePipeline {
  public:
   FeaturePipeline(CameraGeometry geometry, FeaturePipelineOptions options = {});
 
-  // Processes one image (8-bit or 16-bit, grey or colour; converted to 8-bit grey). Returns
+  // Processes one image (8-bit or 16-bit, grey, colour or a Bayer mosaic: converted to 8-bit
+  // grey by to_grey8 with the camera's pixel_format). Returns
   // false with a reason in *why for an image that does not fit the camera (wrong size, the
   // annulus mostly outside the image) or whose mirror cannot be found on the first frame.
   // A later frame whose rim is not found keeps the previous centre (and says so in *why,
   // while still returning true).
   bool process(const cv::Mat& image, FrameFeatures& out, std::string* why = nullptr);
 
-  // Converts any supported image to 8-bit grey; false if the type is not supported.
+  // Converts a grey or colour image to 8-bit grey (to_grey8 with the default PixelFormat);
+  // false if the type is not supported.
   static bool to_gray8(const cv::Mat& image, cv::Mat& gray);
 
   const CameraGeometry& geometry() const { return geometry_; }
