@@ -36,9 +36,8 @@ std::vector<std::string> dataset_images(const fs::path& dir) {
   const fs::path csv = dir / "cam0" / "data.csv";
   std::ifstream in(csv);
   if (!in) {
-    throw InputError(dir.string(),
-                     0,
-                     "is a folder without cam0/data.csv: give image files or a dataset folder");
+    throw InputError(
+        dir.string(), 0, "is a folder without cam0/data.csv: give image files or a dataset folder");
   }
   std::vector<std::string> files;
   std::string row;
@@ -92,44 +91,70 @@ void run_camera(const CameraArgs& a) {
   }
   const CameraEstimate e = estimate_camera(frames);
 
-  std::printf("%5s %10s %10s %9s %8s %8s  %s\n", "frame", "cx", "cy", "rim", "r_min", "r_max",
-              "file");
+  std::printf(
+      "%5s %10s %10s %9s %8s %8s  %s\n", "frame", "cx", "cy", "rim", "r_min", "r_max", "file");
   for (std::size_t i = 0; i < e.frames.size(); ++i) {
     const auto& f = e.frames[i];
     if (f.found) {
-      std::printf("%5zu %10.2f %10.2f %9.2f %8.1f %8.1f  %s%s\n", i, f.circle.center.x(),
-                  f.circle.center.y(), f.circle.rim_radius, f.circle.r_min, f.circle.r_max,
-                  files[i].c_str(), f.inlier ? "" : "  (outlier, not used)");
+      std::printf("%5zu %10.2f %10.2f %9.2f %8.1f %8.1f  %s%s\n",
+                  i,
+                  f.circle.center.x(),
+                  f.circle.center.y(),
+                  f.circle.rim_radius,
+                  f.circle.r_min,
+                  f.circle.r_max,
+                  files[i].c_str(),
+                  f.inlier ? "" : "  (outlier, not used)");
     } else {
-      std::printf("%5zu %10s %10s %9s %8s %8s  %s  (no rim: %s)\n", i, "-", "-", "-", "-", "-",
-                  files[i].c_str(), f.why.c_str());
+      std::printf("%5zu %10s %10s %9s %8s %8s  %s  (no rim: %s)\n",
+                  i,
+                  "-",
+                  "-",
+                  "-",
+                  "-",
+                  "-",
+                  files[i].c_str(),
+                  f.why.c_str());
     }
   }
   const auto& c = e.circle;
   std::printf("camera: %dx%d, centre (%.2f, %.2f) px, rim %.2f px, annulus %.1f..%.1f px\n",
-              e.width, e.height, c.center.x(), c.center.y(), c.rim_radius, c.r_min, c.r_max);
-  std::printf("frames: %zu, rim found on %zu, joint fit on %d (%d rim points, rms %.2f px); "
-              "spread of the per-frame centres %.2f px\n",
-              e.frames.size(),
-              static_cast<std::size_t>(std::count_if(e.frames.begin(), e.frames.end(),
-                                                     [](const auto& f) { return f.found; })),
-              e.used_frames, e.rim_points, e.rim_rms_px, e.spread_px);
+              e.width,
+              e.height,
+              c.center.x(),
+              c.center.y(),
+              c.rim_radius,
+              c.r_min,
+              c.r_max);
+  std::printf(
+      "frames: %zu, rim found on %zu, joint fit on %d (%d rim points, rms %.2f px); "
+      "spread of the per-frame centres %.2f px\n",
+      e.frames.size(),
+      static_cast<std::size_t>(
+          std::count_if(e.frames.begin(), e.frames.end(), [](const auto& f) { return f.found; })),
+      e.used_frames,
+      e.rim_points,
+      e.rim_rms_px,
+      e.spread_px);
 
   std::string mask_entry;
   if (e.mask.empty()) {
     std::printf("%s\n", e.mask_note.c_str());
   } else if (a.mask_out.empty()) {
-    std::printf("a mask was proposed (%.1f%% of the annulus excluded); give --mask-out FILE.png "
-                "to write it\n", 100 * e.masked_fraction);
+    std::printf(
+        "a mask was proposed (%.1f%% of the annulus excluded); give --mask-out FILE.png "
+        "to write it\n",
+        100 * e.masked_fraction);
   } else {
     write_image_atomic(a.mask_out, e.mask);
     const fs::path yaml_dir = fs::absolute(a.out).parent_path();
     mask_entry = fs::absolute(a.mask_out).lexically_relative(yaml_dir).generic_string();
-    std::printf("mask written to %s (%.1f%% of the annulus excluded)\n", a.mask_out.c_str(),
+    std::printf("mask written to %s (%.1f%% of the annulus excluded)\n",
+                a.mask_out.c_str(),
                 100 * e.masked_fraction);
   }
-  const std::string provenance = "estimated by `omnivert camera` from " +
-                                 std::to_string(frames.size()) + " frame(s)";
+  const std::string provenance =
+      "estimated by `omnivert camera` from " + std::to_string(frames.size()) + " frame(s)";
   write_text_atomic(a.out, camera_sensor_yaml(e, mask_entry, provenance));
   std::printf("sensor.yaml written to %s\n", a.out.c_str());
   if (!a.overlay.empty()) {
@@ -146,15 +171,18 @@ void add_camera_command(CLI::App& app) {
       "camera",
       "A new camera from many frames: mirror centre, rim, annulus (and a mask of what never "
       "changes), written as cam0/sensor.yaml");
-  cmd->add_option("IMAGES_OR_DATASET", args->inputs,
+  cmd->add_option("IMAGES_OR_DATASET",
+                  args->inputs,
                   "Image files, or dataset folders (cam0/data.csv and cam0/data/)")
       ->required();
   cmd->add_option("--out", args->out, "sensor.yaml to write (atomically)")->required();
-  cmd->add_option("--overlay", args->overlay,
-                  "Write a picture of the rim, centre, annulus and masked pixels");
-  cmd->add_option("--mask-out", args->mask_out,
+  cmd->add_option(
+      "--overlay", args->overlay, "Write a picture of the rim, centre, annulus and masked pixels");
+  cmd->add_option("--mask-out",
+                  args->mask_out,
                   "Write the proposed mask (PNG, non-zero = usable) when the frames show motion");
-  cmd->add_option("--max-frames", args->max_frames,
+  cmd->add_option("--max-frames",
+                  args->max_frames,
                   "Use at most N frames, evenly spread over the sequence (0: all)")
       ->check(CLI::NonNegativeNumber);
   cmd->callback([args] { run_camera(*args); });

@@ -94,10 +94,11 @@ void propose_mask(const std::vector<cv::Mat>& frames,
       if (annulus.at<uchar>(v, u)) sds.push_back(sd.at<double>(v, u));
   const double scene = median(sds);
   if (!(scene >= o.mask_min_scene_std)) {
-    e.mask_note = "no mask proposed: the frames hardly change (median temporal standard "
-                  "deviation " +
-                  fmt("%.1f", scene) +
-                  " grey levels inside the annulus); record frames while the robot moves";
+    e.mask_note =
+        "no mask proposed: the frames hardly change (median temporal standard "
+        "deviation " +
+        fmt("%.1f", scene) +
+        " grey levels inside the annulus); record frames while the robot moves";
     return;
   }
   cv::Mat stat = (sd < o.mask_static_fraction * scene) & annulus;
@@ -121,8 +122,9 @@ void propose_mask(const std::vector<cv::Mat>& frames,
   const double area = cv::countNonZero(annulus);
   const double excluded = cv::countNonZero(stat);
   if (!(excluded >= o.mask_min_area_px)) {
-    e.mask_note = "no mask proposed: nothing inside the annulus stays still while the scene "
-                  "changes";
+    e.mask_note =
+        "no mask proposed: nothing inside the annulus stays still while the scene "
+        "changes";
     return;
   }
   e.mask = annulus & ~stat;
@@ -131,8 +133,7 @@ void propose_mask(const std::vector<cv::Mat>& frames,
 
 }  // namespace
 
-CameraEstimate estimate_camera(const std::vector<cv::Mat>& frames,
-                               const CameraEstimateOptions& o) {
+CameraEstimate estimate_camera(const std::vector<cv::Mat>& frames, const CameraEstimateOptions& o) {
   if (frames.empty()) throw InputError("no frames given");
   CameraEstimate e;
   e.width = frames[0].cols;
@@ -157,8 +158,8 @@ CameraEstimate estimate_camera(const std::vector<cv::Mat>& frames,
     ++found;
     for (std::size_t j = i + 1; j < e.frames.size(); ++j)
       if (e.frames[j].found)
-        e.spread_px = std::max(
-            e.spread_px, (e.frames[i].circle.center - e.frames[j].circle.center).norm());
+        e.spread_px =
+            std::max(e.spread_px, (e.frames[i].circle.center - e.frames[j].circle.center).norm());
   }
   if (found == 0) {
     // The detector's reason without its advice for a single image.

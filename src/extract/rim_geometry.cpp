@@ -143,13 +143,8 @@ std::vector<double> radial_edge_coverage(const cv::Mat& gx,
   return sm;
 }
 
-
-std::vector<CircleCandidate> hough_circles(const cv::Mat& gray,
-                                           int r_lo,
-                                           int r_hi,
-                                           double threshold,
-                                           int count,
-                                           double separation) {
+std::vector<CircleCandidate> hough_circles(
+    const cv::Mat& gray, int r_lo, int r_hi, double threshold, int count, double separation) {
   std::vector<CircleCandidate> out;
   r_lo = std::max(r_lo, 2);
   if (r_hi <= r_lo + 2) return out;
@@ -184,7 +179,8 @@ std::vector<CircleCandidate> hough_circles(const cv::Mat& gray,
   // Votes in a 3x3x3 neighbourhood, divided by the radius: a circle's votes and the votes of
   // unrelated edges both grow with its circumference.
   std::vector<cv::Mat> box(R);
-  for (int k = 0; k < R; ++k) cv::boxFilter(acc[k], box[k], CV_32F, cv::Size(3, 3), {-1, -1}, false);
+  for (int k = 0; k < R; ++k)
+    cv::boxFilter(acc[k], box[k], CV_32F, cv::Size(3, 3), {-1, -1}, false);
   std::vector<CircleCandidate> all;
   for (int k = 1; k + 1 < R; ++k) {
     cv::Mat s = box[k - 1] + box[k] + box[k + 1];

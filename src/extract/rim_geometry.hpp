@@ -45,12 +45,8 @@ struct CircleCandidate {
 // threshold) votes, for every radius in [r_lo, r_hi], at the two points one radius away
 // along its gradient line, so either polarity counts. Centres lie inside the image. Returns
 // up to `count` peaks, best first, at least `separation` pixels apart in centre or radius.
-std::vector<CircleCandidate> hough_circles(const cv::Mat& gray,
-                                           int r_lo,
-                                           int r_hi,
-                                           double threshold,
-                                           int count,
-                                           double separation);
+std::vector<CircleCandidate> hough_circles(
+    const cv::Mat& gray, int r_lo, int r_hi, double threshold, int count, double separation);
 
 // A rim fitted from points found along rays.
 struct RimFit {

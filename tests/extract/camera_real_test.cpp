@@ -20,8 +20,8 @@ namespace {
 struct RealCamera {
   const char* name;
   std::vector<std::string> files;
-  double cx, cy;  // rim centre checked by eye on the overlay, +-3 px
-  double rim;          // rim radius, +-5 px
+  double cx, cy;              // rim centre checked by eye on the overlay, +-3 px
+  double rim;                 // rim radius, +-5 px
   double r_min_lo, r_min_hi;  // plausible self-reflection radii + margin
 };
 
@@ -56,8 +56,13 @@ TEST_P(RealCameras, RimFoundOnEveryImageAndCentresAgree) {
     std::string why;
     const auto c = det.estimate(frames[i], g, &why);
     ASSERT_TRUE(c.has_value()) << cam.files[i] << ": " << why;
-    std::printf("%-26s centre (%.2f, %.2f) rim %.2f annulus %.1f..%.1f\n", cam.files[i].c_str(),
-                c->center.x(), c->center.y(), c->rim_radius, c->r_min, c->r_max);
+    std::printf("%-26s centre (%.2f, %.2f) rim %.2f annulus %.1f..%.1f\n",
+                cam.files[i].c_str(),
+                c->center.x(),
+                c->center.y(),
+                c->rim_radius,
+                c->r_min,
+                c->r_max);
     EXPECT_NEAR(c->center.x(), cam.cx, 3.0) << cam.files[i];
     EXPECT_NEAR(c->center.y(), cam.cy, 3.0) << cam.files[i];
     EXPECT_NEAR(c->rim_radius, cam.rim, 5.0) << cam.files[i];

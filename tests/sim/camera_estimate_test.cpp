@@ -40,11 +40,19 @@ TEST(CameraEstimate, FindsTheRenderedCentreRimAndSelfReflection) {
   const auto frames = moving_frames(cam, 8);
   const CameraEstimate e = estimate_camera(frames);
   const Eigen::Vector2d truth(cam.cx, cam.cy);
-  std::printf("centre (%.3f, %.3f) vs (%.3f, %.3f): %.3f px; rim %.3f vs %.3f; r_min %.2f; "
-              "spread %.3f px over %zu frames\n",
-              e.circle.center.x(), e.circle.center.y(), truth.x(), truth.y(),
-              (e.circle.center - truth).norm(), e.circle.rim_radius, cam.rim_radius(),
-              e.circle.r_min, e.spread_px, e.frames.size());
+  std::printf(
+      "centre (%.3f, %.3f) vs (%.3f, %.3f): %.3f px; rim %.3f vs %.3f; r_min %.2f; "
+      "spread %.3f px over %zu frames\n",
+      e.circle.center.x(),
+      e.circle.center.y(),
+      truth.x(),
+      truth.y(),
+      (e.circle.center - truth).norm(),
+      e.circle.rim_radius,
+      cam.rim_radius(),
+      e.circle.r_min,
+      e.spread_px,
+      e.frames.size());
   EXPECT_LE((e.circle.center - truth).norm(), 0.3);
   EXPECT_NEAR(e.circle.rim_radius, cam.rim_radius(), 1.0);
   EXPECT_NEAR(e.circle.r_max, cam.rim_radius() * 0.97, 1.0);
@@ -86,12 +94,13 @@ TEST(CameraEstimate, MaskCoversAStaticStrutAndRobotReflection) {
   cv::circle(annulus, c, static_cast<int>(e.circle.r_max), 255, cv::FILLED);
   cv::circle(annulus, c, static_cast<int>(e.circle.r_min), 0, cv::FILLED);
   const cv::Mat target = painted & annulus, rest = annulus & ~painted;
-  const double covered = cv::countNonZero(target & (e.mask == 0)) /
-                         static_cast<double>(cv::countNonZero(target));
-  const double wrong = cv::countNonZero(rest & (e.mask == 0)) /
-                       static_cast<double>(cv::countNonZero(rest));
+  const double covered =
+      cv::countNonZero(target & (e.mask == 0)) / static_cast<double>(cv::countNonZero(target));
+  const double wrong =
+      cv::countNonZero(rest & (e.mask == 0)) / static_cast<double>(cv::countNonZero(rest));
   std::printf("static pixels masked: %.1f%%; rest of the annulus masked: %.2f%%\n",
-              100 * covered, 100 * wrong);
+              100 * covered,
+              100 * wrong);
   EXPECT_GE(covered, 0.95);
   EXPECT_LT(wrong, 0.05);
 }

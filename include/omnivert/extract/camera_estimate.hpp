@@ -2,7 +2,7 @@
 // The image-side geometry of a new camera from many frames: mirror centre, rim, valid
 // annulus r_min..r_max and, from a moving robot's video, a proposed mask of the pixels that
 // never change (the robot's own reflection, struts). What `omnivert camera` writes into
-// cam0/sensor.yaml (docs/getting-started.md#a-new-camera, docs/extraction.md).
+// cam0/sensor.yaml (docs/getting-started.md#write-cam0sensoryaml, docs/extraction.md).
 //
 // Each frame is estimated alone (MirrorCenterDetector::estimate); frames whose centre lies
 // far from the median of all are dropped; the rim is then fitted once to the rim points of
