@@ -12,6 +12,7 @@
 #include "omnivert/core/error.hpp"
 #include "omnivert/describe/feature_pipeline.hpp"
 #include "omnivert/image/image_io.hpp"
+#include "omnivert/image/image_mask.hpp"
 #include "omnivert/viz/overlay.hpp"
 #include "pipeline_options.hpp"
 
@@ -25,6 +26,7 @@ struct ExtractArgs {
   bool json = false;
   std::string overlay;
   int highlight = -1;
+  std::string mask;
   FeaturePipelineOptions pipeline;
 };
 
@@ -35,6 +37,15 @@ void run_extract(const ExtractArgs& a) {
   CameraGeometry geometry;
   if (!a.sensor.empty()) {
     geometry = load_camera_geometry(a.sensor);
+  }
+  if (!a.mask.empty()) {
+    // Without --sensor the mask gives the size the image must have.
+    geometry.mask = a.mask;
+    if (geometry.width == 0) {
+      const cv::Mat m = read_mask(a.mask);
+      geometry.width = m.cols;
+      geometry.height = m.rows;
+    }
   }
   FeaturePipeline pipe(geometry, a.pipeline);
   FrameFeatures f;
@@ -117,6 +128,7 @@ void add_extract_command(CLI::App& app) {
                   args->highlight,
                   "Line whose descriptor areas the overlay draws (default: the longest)");
   add_pipeline_options(cmd, args->pipeline);
+  add_mask_option(cmd, args->mask);
   cmd->callback([args] { run_extract(*args); });
 }
 

@@ -1,6 +1,7 @@
 #include "omnivert/core/camera_geometry.hpp"
 
 #include <cmath>
+#include <filesystem>
 
 #include <yaml-cpp/yaml.h>
 
@@ -57,6 +58,21 @@ CameraGeometry load_camera_geometry(const std::string& path) {
           path, yaml::line_of(root["bearing_sign"]), "field 'bearing_sign' must be 1 or -1");
     }
     g.bearing_sign = static_cast<int>(*s);
+  }
+  if (const auto m = yaml::optional_string(root, "mask", path)) {
+    namespace fs = std::filesystem;
+    const int line = yaml::line_of(root["mask"]);
+    if (m->empty()) throw InputError(path, line, "field 'mask' must name an image file");
+    fs::path p(*m);
+    if (p.is_relative()) p = fs::path(path).parent_path() / p;
+    std::error_code ec;
+    if (!fs::is_regular_file(p, ec)) {
+      throw InputError(path,
+                       line,
+                       "field 'mask': file '" + *m + "' not found (looked for " + p.string() +
+                           "; the path is relative to the folder of this file)");
+    }
+    g.mask = p.string();
   }
   return g;
 }

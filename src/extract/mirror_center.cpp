@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "omnivert/core/angles.hpp"
+#include "omnivert/image/image_mask.hpp"
 
 namespace omnivert {
 
@@ -29,6 +30,11 @@ bool MirrorCenterOptions::IsValid(std::string* why) const {
 
 MirrorCenterDetector::MirrorCenterDetector(MirrorCenterOptions options)
     : options_(std::move(options)) {}
+
+void MirrorCenterDetector::set_mask(const cv::Mat& usable) {
+  CV_Assert(usable.empty() || usable.type() == CV_8UC1);
+  usable_ = usable.empty() || mask_all_usable(usable) ? cv::Mat() : erode_mask(usable, 1);
+}
 
 namespace {
 
@@ -132,14 +138,17 @@ std::vector<double> radial_edge_coverage(const cv::Mat& gx,
                                          const Eigen::Vector2d& c,
                                          int r_max,
                                          double threshold,
-                                         int sign) {
+                                         int sign,
+                                         const cv::Mat& usable) {
   std::vector<double> hits(r_max + 2, 0.0), total(r_max + 2, 0.0);
   const double t2 = threshold * threshold;
   const double cos20 = std::cos(deg2rad(20.0));
   for (int v = 1; v < gx.rows - 1; ++v) {
     const short* px = gx.ptr<short>(v);
     const short* py = gy.ptr<short>(v);
+    const uchar* ok = usable.empty() ? nullptr : usable.ptr<uchar>(v);
     for (int u = 1; u < gx.cols - 1; ++u) {
+      if (ok && !ok[u]) continue;  // masked: neither on the circumference nor a hit
       const double dx = u - c.x(), dy = v - c.y();
       const double rr = std::sqrt(dx * dx + dy * dy);
       const int ri = static_cast<int>(rr + 0.5);
@@ -163,7 +172,25 @@ std::vector<double> radial_edge_coverage(const cv::Mat& gx,
   return sm;
 }
 
+// The usable mask of a reduced image: a small pixel is usable when all the pixels it averages
+// are, and its Sobel window is then shrunk by one small pixel. Empty stays empty.
+cv::Mat shrink_mask(const cv::Mat& usable, cv::Size small) {
+  if (usable.empty() || usable.size() == small) return usable;
+  cv::Mat s;
+  cv::resize(usable, s, small, 0, 0, cv::INTER_AREA);
+  cv::compare(s, 255, s, cv::CMP_GE);
+  return erode_mask(s, 1);
+}
+
 }  // namespace
+
+bool MirrorCenterDetector::usable_at(const Eigen::Vector2d& p) const {
+  // The four pixels of the bilinear sample (inside the image: sample() checked it).
+  const int x0 = static_cast<int>(p.x()), y0 = static_cast<int>(p.y());
+  const uchar* r0 = usable_.ptr<uchar>(y0);
+  const uchar* r1 = usable_.ptr<uchar>(y0 + 1);
+  return r0[x0] && r0[x0 + 1] && r1[x0] && r1[x0 + 1];
+}
 
 bool MirrorCenterDetector::refine(const cv::Mat& gray,
                                   Eigen::Vector2d& center,
@@ -181,7 +208,7 @@ bool MirrorCenterDetector::refine(const cv::Mat& gray,
       bool ok = true;
       for (int i = 0; i < n && ok; ++i) {
         const Eigen::Vector2d p = center + (rim_radius - W + i * step) * d;
-        ok = sample(gray, p.x(), p.y(), prof[i]);
+        ok = sample(gray, p.x(), p.y(), prof[i]) && (usable_.empty() || usable_at(p));
       }
       if (!ok) continue;
       for (int s = 0; s < 2; ++s) {
@@ -227,6 +254,8 @@ std::optional<MirrorCircle> MirrorCenterDetector::estimate(const cv::Mat& gray,
     cv::resize(gray, small, cv::Size(), scale, scale, cv::INTER_AREA);
   else
     small = gray;
+  CV_Assert(usable_.empty() || usable_.size() == gray.size());
+  const cv::Mat small_usable = shrink_mask(usable_, small.size());
   cv::Mat gx, gy;
   cv::Sobel(small, gx, CV_16S, 1, 0, 3);
   cv::Sobel(small, gy, CV_16S, 0, 1, 3);
@@ -244,7 +273,9 @@ std::optional<MirrorCircle> MirrorCenterDetector::estimate(const cv::Mat& gray,
     for (int v = 1; v < small.rows - 1; v += 1) {
       const short* px = gx.ptr<short>(v);
       const short* py = gy.ptr<short>(v);
+      const uchar* ok = small_usable.empty() ? nullptr : small_usable.ptr<uchar>(v);
       for (int u = 1; u < small.cols - 1; u += 1) {
+        if (ok && !ok[u]) continue;  // masked pixels cast no vote
         const double g2 = double(px[u]) * px[u] + double(py[u]) * py[u];
         if (g2 < t2) continue;
         const double g = std::sqrt(g2);
@@ -266,7 +297,7 @@ std::optional<MirrorCircle> MirrorCenterDetector::estimate(const cv::Mat& gray,
   // that fits to sub-pixel precision is the rim (a mirror holder can add rings that lie
   // mostly outside the image).
   const int rmax_search = static_cast<int>(std::hypot(small.cols, small.rows) / 2);
-  const auto outer = radial_edge_coverage(gx, gy, c, rmax_search, thr, -1);
+  const auto outer = radial_edge_coverage(gx, gy, c, rmax_search, thr, -1, small_usable);
   std::vector<std::pair<double, int>> rims;  // (coverage, radius in the small image)
   int r_lo = static_cast<int>(0.15 * std::min(small.cols, small.rows)), r_hi = rmax_search;
   if (geometry.r_max) {
@@ -315,7 +346,8 @@ std::optional<MirrorCircle> MirrorCenterDetector::estimate(const cv::Mat& gray,
     circle.r_min = *geometry.r_min;
   } else {
     // The camera's own reflection: a dark disc, so brighter-outward circular edges.
-    const auto inner = radial_edge_coverage(gx, gy, center * scale, rmax_search, thr, +1);
+    const auto inner =
+        radial_edge_coverage(gx, gy, center * scale, rmax_search, thr, +1, small_usable);
     double best = 0;
     int disc = 0;
     for (int r = static_cast<int>(0.05 * rim); r <= static_cast<int>(0.5 * rim); ++r)
@@ -334,6 +366,7 @@ std::optional<MirrorCircle> MirrorCenterDetector::detect(const cv::Mat& gray,
                                                          const MirrorCircle& prior,
                                                          std::string* why) const {
   CV_Assert(gray.type() == CV_8UC1);
+  CV_Assert(usable_.empty() || usable_.size() == gray.size());
   const double R = prior.rim_radius;
   if (!(R > 0)) {
     set_why(why, "no rim radius known: call estimate() on a first frame");
@@ -358,7 +391,9 @@ std::optional<MirrorCircle> MirrorCenterDetector::detect(const cv::Mat& gray,
     const short* px = gx.ptr<short>(v);
     const short* py = gy.ptr<short>(v);
     const double y = roi.y + v;
+    const uchar* ok = usable_.empty() ? nullptr : usable_.ptr<uchar>(roi.y + v) + roi.x;
     for (int u = 1; u < roi.width - 1; ++u) {
+      if (ok && !ok[u]) continue;  // masked pixels cast no vote
       const double x = roi.x + u;
       const double dx = x - prior.center.x(), dy = y - prior.center.y();
       const double d2 = dx * dx + dy * dy;
