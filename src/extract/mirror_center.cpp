@@ -199,6 +199,7 @@ bool MirrorCenterDetector::refine(const cv::Mat& gray,
   const double W = options_.rim_window;
   const int n = static_cast<int>(2 * W / step) + 1;
   std::vector<double> prof(n);
+  const bool masked = !usable_.empty();
   for (int pass = 0; pass < 2; ++pass) {
     std::vector<Eigen::Vector2d> pts[2];  // [0]: darker outward, [1]: brighter outward
     double strength[2] = {0, 0};
@@ -208,7 +209,7 @@ bool MirrorCenterDetector::refine(const cv::Mat& gray,
       bool ok = true;
       for (int i = 0; i < n && ok; ++i) {
         const Eigen::Vector2d p = center + (rim_radius - W + i * step) * d;
-        ok = sample(gray, p.x(), p.y(), prof[i]) && (usable_.empty() || usable_at(p));
+        ok = sample(gray, p.x(), p.y(), prof[i]) && (!masked || usable_at(p));
       }
       if (!ok) continue;
       for (int s = 0; s < 2; ++s) {
@@ -275,9 +276,9 @@ std::optional<MirrorCircle> MirrorCenterDetector::estimate(const cv::Mat& gray,
       const short* py = gy.ptr<short>(v);
       const uchar* ok = small_usable.empty() ? nullptr : small_usable.ptr<uchar>(v);
       for (int u = 1; u < small.cols - 1; u += 1) {
-        if (ok && !ok[u]) continue;  // masked pixels cast no vote
         const double g2 = double(px[u]) * px[u] + double(py[u]) * py[u];
         if (g2 < t2) continue;
+        if (ok && !ok[u]) continue;  // masked pixels cast no vote
         const double g = std::sqrt(g2);
         const double ex = px[u] / g, ey = py[u] / g;
         for (int sgn = -1; sgn <= 1; sgn += 2) {
@@ -393,13 +394,13 @@ std::optional<MirrorCircle> MirrorCenterDetector::detect(const cv::Mat& gray,
     const double y = roi.y + v;
     const uchar* ok = usable_.empty() ? nullptr : usable_.ptr<uchar>(roi.y + v) + roi.x;
     for (int u = 1; u < roi.width - 1; ++u) {
-      if (ok && !ok[u]) continue;  // masked pixels cast no vote
       const double x = roi.x + u;
       const double dx = x - prior.center.x(), dy = y - prior.center.y();
       const double d2 = dx * dx + dy * dy;
       if (d2 < band_lo * band_lo || d2 > band_hi * band_hi) continue;
       const double g2 = double(px[u]) * px[u] + double(py[u]) * py[u];
       if (g2 < t2) continue;
+      if (ok && !ok[u]) continue;  // masked pixels cast no vote
       const double g = std::sqrt(g2);
       for (int sgn = -1; sgn <= 1; sgn += 2) {
         const double cx = x + sgn * R * px[u] / g - prior.center.x();
