@@ -86,7 +86,8 @@ OverlayPicture overlay_picture(const RobotOverlay& o, const CatadioptricCamera& 
   for (double deg : o.strut_angles_deg) {
     const double a = deg2rad(deg);
     const double ca = std::cos(a), sa = std::sin(a);
-    const double xs[2] = {cx + r_in * ca, cx + r_out * ca}, ys[2] = {cy + r_in * sa, cy + r_out * sa};
+    const double xs[2] = {cx + r_in * ca, cx + r_out * ca},
+                 ys[2] = {cy + r_in * sa, cy + r_out * sa};
     const int u0 = static_cast<int>(std::floor(std::min(xs[0], xs[1]) - hw)) - 1;
     const int v0 = static_cast<int>(std::floor(std::min(ys[0], ys[1]) - hw)) - 1;
     const int u1 = static_cast<int>(std::ceil(std::max(xs[0], xs[1]) + hw)) + 1;
@@ -119,7 +120,8 @@ cv::Mat overlay_mask(const OverlayPicture& p, double margin_px) {
   cv::compare(p.coverage, 0.0, masked, cv::CMP_GT);
   const int m = static_cast<int>(std::ceil(margin_px));
   if (m > 0) {
-    cv::dilate(masked, masked, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * m + 1, 2 * m + 1}));
+    cv::dilate(
+        masked, masked, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * m + 1, 2 * m + 1}));
   }
   cv::Mat usable;
   cv::bitwise_not(masked, usable);

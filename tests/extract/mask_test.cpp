@@ -4,8 +4,8 @@
 
 #include <unistd.h>
 
-#include <filesystem>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -62,12 +62,11 @@ TEST_F(MaskFiles, ReadsGreyMasksAndRefusesTheRest) {
   EXPECT_EQ(message(path("m.png"), 640, 480),
             path("m.png") + ": mask is 64x48 but the camera's resolution is 640x480");
   write_image_atomic(path("zero.png"), cv::Mat(48, 64, CV_8U, cv::Scalar(0)));
-  EXPECT_EQ(message(path("zero.png"), 64, 48),
-            path("zero.png") +
-                ": mask has no usable pixel (every pixel is zero; non-zero = usable)");
+  EXPECT_EQ(
+      message(path("zero.png"), 64, 48),
+      path("zero.png") + ": mask has no usable pixel (every pixel is zero; non-zero = usable)");
   write_image_atomic(path("colour.png"), cv::Mat(48, 64, CV_8UC3, cv::Scalar(255, 255, 255)));
-  EXPECT_NE(message(path("colour.png"), 64, 48).find("this one has 3 channels"),
-            std::string::npos);
+  EXPECT_NE(message(path("colour.png"), 64, 48).find("this one has 3 channels"), std::string::npos);
   EXPECT_EQ(message(path("nope.png"), 64, 48), path("nope.png") + ": file not found");
 }
 
@@ -115,8 +114,8 @@ TEST(LineExtractorMask, MaskedEdgesVanishTheOthersStay) {
   // Mask a wedge of +-1.5 degrees around the first line, over the whole annulus.
   const double a = all.front().image_angle;
   cv::Mat mask(p.image.size(), CV_8U, cv::Scalar(255));
-  std::vector<cv::Point> wedge = {cv::Point(static_cast<int>(p.circle.center.x()),
-                                            static_cast<int>(p.circle.center.y()))};
+  std::vector<cv::Point> wedge = {
+      cv::Point(static_cast<int>(p.circle.center.x()), static_cast<int>(p.circle.center.y()))};
   for (double d : {-1.5, 1.5}) {
     const double b = a + deg2rad(d);
     wedge.emplace_back(static_cast<int>(p.circle.center.x() + 400 * std::cos(b)),
@@ -130,8 +129,9 @@ TEST(LineExtractorMask, MaskedEdgesVanishTheOthersStay) {
   masked.extract(p.image, p.circle, rest);
   for (const VerticalLine& l : rest) EXPECT_GT(std::abs(angle_diff(l.image_angle, a)), deg2rad(1));
   for (const auto& e : masked.last_edge_points())
-    EXPECT_EQ(mask.at<uchar>(static_cast<int>(std::lround(e.y)), static_cast<int>(std::lround(e.x))),
-              255);
+    EXPECT_EQ(
+        mask.at<uchar>(static_cast<int>(std::lround(e.y)), static_cast<int>(std::lround(e.x))),
+        255);
   // Every line more than 5 degrees from the wedge: unchanged.
   int far = 0;
   for (const VerticalLine& l : all) {

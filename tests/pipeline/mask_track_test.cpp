@@ -39,9 +39,9 @@ TEST_F(MaskTrack, NoTrackAtTheStrutsWithTheMask) {
   const fs::path dir = scratch("struts");
   sim::simulate(sim::load_world("corridor"), sim::load_trajectory("paper"), cfg, dir.string());
   const fs::path mask = scratch("struts-mask.png");
-  write_image_atomic(mask.string(),
-                     sim::overlay_mask(sim::overlay_picture(cfg.overlay, cfg.camera),
-                                       cfg.overlay.mask_margin_px));
+  write_image_atomic(
+      mask.string(),
+      sim::overlay_mask(sim::overlay_picture(cfg.overlay, cfg.camera), cfg.overlay.mask_margin_px));
 
   dataset::LoadOptions lo;
   lo.require_wheel = false;
@@ -53,13 +53,14 @@ TEST_F(MaskTrack, NoTrackAtTheStrutsWithTheMask) {
   const TrackDatasetResult with = track_dataset(data, masked);
   const int n_without = near_struts(without.rows, cfg.overlay.strut_angles_deg);
   const int n_with = near_struts(with.rows, cfg.overlay.strut_angles_deg);
-  std::printf("detections within 1 degree of a strut in %d frames: %d without the mask, %d with "
-              "it; %zu and %zu detections in all\n",
-              frames,
-              n_without,
-              n_with,
-              without.rows.size(),
-              with.rows.size());
+  std::printf(
+      "detections within 1 degree of a strut in %d frames: %d without the mask, %d with "
+      "it; %zu and %zu detections in all\n",
+      frames,
+      n_without,
+      n_with,
+      without.rows.size(),
+      with.rows.size());
   EXPECT_GE(n_without, frames);  // each strut's edges, in (nearly) every frame
   EXPECT_EQ(n_with, 0);
   EXPECT_EQ(with.frames_skipped, 0);

@@ -88,13 +88,14 @@ TEST(MaskOnSimulatedFrames, StrutIsALineUntilMasked) {
   std::vector<VerticalLine> without, with;
   plain.extract(f.image, f.circle, without);
   masked.extract(f.image, f.circle, with);
-  std::printf("strut at %.2f deg: nearest line %.3f deg without the mask, %.3f deg with it; "
-              "%zu and %zu lines\n",
-              strut,
-              nearest_deg(without, strut),
-              nearest_deg(with, strut),
-              without.size(),
-              with.size());
+  std::printf(
+      "strut at %.2f deg: nearest line %.3f deg without the mask, %.3f deg with it; "
+      "%zu and %zu lines\n",
+      strut,
+      nearest_deg(without, strut),
+      nearest_deg(with, strut),
+      without.size(),
+      with.size());
   EXPECT_LT(nearest_deg(without, strut), 1.0);
   EXPECT_GT(nearest_deg(with, strut), 1.0);
 
@@ -142,8 +143,8 @@ TEST(MaskOnSimulatedFrames, DescriptorChangesOnlyWhereMasked) {
   std::vector<VerticalLine> lines;
   ex.extract(f.image, f.circle, lines);
   ASSERT_FALSE(lines.empty());
-  const VerticalLine line = *std::max_element(
-      lines.begin(), lines.end(), [](const auto& x, const auto& y) {
+  const VerticalLine line =
+      *std::max_element(lines.begin(), lines.end(), [](const auto& x, const auto& y) {
         return x.edge_pixels < y.edge_pixels;
       });
   DescriptorExtractor d;
