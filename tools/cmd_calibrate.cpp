@@ -46,6 +46,7 @@ struct CalibrateArgs {
   std::optional<double> track_bias_sigma_deg;
   double crossing_guard_deg = rad2deg(calib::Options{}.crossing_guard);
   FeaturePipelineOptions pipeline;
+  std::string mask;
   TrackerFlags tracker;
 };
 
@@ -98,6 +99,7 @@ calib::Options calibration_options(const CalibrateArgs& a) {
 void run_calibrate(const CalibrateArgs& a) {
   pipeline::CalibrateDatasetOptions o;
   o.features = a.pipeline;
+  o.mask = a.mask;
   o.tracker = a.tracker.options();
   o.calibration = calibration_options(a);
   o.run = {.refine = a.refine,
@@ -269,6 +271,7 @@ void add_calibrate_command(CLI::App& app) {
   add_prior_options(cmd, *a);
   add_model_options(cmd, *a);
   add_pipeline_options(cmd, a->pipeline);
+  add_mask_option(cmd, a->mask);
   add_tracker_options(cmd, a->tracker);
   cmd->callback([a, cmd] {
     // Extraction and tracking flags given with --tracks do nothing: say so.

@@ -13,6 +13,7 @@
 #include "omnivert/describe/feature_pipeline.hpp"
 #include "omnivert/image/grey.hpp"
 #include "omnivert/image/image_io.hpp"
+#include "omnivert/image/image_mask.hpp"
 #include "omnivert/viz/overlay.hpp"
 #include "pipeline_options.hpp"
 
@@ -28,6 +29,7 @@ struct ExtractArgs {
   bool json = false;
   std::string overlay;
   int highlight = -1;
+  std::string mask;
   FeaturePipelineOptions pipeline;
 };
 
@@ -45,6 +47,15 @@ void run_extract(const ExtractArgs& a) {
     geometry.pixel_format.bayer = *p;
   }
   if (a.bit_depth >= 0) geometry.pixel_format.bit_depth = a.bit_depth;
+  if (!a.mask.empty()) {
+    // Without --sensor the mask gives the size the image must have.
+    geometry.mask = a.mask;
+    if (geometry.width == 0) {
+      const cv::Mat m = read_mask(a.mask);
+      geometry.width = m.cols;
+      geometry.height = m.rows;
+    }
+  }
   FeaturePipeline pipe(geometry, a.pipeline);
   FrameFeatures f;
   if (!pipe.process(image, f, &why)) throw InputError(a.image, 0, why);
@@ -142,6 +153,7 @@ void add_extract_command(CLI::App& app) {
                   args->highlight,
                   "Line whose descriptor areas the overlay draws (default: the longest)");
   add_pipeline_options(cmd, args->pipeline);
+  add_mask_option(cmd, args->mask);
   cmd->callback([args] { run_extract(*args); });
 }
 

@@ -23,6 +23,7 @@ struct TrackArgs {
   std::string dataset;
   std::string out;
   FeaturePipelineOptions pipeline;
+  std::string mask;
   TrackerFlags tracker;
 };
 
@@ -40,6 +41,7 @@ void run_track(const TrackArgs& a) {
 
   TrackDatasetOptions o;
   o.pipeline = a.pipeline;
+  o.mask = a.mask;
   o.tracker = a.tracker.options();
   Progress bar("track", data.size());
   const auto r = track_dataset(data, o, [&](std::size_t done, std::size_t) { bar.update(done); });
@@ -68,6 +70,7 @@ void add_track_command(CLI::App& app) {
   cmd->add_option("DATASET", a->dataset, "Dataset folder (cam0/, optional wheel0/)")->required();
   cmd->add_option("--out", a->out, "Output folder")->required();
   add_pipeline_options(cmd, a->pipeline);
+  add_mask_option(cmd, a->mask);
   add_tracker_options(cmd, a->tracker);
   cmd->callback([a] { run_track(*a); });
 }

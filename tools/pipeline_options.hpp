@@ -17,6 +17,15 @@ namespace omnivert::cli {
 inline constexpr const char* kExtractionGroup = "Extraction (Sec. 2)";
 inline constexpr const char* kDescriptorGroup = "Descriptor (Sec. 3)";
 
+// --mask FILE: the image mask of docs/dataset-format.md#image-mask, instead of sensor.yaml's.
+inline void add_mask_option(CLI::App* cmd, std::string& mask) {
+  cmd->add_option("--mask",
+                  mask,
+                  "Image mask: a one-channel image of the camera's size, non-zero = usable pixel "
+                  "(instead of the mask: of sensor.yaml)")
+      ->group(kExtractionGroup);
+}
+
 inline void add_pipeline_options(CLI::App* cmd, FeaturePipelineOptions& o) {
   const std::string g = kExtractionGroup;
   static const std::map<std::string, LineThreshold> kThreshold{

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <filesystem>
 
 #include <yaml-cpp/yaml.h>
 
@@ -115,6 +116,21 @@ CameraGeometry load_camera_geometry(const std::string& path) {
     g.bearing_sign = static_cast<int>(*s);
   }
   g.pixel_format = load_pixel_format(root, path);
+  if (const auto m = yaml::optional_string(root, "mask", path)) {
+    namespace fs = std::filesystem;
+    const int line = yaml::line_of(root["mask"]);
+    if (m->empty()) throw InputError(path, line, "field 'mask' must name an image file");
+    fs::path p(*m);
+    if (p.is_relative()) p = fs::path(path).parent_path() / p;
+    std::error_code ec;
+    if (!fs::is_regular_file(p, ec)) {
+      throw InputError(path,
+                       line,
+                       "field 'mask': file '" + *m + "' not found (looked for " + p.string() +
+                           "; the path is relative to the folder of this file)");
+    }
+    g.mask = p.string();
+  }
   return g;
 }
 

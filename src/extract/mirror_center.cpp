@@ -9,6 +9,7 @@
 
 #include "extract/rim_geometry.hpp"
 #include "omnivert/core/angles.hpp"
+#include "omnivert/image/image_mask.hpp"
 
 namespace omnivert {
 
@@ -37,7 +38,22 @@ void set_why(std::string* why, const std::string& m) {
   if (why) *why = m;
 }
 
+// The usable mask of a reduced image: a small pixel is usable when all the pixels it averages
+// are, and its Sobel window is then shrunk by one small pixel. Empty stays empty.
+cv::Mat shrink_mask(const cv::Mat& usable, cv::Size small) {
+  if (usable.empty() || usable.size() == small) return usable;
+  cv::Mat s;
+  cv::resize(usable, s, small, 0, 0, cv::INTER_AREA);
+  cv::compare(s, 255, s, cv::CMP_GE);
+  return erode_mask(s, 1);
+}
+
 }  // namespace
+
+void MirrorCenterDetector::set_mask(const cv::Mat& usable) {
+  CV_Assert(usable.empty() || usable.type() == CV_8UC1);
+  usable_ = usable.empty() || mask_all_usable(usable) ? cv::Mat() : erode_mask(usable, 1);
+}
 
 bool MirrorCenterDetector::refine(const cv::Mat& gray,
                                   Eigen::Vector2d& center,
@@ -55,9 +71,10 @@ bool MirrorCenterDetector::refine(const cv::Mat& gray,
       bool ok = true;
       for (int i = 0; i < n && ok; ++i) {
         const Eigen::Vector2d p = center + (rim_radius - W + i * step) * d;
-        ok = rim::sample(gray, p.x(), p.y(), prof[i]);
+        ok = rim::sample(gray, p.x(), p.y(), prof[i]) &&
+             (usable_.empty() || rim::usable_at(usable_, p));
       }
-      if (!ok) continue;
+      if (!ok) continue;  // outside the image or masked
       for (int s = 0; s < 2; ++s) {
         const double sgn = s == 0 ? -1.0 : 1.0;
         int best = -1;
@@ -95,6 +112,7 @@ namespace {
 std::optional<rim::RimFit> find_rim(const cv::Mat& gray,
                                     const CameraGeometry& geometry,
                                     const MirrorCenterOptions& options_,
+                                    const cv::Mat& usable,
                                     std::string* why) {
   // Candidate circles (centre, radius) on a copy no larger than 320 pixels across.
   const double scale = std::min(1.0, 320.0 / std::max(gray.cols, gray.rows));
@@ -103,6 +121,7 @@ std::optional<rim::RimFit> find_rim(const cv::Mat& gray,
     cv::resize(gray, small, cv::Size(), scale, scale, cv::INTER_AREA);
   else
     small = gray;
+  const cv::Mat small_usable = shrink_mask(usable, small.size());
   const int diag = static_cast<int>(std::hypot(small.cols, small.rows) / 2);
   // The rim is larger than the self-reflection: at least 30% of the image's smaller side.
   int r_lo = static_cast<int>(0.3 * std::min(small.cols, small.rows)), r_hi = diag;
@@ -117,7 +136,8 @@ std::optional<rim::RimFit> find_rim(const cv::Mat& gray,
     cv::Sobel(small, gx, CV_16S, 1, 0, 3);
     cv::Sobel(small, gy, CV_16S, 0, 1, 3);
     const Eigen::Vector2d c = *geometry.center * scale;
-    const auto cov = rim::radial_edge_coverage(gx, gy, c, diag, options_.edge_threshold, 0);
+    const auto cov =
+        rim::radial_edge_coverage(gx, gy, c, diag, options_.edge_threshold, 0, small_usable);
     for (int r = std::max(r_lo, 2); r < std::min(r_hi, diag); ++r)
       if (cov[r] >= 0.3 && cov[r] >= cov[r - 1] && cov[r] > cov[r + 1])
         cands.push_back({c, double(r), cov[r]});
@@ -125,7 +145,7 @@ std::optional<rim::RimFit> find_rim(const cv::Mat& gray,
         cands.begin(), cands.end(), [](const auto& x, const auto& y) { return x.score > y.score; });
     if (cands.size() > 8) cands.resize(8);
   } else {
-    cands = rim::hough_circles(small, r_lo, r_hi, options_.edge_threshold, 10, 6.0);
+    cands = rim::hough_circles(small, r_lo, r_hi, options_.edge_threshold, 10, 6.0, small_usable);
   }
   // Each candidate is refined on rays at full resolution; the rim is the candidate found on
   // the largest part of its visible circumference, with enough arc to fix a centre.
@@ -139,7 +159,7 @@ std::optional<rim::RimFit> find_rim(const cv::Mat& gray,
     double window = std::max(options_.rim_window, 2.0 / scale + 2.0);
     bool ok = true;
     for (int pass = 0; pass < 3 && ok; ++pass) {
-      ok = rim::fit_rim_on_rays(gray, c, r, window, options_.rim_rays, fit);
+      ok = rim::fit_rim_on_rays(gray, c, r, window, options_.rim_rays, fit, usable);
       c = fit.center;
       r = fit.radius;
       window = options_.rim_window;
@@ -166,7 +186,7 @@ std::optional<MirrorCircle> MirrorCenterDetector::estimate(const cv::Mat& gray,
                                                            std::string* why) const {
   CV_Assert(gray.type() == CV_8UC1);
   std::string reason;
-  const auto fit = find_rim(gray, geometry, options_, &reason);
+  const auto fit = find_rim(gray, geometry, options_, usable_, &reason);
   Eigen::Vector2d center;
   double rim_radius = 0;
   if (fit) {
@@ -211,8 +231,13 @@ double MirrorCenterDetector::self_reflection_radius(const cv::Mat& gray,
   cv::Sobel(small, gy, CV_16S, 0, 1, 3);
   // The camera's own reflection: a dark disc, so brighter-outward circular edges.
   const int rmax_search = static_cast<int>(std::hypot(small.cols, small.rows) / 2);
-  const auto inner =
-      rim::radial_edge_coverage(gx, gy, center * scale, rmax_search, options_.edge_threshold, +1);
+  const auto inner = rim::radial_edge_coverage(gx,
+                                               gy,
+                                               center * scale,
+                                               rmax_search,
+                                               options_.edge_threshold,
+                                               +1,
+                                               shrink_mask(usable_, small.size()));
   const double rim = r_max * scale;
   double best = 0;
   int disc = 0;
@@ -249,6 +274,7 @@ std::optional<MirrorCircle> MirrorCenterDetector::detect(const cv::Mat& gray,
     const short* px = gx.ptr<short>(v);
     const short* py = gy.ptr<short>(v);
     const double y = roi.y + v;
+    const uchar* ok = usable_.empty() ? nullptr : usable_.ptr<uchar>(roi.y + v) + roi.x;
     for (int u = 1; u < roi.width - 1; ++u) {
       const double x = roi.x + u;
       const double dx = x - prior.center.x(), dy = y - prior.center.y();
@@ -256,6 +282,7 @@ std::optional<MirrorCircle> MirrorCenterDetector::detect(const cv::Mat& gray,
       if (d2 < band_lo * band_lo || d2 > band_hi * band_hi) continue;
       const double g2 = double(px[u]) * px[u] + double(py[u]) * py[u];
       if (g2 < t2) continue;
+      if (ok && !ok[u]) continue;  // masked pixels cast no vote
       const double g = std::sqrt(g2);
       for (int sgn = -1; sgn <= 1; sgn += 2) {
         const double cx = x + sgn * R * px[u] / g - prior.center.x();

@@ -104,6 +104,14 @@ Eigen::Vector2d accumulator_peak(cv::Mat& acc, double sigma) {
   return {loc.x + dx, loc.y + dy};
 }
 
+bool usable_at(const cv::Mat& usable, const Eigen::Vector2d& p) {
+  // The four pixels of a bilinear sample at p (inside the image: sample() checked it).
+  const int x0 = static_cast<int>(p.x()), y0 = static_cast<int>(p.y());
+  const uchar* r0 = usable.ptr<uchar>(y0);
+  const uchar* r1 = usable.ptr<uchar>(y0 + 1);
+  return r0[x0] && r0[x0 + 1] && r1[x0] && r1[x0 + 1];
+}
+
 // Fraction of the in-image circumference at each integer radius covered by edge pixels with
 // a radial gradient of the given sign (+1: brighter outward, -1: darker outward).
 std::vector<double> radial_edge_coverage(const cv::Mat& gx,
@@ -111,14 +119,17 @@ std::vector<double> radial_edge_coverage(const cv::Mat& gx,
                                          const Eigen::Vector2d& c,
                                          int r_max,
                                          double threshold,
-                                         int sign) {
+                                         int sign,
+                                         const cv::Mat& usable) {
   std::vector<double> hits(r_max + 2, 0.0), total(r_max + 2, 0.0);
   const double t2 = threshold * threshold;
   const double cos20 = std::cos(deg2rad(20.0));
   for (int v = 1; v < gx.rows - 1; ++v) {
     const short* px = gx.ptr<short>(v);
     const short* py = gy.ptr<short>(v);
+    const uchar* ok = usable.empty() ? nullptr : usable.ptr<uchar>(v);
     for (int u = 1; u < gx.cols - 1; ++u) {
+      if (ok && !ok[u]) continue;  // masked: neither on the circumference nor a hit
       const double dx = u - c.x(), dy = v - c.y();
       const double rr = std::sqrt(dx * dx + dy * dy);
       const int ri = static_cast<int>(rr + 0.5);
@@ -143,8 +154,13 @@ std::vector<double> radial_edge_coverage(const cv::Mat& gx,
   return sm;
 }
 
-std::vector<CircleCandidate> hough_circles(
-    const cv::Mat& gray, int r_lo, int r_hi, double threshold, int count, double separation) {
+std::vector<CircleCandidate> hough_circles(const cv::Mat& gray,
+                                           int r_lo,
+                                           int r_hi,
+                                           double threshold,
+                                           int count,
+                                           double separation,
+                                           const cv::Mat& usable) {
   std::vector<CircleCandidate> out;
   r_lo = std::max(r_lo, 2);
   if (r_hi <= r_lo + 2) return out;
@@ -159,9 +175,11 @@ std::vector<CircleCandidate> hough_circles(
   for (int v = 1; v < H - 1; ++v) {
     const short* px = gx.ptr<short>(v);
     const short* py = gy.ptr<short>(v);
+    const uchar* ok = usable.empty() ? nullptr : usable.ptr<uchar>(v);
     for (int u = 1; u < W - 1; ++u) {
       const double g2 = double(px[u]) * px[u] + double(py[u]) * py[u];
       if (g2 < t2) continue;
+      if (ok && !ok[u]) continue;  // masked pixels cast no vote
       const double g = std::sqrt(g2);
       const double ex = px[u] / g, ey = py[u] / g;
       for (int k = 0; k < R; ++k) {
@@ -218,7 +236,8 @@ bool fit_rim_on_rays(const cv::Mat& gray,
                      double radius,
                      double window,
                      int rays,
-                     RimFit& out) {
+                     RimFit& out,
+                     const cv::Mat& usable) {
   const double step = 0.5;
   const int n = static_cast<int>(2 * window / step) + 1;
   std::vector<double> prof(n), der(n, 0.0);
@@ -230,9 +249,9 @@ bool fit_rim_on_rays(const cv::Mat& gray,
     bool ok = true;
     for (int i = 0; i < n && ok; ++i) {
       const Eigen::Vector2d p = center + (radius - window + i * step) * d;
-      ok = sample(gray, p.x(), p.y(), prof[i]);
+      ok = sample(gray, p.x(), p.y(), prof[i]) && (usable.empty() || usable_at(usable, p));
     }
-    if (!ok) continue;
+    if (!ok) continue;  // outside the image or masked: not part of the visible rim
     ++out.rays_inside;
     int best = -1;
     double best_v = 0;

@@ -12,6 +12,8 @@ namespace omnivert::rim {
 
 // Bilinear sample of an 8-bit image; false outside.
 bool sample(const cv::Mat& img, double x, double y, double& out);
+// True when the four pixels of a bilinear sample at p are usable (p inside the image).
+bool usable_at(const cv::Mat& usable, const Eigen::Vector2d& p);
 
 // Least-squares circle through points: algebraic (Kasa) start, then Gauss-Newton on the
 // geometric distance, with outliers beyond 3 robust sigmas removed between passes. When
@@ -27,13 +29,14 @@ Eigen::Vector2d accumulator_peak(cv::Mat& acc, double sigma);
 
 // Fraction of the in-image circumference at each integer radius covered by edge pixels with
 // a radial gradient of the given sign (+1: brighter outward, -1: darker outward, 0: either),
-// smoothed over +-1 pixel.
+// smoothed over +-1 pixel. Masked pixels (`usable` zero; empty: none) count neither way.
 std::vector<double> radial_edge_coverage(const cv::Mat& gx,
                                          const cv::Mat& gy,
                                          const Eigen::Vector2d& c,
                                          int r_max,
                                          double threshold,
-                                         int sign);
+                                         int sign,
+                                         const cv::Mat& usable = cv::Mat());
 
 struct CircleCandidate {
   Eigen::Vector2d center;
@@ -45,8 +48,14 @@ struct CircleCandidate {
 // threshold) votes, for every radius in [r_lo, r_hi], at the two points one radius away
 // along its gradient line, so either polarity counts. Centres lie inside the image. Returns
 // up to `count` peaks, best first, at least `separation` pixels apart in centre or radius.
-std::vector<CircleCandidate> hough_circles(
-    const cv::Mat& gray, int r_lo, int r_hi, double threshold, int count, double separation);
+// Masked edge pixels (`usable` zero; empty: none) cast no vote.
+std::vector<CircleCandidate> hough_circles(const cv::Mat& gray,
+                                           int r_lo,
+                                           int r_hi,
+                                           double threshold,
+                                           int count,
+                                           double separation,
+                                           const cv::Mat& usable = cv::Mat());
 
 // A rim fitted from points found along rays.
 struct RimFit {
@@ -66,12 +75,14 @@ struct RimFit {
 // radial intensity step of either sign within +-window of `radius` (at least 4 grey levels
 // per pixel), then a robust circle fit. Rays whose window leaves the image are skipped, so a
 // rim partly outside the image is fitted on its visible arcs. Returns false when fewer than
-// 8 points were found or the fit fails.
+// 8 points were found or the fit fails. A ray whose window touches a masked pixel (`usable`
+// zero; empty: none) is skipped like one that leaves the image.
 bool fit_rim_on_rays(const cv::Mat& gray,
                      const Eigen::Vector2d& center,
                      double radius,
                      double window,
                      int rays,
-                     RimFit& out);
+                     RimFit& out,
+                     const cv::Mat& usable = cv::Mat());
 
 }  // namespace omnivert::rim

@@ -58,6 +58,7 @@ TrackDatasetResult tracks_of(const dataset::Dataset& data,
   if (given) return std::move(*given);
   TrackDatasetOptions to;
   to.pipeline = o.features;
+  to.mask = o.mask;
   to.tracker = o.tracker;
   return track_dataset(data, to, [&](std::size_t done, std::size_t total) {
     if (o.progress) o.progress("track", done, total);

@@ -23,7 +23,9 @@ TrackDatasetResult track_dataset(const dataset::Dataset& data,
     }
   }
   Tracker tracker(to);
-  FeaturePipeline pipe(data.camera(), options.pipeline);
+  CameraGeometry camera = data.camera();
+  if (!options.mask.empty()) camera.mask = options.mask;
+  FeaturePipeline pipe(camera, options.pipeline);
   TrackDatasetResult out;
   std::vector<TrackAssignment> assignments;
   FrameFeatures f;

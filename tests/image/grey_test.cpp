@@ -50,14 +50,15 @@ cv::Mat colour_blocks(int depth_scale, int type) {
   const cv::Vec3d bgr[4] = {{0, 0, 255}, {0, 255, 0}, {255, 0, 0}, {40, 120, 200}};
   for (int k = 0; k < 4; ++k) {
     m(cv::Rect(32 * k, 0, 32, 32))
-        .setTo(cv::Scalar(
-            bgr[k][0] * depth_scale, bgr[k][1] * depth_scale, bgr[k][2] * depth_scale));
+        .setTo(
+            cv::Scalar(bgr[k][0] * depth_scale, bgr[k][1] * depth_scale, bgr[k][2] * depth_scale));
   }
   return m;
 }
 
 void expect_block_lumas(const cv::Mat1b& g, double tolerance) {
-  const double expected[4] = {luma(255, 0, 0), luma(0, 255, 0), luma(0, 0, 255), luma(200, 120, 40)};
+  const double expected[4] = {
+      luma(255, 0, 0), luma(0, 255, 0), luma(0, 0, 255), luma(200, 120, 40)};
   for (int k = 0; k < 4; ++k) {
     // The block's interior: JPEG blurs colour across block borders.
     const double v = cv::mean(g(cv::Rect(32 * k + 8, 8, 16, 16)))[0];

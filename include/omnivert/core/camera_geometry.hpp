@@ -44,6 +44,11 @@ struct CameraGeometry {
   int bearing_sign = 1;
   // Bayer pattern and bit depth of the stored images (fields 'bayer' and 'bit_depth').
   PixelFormat pixel_format;
+  // Image mask (`mask:`, a path relative to the yaml's folder, stored resolved): a one-channel
+  // image of the camera's resolution whose non-zero pixels are usable; every stage ignores the
+  // others (robot, struts, cables). Absent: every pixel is usable. Read by the image stage
+  // (read_mask): core has no image reader.
+  std::optional<std::string> mask;
 
   // Camera bearing of an image angle (docs/theory/conventions.md).
   double bearing_of_image_angle(double a) const;
@@ -55,7 +60,8 @@ struct CameraGeometry {
 // simulator adds its intrinsics). Throws InputError naming the file, the line and the field
 // for: a missing file, YAML that does not parse, a missing or non-numeric resolution,
 // negative or non-numeric values, r_min >= r_max, bearing_sign other than +-1, an unknown
-// bayer pattern, a bit_depth outside 9..16.
+// bayer pattern, a bit_depth outside 9..16, a mask field that is not a file name or names a
+// file that does not exist.
 CameraGeometry load_camera_geometry(const std::string& path);
 
 }  // namespace omnivert

@@ -35,7 +35,15 @@ struct FeaturePipelineOptions {
 
 class FeaturePipeline {
  public:
+  // With geometry.mask set, reads that mask (read_mask: InputError naming the mask file) and
+  // hands it to every stage (set_mask).
   FeaturePipeline(CameraGeometry geometry, FeaturePipelineOptions options = {});
+
+  // Image mask for every stage (image_mask.hpp: CV_8UC1, non-zero = usable; empty: none).
+  // The first frame is refused when less than kMinUsableAnnulus of the annulus is usable.
+  void set_mask(const cv::Mat& usable);
+  const cv::Mat& mask() const { return mask_; }
+  static constexpr double kMinUsableAnnulus = 0.2;
 
   // Processes one image (8-bit or 16-bit, grey, colour or a Bayer mosaic: converted to 8-bit
   // grey by to_grey8 with the camera's pixel_format). Returns
@@ -63,9 +71,14 @@ class FeaturePipeline {
   DescriptorExtractor descriptors_;
   std::optional<MirrorCircle> circle_;
   cv::Mat gray_;
+  cv::Mat mask_;
 };
 
 // Fraction of the annulus r_min..r_max around `circle.center` that lies inside a w x h image.
 double annulus_fraction_inside(const MirrorCircle& circle, int width, int height);
+
+// Fraction of the annulus r_min..r_max around `circle.center`, inside the mask's image, that
+// the mask leaves usable (area-weighted samples, as above).
+double annulus_fraction_usable(const MirrorCircle& circle, const cv::Mat& usable);
 
 }  // namespace omnivert

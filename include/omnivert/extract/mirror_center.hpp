@@ -79,8 +79,15 @@ class MirrorCenterDetector {
 
   const MirrorCenterOptions& options() const { return options_; }
 
+  // Image mask (image_mask.hpp: CV_8UC1, non-zero = usable) for the following calls, whose
+  // images must have its size. Pixels whose Sobel window touches a masked pixel cast no
+  // centre votes and do not count in the rim's coverage, and rays whose rim window touches
+  // one give no rim point. An empty or all-usable mask: no mask (bit-identical results).
+  void set_mask(const cv::Mat& usable);
+
  private:
   MirrorCenterOptions options_;
+  cv::Mat usable_;  // the mask eroded by the Sobel radius; empty: no mask
 };
 
 }  // namespace omnivert

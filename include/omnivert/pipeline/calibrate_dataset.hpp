@@ -31,6 +31,8 @@ namespace omnivert::pipeline {
 
 struct CalibrateDatasetOptions {
   FeaturePipelineOptions features;  // extraction and descriptor (Sec. 2-3)
+  // Image mask file used instead of the `mask:` of cam0/sensor.yaml; empty: that one, if any.
+  std::string mask;
   // The tracker; its odometry gate takes the wheel base of wheel0/sensor.yaml.
   TrackerOptions tracker = recommended_dataset_tracker_options();
   // Prior and models. The wheel base and Chong-Kleeman K come from wheel0/sensor.yaml

@@ -26,6 +26,9 @@ struct TrackDatasetOptions {
   // Use the wheel odometry for the tracker's bearing gate when the dataset has it (and the
   // gate is enabled in `tracker`; its wheel base is taken from wheel0/sensor.yaml).
   bool use_odometry = true;
+  // Image mask file (image_mask.hpp) used instead of the `mask:` of cam0/sensor.yaml; empty:
+  // that one, if any.
+  std::string mask;
 };
 
 struct TrackDatasetResult {
