@@ -147,10 +147,10 @@ std::optional<rim::RimFit> find_rim(const cv::Mat& gray,
   } else {
     cands = rim::hough_circles(small, r_lo, r_hi, options_.edge_threshold, 10, 6.0, small_usable);
   }
-  // Each candidate is refined on rays at full resolution; the rim is the candidate found on
-  // the largest part of its visible circumference, with enough arc to fix a centre.
+  // Each candidate is refined on rays at full resolution; the rim is the candidate found
+  // within 1 px on the most rays, on at least 30% of its visible circumference, with enough
+  // arc to fix a centre (a mirror holder's ring cut by the frame loses to the rim inside it).
   std::optional<rim::RimFit> best;
-  double best_coverage = 0;
   const int min_points = options_.rim_rays / 4;
   for (const auto& cand : cands) {
     rim::RimFit fit;
@@ -167,9 +167,9 @@ std::optional<rim::RimFit> find_rim(const cv::Mat& gray,
     if (!ok || fit.inliers < min_points || fit.quadrants < 3 || fit.rms > 2.0) continue;
     if (geometry.center && (fit.center - *geometry.center).norm() > options_.search_radius)
       continue;
-    if (fit.coverage() > best_coverage) best_coverage = fit.coverage(), best = fit;
+    if (fit.coverage() >= 0.3 && (!best || fit.close > best->close)) best = fit;
   }
-  if (!best || best_coverage < 0.3) {
+  if (!best) {
     set_why(why,
             "no mirror rim found (no circle of edges, darker or brighter outward, on enough of "
             "its visible arc around a centre inside the image); give center, r_min and r_max "

@@ -14,12 +14,12 @@
 // smaller side up, so a rim darker or brighter outward counts alike) on a copy at most 320
 // pixels across; each of the best ten circles is refined on rays at full resolution (the
 // strongest radial step of either sign near the circle, a robust circle fit) and the rim is
-// the circle found within one pixel on the largest part of its circumference inside the
-// image. Rays that leave the image are skipped, so a rim cut off by the frame is fitted on
-// its visible arcs; the fit must hold a quarter of the rays and three quadrants of the
-// circle (docs/extraction.md#mirror-centre-and-annulus). This is meant for one static
-// image, as in the paper, and its result seeds `detect`; `estimate_camera`
-// (extract/camera_estimate.hpp) combines many frames.
+// the circle found within one pixel on the most rays (at least 30% of its circumference
+// inside the image). Rays that leave the image are skipped, so a rim cut off by the frame is fitted
+// on its visible arcs; the fit must hold a quarter of the rays and three quadrants of the circle
+// (docs/extraction.md#mirror-centre-and-annulus). This is meant for one static image, as in the
+// paper, and its result seeds `detect`; `estimate_camera` (extract/camera_estimate.hpp) combines
+// many frames.
 
 #include <optional>
 #include <string>
