@@ -218,18 +218,18 @@ json inputs_json(const CalibrationResult& r, const ReportInputs& in) {
     inputs["frames_dropped_for_wheel_gaps"] = in.run->frames_dropped_for_gaps;
     inputs["frames_with_too_few_lines"] = in.run->starved_frames;
   }
-  inputs["wheel_base_m"] = num(in.options.wheel_base);
-  inputs["odometry_K_m"] = num(in.options.odometry_K);
-  inputs["odometry_inflation"] = num(in.options.odometry_inflation);
+  inputs["wheel_base_m"] = num(in.options.robot.wheel_base);
+  inputs["odometry_K_m"] = num(in.options.robot.odometry_K);
+  inputs["odometry_inflation"] = num(in.options.filter.odometry_inflation);
   inputs["bearing_sigma_deg"] = num(rad2deg(r.bearing_sigma));
   inputs["track_bias_sigma_deg"] = num(rad2deg(r.track_bias_sigma));
 
-  inputs["prior"] = {{"phi", num(in.options.prior.phi)},
-                     {"rho", num(in.options.prior.rho)},
-                     {"psi", num(in.options.prior.psi)},
-                     {"sigma_phi", num(in.options.prior_sigma(0))},
-                     {"sigma_rho", num(in.options.prior_sigma(1))},
-                     {"sigma_psi", num(in.options.prior_sigma(2))}};
+  inputs["prior"] = {{"phi", num(in.options.prior.mean.phi)},
+                     {"rho", num(in.options.prior.mean.rho)},
+                     {"psi", num(in.options.prior.mean.psi)},
+                     {"sigma_phi", num(in.options.prior.sigma(0))},
+                     {"sigma_rho", num(in.options.prior.sigma(1))},
+                     {"sigma_psi", num(in.options.prior.sigma(2))}};
   return inputs;
 }
 
@@ -258,7 +258,8 @@ json filter_json(const FilterResult& f) {
   j["window_solved"] = f.window_frames > 0 && f.window_failure.empty();
   if (!f.window_failure.empty()) j["window_failure"] = f.window_failure;
   j["splits"] = splits_json(f.splits);
-  // Bearings left out where lines cross (Options::crossing_guard), window and EKF.
+  // Bearings left out where lines cross (CalibrationOptions::association.crossing_guard), window
+  // and EKF.
   j["bearings_guarded"] = f.guarded.size();
   // Refused by the chi-square gate (outliers), window and EKF.
   j["bearings_rejected"] = f.rejected.size();
@@ -291,7 +292,7 @@ json noise_check_json(const CalibrationResult& r) {
   nc["checked"] = r.noise_checked;
   nc["applied"] = r.noise_applied;  // the reported covariance is the checked one
   nc["verdict"] = verdict_name(r.noise_verdict);
-  // The levels of the verdict's sides (CalibrateOptions::noise_check_level, _lower_level).
+  // The levels of the verdict's sides (CalibrationOptions::noise_check.level, lower_level).
   nc["level_more_noise"] = r.noise_check_level;
   nc["level_less_noise"] = r.noise_check_lower_level;
   nc["scale"] = num(n.ok ? n.scale : NAN);
@@ -390,7 +391,7 @@ void html_estimates(std::ostringstream& h, const CalibrationResult& r, const Rep
     h << "</td><td>" << f("%.2f", p(0) * 1e3) << "</td><td>" << f("%.2f", p(1) * 1e3) << "</td><td>"
       << f("%.3f", rad2deg(e.yaw())) << "</td></tr>\n";
   };
-  row("prior (hand measurement)", in.options.prior, nullptr);
+  row("prior (hand measurement)", in.options.prior.mean, nullptr);
   row("filter (Sec. 8.2)", r.filter.extrinsics, &r.filter.covariance);
   if (r.refined && r.refinement.covariance_ok)
     row("batch refinement (--refine)", r.refinement.extrinsics, &r.refinement.covariance);
@@ -442,8 +443,8 @@ void html_inputs(std::ostringstream& h, const CalibrationResult& r, const Report
     kv("frames dropped for wheel gaps", std::to_string(in.run->frames_dropped_for_gaps));
   }
   kv("wheel base e / Chong-Kleeman K (x inflation)",
-     f("%.4f m", in.options.wheel_base) + " / " + f("%.3g m", in.options.odometry_K) + " (x" +
-         f("%g", in.options.odometry_inflation) + ")");
+     f("%.4f m", in.options.robot.wheel_base) + " / " + f("%.3g m", in.options.robot.odometry_K) +
+         " (x" + f("%g", in.options.filter.odometry_inflation) + ")");
   kv("bearing sigma", bearing_noise_text(r.bearing_sigma, r.track_bias_sigma));
   kv("noise check", r.noise_checked ? noise_check_line(r) : std::string("not made"));
   {

@@ -3,9 +3,10 @@
 //   filter (Sec. 8.2) -> observability and Cramer-Rao bounds (Sec. 8.1) -> optional batch
 //   maximum-likelihood refinement (Ceres) -> outputs.
 //
-//   omnivert::calib::CalibrationRun run;          // one FrameInput per image
-//   omnivert::calib::Options options;             // wheel base, K, bearing sigma, prior...
-//   auto result = omnivert::calib::calibrate(run, options, {.refine = true});
+//   omnivert::calib::CalibrationRun run;              // one FrameInput per image
+//   omnivert::calib::CalibrationOptions options;      // options.hpp: robot, noise, prior...
+//   options.refinement.enabled = true;
+//   auto result = omnivert::calib::calibrate(run, options);
 //   if (!result.observability.all_determined() && !force) -> print message, exit code 3
 //   omnivert::calib::write_extrinsics_yaml(dir + "/extrinsics.yaml", result);
 //   omnivert::calib::write_states_csv(dir + "/states.csv", result.filter.history);
@@ -16,45 +17,11 @@
 #include "omnivert/calib/calibration_filter.hpp"
 #include "omnivert/calib/diagnostics.hpp"
 #include "omnivert/calib/observability.hpp"
+#include "omnivert/calib/options.hpp"
 #include "omnivert/calib/refinement.hpp"
 #include "omnivert/calib/track_ids.hpp"
-#include "omnivert/calib/types.hpp"
 
 namespace omnivert::calib {
-
-struct CalibrateOptions {
-  bool refine = false;
-  // The data's check of the bearing noise (BatchNoiseCheck, at a batch solution): where it
-  // shows more noise than the model allows (noise_check_verdict), the reported covariance
-  // becomes the checked one. The refinement's: model + (scale - 1) x its bearing part. The
-  // filter's: scaled by the overall variance ratio tr(model^-1 checked) / 3 of a check on its
-  // own tracks (split only where its window split them), a batch solved for the check alone.
-  // Where it shows less noise than the model assumes, the bearings' share of the covariance
-  // is shrunk the same way (the refinement's: the checked covariance; the filter's: plus the
-  // checked minus the model covariance of its own check), but only when the tracker kept its
-  // lines: at most noise_check_lower_max_joins pieces joined per track checked. A tracker that
-  // loses lines leaves pieces of one line that the joins miss, independent tracks to the
-  // check, which then reads less noise than there is: runs with tracks broken every ~10
-  // frames join 2.6-7.4 pieces per track (our tracker's runs from pixels at most 0.6), and
-  // shrunk they would be overconfident (docs/theory/noise-check.md#verdicts). Otherwise the
-  // verdict is reported and the covariances kept (noise_check_line names the sigma the data
-  // want).
-  // false: no check, the model's covariances.
-  bool noise_check = true;
-  // The levels of noise_check_verdict's two sides. "More noise" at 1%: enlarging sigmas that
-  // were right costs accuracy nowhere and is rare. "Less noise" at 20%: when the model is
-  // right, 1 run in 5 is shrunk, a mean NEES 0.10-0.15 higher (synthetic, 0.03 degree, 200
-  // runs: still inside the 95% interval [2.67, 3.35]); where the model's
-  // sigma is too large, most runs are (from pixels, corridor, paper trajectory, 188 of 200
-  // runs; at 1% 74 of 200; docs/theory/noise-check.md#verdicts).
-  double noise_check_level = 0.01;
-  double noise_check_lower_level = 0.2;
-  // Pieces joined per track checked above which "less noise" is reported, not applied (< 0:
-  // never applied).
-  double noise_check_lower_max_joins = 0.5;
-  BatchOptions batch;
-  ObservabilityOptions observability;
-};
 
 struct CalibrationResult {
   FilterResult filter;
@@ -64,15 +31,16 @@ struct CalibrationResult {
   // The answer: the refinement's when refined and its covariance exists, else the filter's.
   Extrinsics extrinsics;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  double bearing_sigma = 0.0;     // the bearing sigma used by the models [rad]
-  double track_bias_sigma = 0.0;  // Options::track_bias_sigma used by the models [rad]
+  double bearing_sigma = 0.0;  // the bearing sigma used by the models [rad]
+  double track_bias_sigma =
+      0.0;  // CalibrationOptions::noise.track_bias_sigma used by the models [rad]
   // Refinement only: its covariance came from the Fisher information of the observability
   // analysis (the inverse of the same information) because ceres::Covariance failed.
   bool covariance_from_information = false;
-  // CalibrateOptions::noise_check. noise: the check of the reported estimate (the
+  // CalibrationOptions::noise_check. noise: the check of the reported estimate (the
   // refinement's when refined, else the filter's), valid when noise_checked; noise_verdict:
   // what it found; noise_applied: it showed more noise than the model allows and the
-  // reported covariance is the checked one (CalibrateOptions::noise_check); noise_ratio: the
+  // reported covariance is the checked one (CalibrationOptions::noise_check); noise_ratio: the
   // overall variance ratio tr(model^-1 checked) / 3 then (1 when not applied). filter_noise: the
   // check of the filter on its own tracks (split only where its window split them), its
   // verdict, and the filter's variance ratio (1 when not applied). The model's covariances
@@ -86,7 +54,7 @@ struct CalibrationResult {
   NoiseVerdict filter_noise_verdict = NoiseVerdict::kAgrees;
   bool filter_noise_applied = false;
   double filter_noise_ratio = 1.0;
-  // CalibrateOptions::noise_check_level and noise_check_lower_level, as used.
+  // CalibrationOptions::noise_check.level and lower_level, as used.
   double noise_check_level = 0.01;
   double noise_check_lower_level = 0.2;
   Eigen::Matrix3d filter_model_covariance = Eigen::Matrix3d::Zero();
@@ -97,7 +65,7 @@ struct CalibrationResult {
 // The independent bearing noise [rad] that would do the harm the noise check found:
 // bearing_sigma x sqrt(noise.scale) (the sigma its messages advise); NaN when not checked.
 double effective_bearing_sigma(const CalibrationResult& result);
-// The same for the per-track part (Options::track_bias_sigma): track_bias_sigma x
+// The same for the per-track part (CalibrationOptions::noise.track_bias_sigma): track_bias_sigma x
 // sqrt(noise.scale); 0 when the model has none, NaN when not checked.
 double effective_track_bias_sigma(const CalibrationResult& result);
 // The bearing noise model in words, e.g. "0.025 deg" or "0.018 deg + 0.016 deg per track",
@@ -111,9 +79,7 @@ std::string noise_check_flags(const CalibrationResult& result);
 std::string noise_check_chance(double limit, const char* side, double level);
 
 // Throws InputError on invalid options or input (non-finite values, repeated track ids).
-CalibrationResult calibrate(const CalibrationRun& run,
-                            const Options& options,
-                            const CalibrateOptions& calibrate_options = {});
+CalibrationResult calibrate(const CalibrationRun& run, const CalibrationOptions& options = {});
 
 // What a user should be told about a result (empty when nothing): the filter's gate refused
 // more than 20% of the bearings after its start-up window (it has probably diverged, or the
