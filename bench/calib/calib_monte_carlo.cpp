@@ -307,11 +307,11 @@ void add_crlb(const SyntheticRun& run, const CalibrationOptions& fo, const Args&
 // With --refine: the refinement's errors, the noise check, and the joins of pieces.
 void add_refinement(int r, const SyntheticRun& run, const CalibrationResult& cr, Totals& t) {
   if (cr.refinement.covariance_ok) {
-    t.ref.add(cr.refinement.extrinsics, cr.refinement_model_covariance, run.truth);
-    if (cr.noise_checked) {
-      t.scales.push_back(cr.noise.scale);
-      t.applied += cr.noise_applied ? 1 : 0;
-      t.filter_applied += cr.filter_noise_applied ? 1 : 0;
+    t.ref.add(cr.refinement.extrinsics, cr.noise_check.refinement_model_covariance, run.truth);
+    if (cr.noise_check.checked) {
+      t.scales.push_back(cr.noise_check.check.scale);
+      t.applied += cr.noise_check.applied ? 1 : 0;
+      t.filter_applied += cr.noise_check.filter_applied ? 1 : 0;
       t.ref_checked.add(cr.refinement.extrinsics, cr.refinement.covariance, run.truth);
       t.filt_checked.add(cr.filter.extrinsics, cr.filter.covariance, run.truth);
     }
@@ -377,7 +377,8 @@ void run_once(
     cr = calibrate(run.run, co);
   }
   const FilterResult fr = a.refine ? cr.filter : run_filter(run.run, fo);
-  t.filt.add(fr.extrinsics, a.refine ? cr.filter_model_covariance : fr.covariance, run.truth);
+  t.filt.add(
+      fr.extrinsics, a.refine ? cr.noise_check.filter_model_covariance : fr.covariance, run.truth);
   if (std::getenv("MISSING")) print_missing_tracks(run, fr);
   if (std::getenv("WINDOW_NEES") && fr.window_frames > 0) print_window_nees(run, fr, t.filt);
   if (std::getenv("VERBOSE") && !t.filt.nees.empty())

@@ -55,10 +55,13 @@ bool lower_side_applies(const NoiseCheckOptions& nc,
 // Each stage's time, on the log's debug level (omnivert -v).
 class StageTimer {
  public:
-  void lap(const char* stage) {
+  // Logs and returns the time since the last lap [s].
+  double lap(const char* stage) {
     const auto now = std::chrono::steady_clock::now();
-    spdlog::debug("calibrate: {} {:.2f} s", stage, std::chrono::duration<double>(now - t_).count());
+    const double seconds = std::chrono::duration<double>(now - t_).count();
+    spdlog::debug("calibrate: {} {:.2f} s", stage, seconds);
     t_ = now;
+    return seconds;
   }
 
  private:
@@ -92,10 +95,10 @@ void refine_and_analyse(const CalibrationRun& run,
     analysed = without_bearings(r->refinement.renamed() ? r->refinement.solved_run : run,
                                 r->refinement.guarded,
                                 r->refinement.rejected);
-    timer->lap("refinement");
+    r->seconds.refinement = timer->lap("refinement");
   }
   r->observability = analyse_observability(analysed, options, at);
-  timer->lap("observability");
+  r->seconds.observability = timer->lap("observability");
   if (r->refined && !r->refinement.covariance_ok && r->observability.all_determined() &&
       r->observability.crlb_covariance.allFinite()) {
     // ceres::Covariance gives up on badly scaled problems (poses in metres, bearings whitened
@@ -143,23 +146,24 @@ BatchNoiseCheck filter_noise_check(const CalibrationRun& run,
 // shows more noise, the bearings' share shrunk when it shows less where the tracker kept its
 // lines (CalibrationOptions::noise_check).
 void apply_filter_noise(const NoiseCheckOptions& nc, CalibrationResult* r) {
-  const double ratio = ratio_of(r->filter_noise);
+  const double ratio = ratio_of(r->noise_check.filter_check);
   if (!(ratio > 0.0)) return;
-  r->noise_checked = true;
-  r->noise = r->filter_noise;
-  r->filter_noise_verdict = noise_check_verdict(r->filter_noise, nc.level, nc.lower_level);
-  r->noise_verdict = r->filter_noise_verdict;
+  r->noise_check.checked = true;
+  r->noise_check.check = r->noise_check.filter_check;
+  r->noise_check.filter_verdict =
+      noise_check_verdict(r->noise_check.filter_check, nc.level, nc.lower_level);
+  r->noise_check.verdict = r->noise_check.filter_verdict;
   auto apply = [&](const Eigen::Matrix3d& covariance) {
     r->filter.covariance = covariance;
-    r->filter_noise_applied = r->noise_applied = true;
-    r->filter_noise_ratio = r->noise_ratio = ratio;
+    r->noise_check.filter_applied = r->noise_check.applied = true;
+    r->noise_check.filter_ratio = r->noise_check.ratio = ratio;
   };
-  if (r->filter_noise_verdict == NoiseVerdict::kMoreNoise) {
+  if (r->noise_check.filter_verdict == NoiseVerdict::kMoreNoise) {
     apply(r->filter.covariance * ratio);
-  } else if (r->filter_noise_verdict == NoiseVerdict::kLessNoise &&
-             lower_side_applies(nc, r->filter.joins.size(), r->filter_noise)) {
-    const Eigen::Matrix3d shrunk =
-        r->filter.covariance + r->filter_noise.covariance - r->filter_noise.model_covariance;
+  } else if (r->noise_check.filter_verdict == NoiseVerdict::kLessNoise &&
+             lower_side_applies(nc, r->filter.joins.size(), r->noise_check.filter_check)) {
+    const Eigen::Matrix3d shrunk = r->filter.covariance + r->noise_check.filter_check.covariance -
+                                   r->noise_check.filter_check.model_covariance;
     if (shrunk.allFinite() && Eigen::LLT<Eigen::Matrix3d>(shrunk).info() == Eigen::Success)
       apply(0.5 * (shrunk + shrunk.transpose()));
   }
@@ -168,38 +172,38 @@ void apply_filter_noise(const NoiseCheckOptions& nc, CalibrationResult* r) {
 // The refinement's noise check (at its solution) applied to its covariance: the checked
 // covariance where the check shows more noise, or less where few pieces of lines were joined.
 void apply_refinement_noise(const NoiseCheckOptions& nc, CalibrationResult* r) {
-  r->noise_checked = false;
-  r->noise_applied = false;
-  r->noise_verdict = NoiseVerdict::kAgrees;
-  r->noise_ratio = 1.0;
+  r->noise_check.checked = false;
+  r->noise_check.applied = false;
+  r->noise_check.verdict = NoiseVerdict::kAgrees;
+  r->noise_check.ratio = 1.0;
   const double ratio = ratio_of(r->refinement.noise);
   if (!(ratio > 0.0)) return;
-  r->noise_checked = true;
-  r->noise = r->refinement.noise;
-  r->noise_verdict = noise_check_verdict(r->noise, nc.level, nc.lower_level);
-  if (r->noise_verdict == NoiseVerdict::kMoreNoise ||
-      (r->noise_verdict == NoiseVerdict::kLessNoise &&
-       lower_side_applies(nc, r->refinement.merges.size(), r->noise))) {
-    r->noise_applied = true;
-    r->noise_ratio = ratio;
-    r->refinement.covariance = r->noise.covariance;
+  r->noise_check.checked = true;
+  r->noise_check.check = r->refinement.noise;
+  r->noise_check.verdict = noise_check_verdict(r->noise_check.check, nc.level, nc.lower_level);
+  if (r->noise_check.verdict == NoiseVerdict::kMoreNoise ||
+      (r->noise_check.verdict == NoiseVerdict::kLessNoise &&
+       lower_side_applies(nc, r->refinement.merges.size(), r->noise_check.check))) {
+    r->noise_check.applied = true;
+    r->noise_check.ratio = ratio;
+    r->refinement.covariance = r->noise_check.check.covariance;
   }
 }
 
 CalibrationResult calibrate_once(const CalibrationRun& run, const CalibrationOptions& options) {
   const NoiseCheckOptions& nc = options.noise_check;
   CalibrationResult r;
-  r.bearing_sigma = options.noise.bearing_sigma;
-  r.track_bias_sigma = options.noise.track_bias_sigma;
-  r.noise_check_level = nc.level;
-  r.noise_check_lower_level = nc.lower_level;
+  r.model.bearing_sigma = options.noise.bearing_sigma;
+  r.model.track_bias_sigma = options.noise.track_bias_sigma;
+  r.noise_check.level = nc.level;
+  r.noise_check.lower_level = nc.lower_level;
   StageTimer timer;
   r.filter = run_filter(run, options);
-  timer.lap("filter");
+  r.seconds.filter = timer.lap("filter");
   const BatchPoint filter_point = batch_point_from_filter(run, options, r.filter);
   refine_and_analyse(run, options, filter_point, &timer, &r);
-  r.filter_model_covariance = r.filter.covariance;
-  r.refinement_model_covariance = r.refinement.covariance;
+  r.noise_check.filter_model_covariance = r.filter.covariance;
+  r.noise_check.refinement_model_covariance = r.refinement.covariance;
   if (nc.enabled && r.observability.all_determined()) {
     // How large the errors really are, measured by the data (docs/theory/noise-check.md): at a
     // batch solution, the errors of each track summed before squaring. The
@@ -210,8 +214,8 @@ CalibrationResult calibrate_once(const CalibrationRun& run, const CalibrationOpt
     // is right (synthetic 0.3 degree, 50 runs: 3.50 -> 5.18). Less noise is applied only
     // where few pieces of lines were joined (CalibrationOptions::noise_check,
     // noise_check_lower_max_joins).
-    r.filter_noise = filter_noise_check(run, options, filter_point, r);
-    timer.lap("the filter's noise check");
+    r.noise_check.filter_check = filter_noise_check(run, options, filter_point, r);
+    r.seconds.noise_check = timer.lap("the filter's noise check");
     apply_filter_noise(nc, &r);
     if (r.refined && r.refinement.covariance_ok) apply_refinement_noise(nc, &r);
   }
@@ -232,16 +236,17 @@ CalibrationResult calibrate(const CalibrationRun& run, const CalibrationOptions&
 namespace {
 // A model sigma scaled as the noise check found the errors; NaN when not checked.
 double checked_sigma(const CalibrationResult& r, double sigma) {
-  return r.noise.ok ? sigma * std::sqrt(r.noise.scale) : std::numeric_limits<double>::quiet_NaN();
+  return r.noise_check.check.ok ? sigma * std::sqrt(r.noise_check.check.scale)
+                                : std::numeric_limits<double>::quiet_NaN();
 }
 }  // namespace
 
 double effective_bearing_sigma(const CalibrationResult& r) {
-  return checked_sigma(r, r.bearing_sigma);
+  return checked_sigma(r, r.model.bearing_sigma);
 }
 
 double effective_track_bias_sigma(const CalibrationResult& r) {
-  return checked_sigma(r, r.track_bias_sigma);
+  return checked_sigma(r, r.model.track_bias_sigma);
 }
 
 namespace {

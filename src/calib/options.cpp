@@ -92,8 +92,7 @@ bool checks_valid(const CalibrationOptions& o, std::string* why) {
   if (!finite_positive(r.huber_sigmas)) return fail(why, "refinement.huber_sigmas must be > 0");
   if (r.max_iterations < 1) return fail(why, "refinement.max_iterations must be >= 1");
   const NoiseCheckOptions& n = o.noise_check;
-  if (!(n.level > 0.0 && n.level < 0.5))
-    return fail(why, "noise_check.level must be in (0, 0.5)");
+  if (!(n.level > 0.0 && n.level < 0.5)) return fail(why, "noise_check.level must be in (0, 0.5)");
   if (!(n.lower_level >= 0.0 && n.lower_level < 0.5))
     return fail(why, "noise_check.lower_level must be in [0, 0.5) (0: that side off)");
   if (std::isnan(n.lower_max_joins))

@@ -144,7 +144,7 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
   ri.tracks_total = tracked.stats.new_tracks;
   ri.run = &r.input;
   ri.options = opt;
-  ri.options.noise.bearing_sigma = result.bearing_sigma;
+  ri.options.noise.bearing_sigma = result.model.bearing_sigma;
   ri.truth = r.truth;
   ri.force = o.force;
   ri.exit_code = r.wrote_extrinsics ? 0 : 3;
@@ -218,8 +218,9 @@ std::string CalibrateDatasetResult::BriefReport() const {
               p(0) * 1e3,
               p(1) * 1e3,
               rad2deg(e.yaw()));
-  const std::string noise = calib::bearing_noise_text(c.bearing_sigma, c.track_bias_sigma);
-  if (c.noise_checked)
+  const std::string noise =
+      calib::bearing_noise_text(c.model.bearing_sigma, c.model.track_bias_sigma);
+  if (c.noise_check.checked)
     s += "bearing sigma " + noise + "; " + calib::noise_check_line(c) + "\n";
   else
     s += "bearing sigma " + noise + " (no noise check" +

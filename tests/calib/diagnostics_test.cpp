@@ -327,13 +327,13 @@ TEST(NoiseCheck, FindsBearingsLessNoisyThanAssumed) {
     so.break_probability = 0.0;
     const SyntheticRun run = make_synthetic_run(so);
     const CalibrationResult r = calibrate(run.run, refined(o));
-    ASSERT_TRUE(r.noise_checked && r.refinement.covariance_ok) << "seed " << so.seed;
-    scale += r.noise.scale;
-    if (r.noise_verdict == NoiseVerdict::kLessNoise) {
+    ASSERT_TRUE(r.noise_check.checked && r.refinement.covariance_ok) << "seed " << so.seed;
+    scale += r.noise_check.check.scale;
+    if (r.noise_check.verdict == NoiseVerdict::kLessNoise) {
       ++less;
-      EXPECT_LT(r.noise.scale,
-                noise_check_lower_limit(r.noise.clusters, r.noise_check_lower_level));
-      EXPECT_TRUE(r.noise_applied);
+      EXPECT_LT(r.noise_check.check.scale,
+                noise_check_lower_limit(r.noise_check.check.clusters, r.noise_check.lower_level));
+      EXPECT_TRUE(r.noise_check.applied);
       EXPECT_NE(noise_check_line(r).find("less than the model assumes"), std::string::npos);
       EXPECT_NE(noise_check_line(r).find("sigmas scaled by"), std::string::npos);
       EXPECT_NE(noise_check_line(r).find("--bearing-sigma"), std::string::npos);
@@ -341,28 +341,32 @@ TEST(NoiseCheck, FindsBearingsLessNoisyThanAssumed) {
       // definite.
       EXPECT_LT(r.refinement.covariance(0, 0) + r.refinement.covariance(2, 2) +
                     2.0 * r.refinement.covariance(0, 2),
-                r.refinement_model_covariance(0, 0) + r.refinement_model_covariance(2, 2) +
-                    2.0 * r.refinement_model_covariance(0, 2));
+                r.noise_check.refinement_model_covariance(0, 0) +
+                    r.noise_check.refinement_model_covariance(2, 2) +
+                    2.0 * r.noise_check.refinement_model_covariance(0, 2));
       EXPECT_EQ(Eigen::LLT<Eigen::Matrix3d>(r.refinement.covariance).info(), Eigen::Success);
     } else {
-      EXPECT_EQ(r.refinement.covariance, r.refinement_model_covariance);
+      EXPECT_EQ(r.refinement.covariance, r.noise_check.refinement_model_covariance);
     }
-    if (r.filter_noise_verdict == NoiseVerdict::kLessNoise) {
+    if (r.noise_check.filter_verdict == NoiseVerdict::kLessNoise) {
       ++filter_less;
-      EXPECT_TRUE(r.filter_noise_applied);
+      EXPECT_TRUE(r.noise_check.filter_applied);
       EXPECT_EQ(Eigen::LLT<Eigen::Matrix3d>(r.filter.covariance).info(), Eigen::Success);
     }
     yaw += yaw_z2(r.refinement.extrinsics, r.refinement.covariance, run.truth);
-    yaw_model += yaw_z2(r.refinement.extrinsics, r.refinement_model_covariance, run.truth);
+    yaw_model +=
+        yaw_z2(r.refinement.extrinsics, r.noise_check.refinement_model_covariance, run.truth);
     // The same bearings in pieces: kept.
     so.break_probability = 0.1;
     const SyntheticRun broken = make_synthetic_run(so);
     const CalibrationResult b = calibrate(broken.run, refined(o));
-    ASSERT_TRUE(b.noise_checked && b.refinement.covariance_ok) << "seed " << so.seed;
-    if (b.noise_verdict == NoiseVerdict::kLessNoise) {
+    ASSERT_TRUE(b.noise_check.checked && b.refinement.covariance_ok) << "seed " << so.seed;
+    if (b.noise_check.verdict == NoiseVerdict::kLessNoise) {
       ++less_broken;
-      EXPECT_GT(static_cast<double>(b.refinement.merges.size()), 0.5 * b.noise.clusters);
-      kept_broken += !b.noise_applied && b.refinement.covariance == b.refinement_model_covariance;
+      EXPECT_GT(static_cast<double>(b.refinement.merges.size()),
+                0.5 * b.noise_check.check.clusters);
+      kept_broken += !b.noise_check.applied &&
+                     b.refinement.covariance == b.noise_check.refinement_model_covariance;
       EXPECT_NE(noise_check_line(b).find("pieces of lines were joined"), std::string::npos);
     }
   }

@@ -81,7 +81,7 @@ TEST_F(CalibrateDataset, NoiseCheckChoosesTheReportedCovarianceAndCanBeTurnedOff
                               ? nc["batch_checked_covariance"][0].get<double>()
                               : nc["refinement_model_covariance"][0].get<double>();
   EXPECT_EQ(json["result"]["covariance"][0].get<double>(), expected);
-  EXPECT_TRUE(r.calibration.noise_checked);
+  EXPECT_TRUE(r.calibration.noise_check.checked);
   EXPECT_THAT(r.BriefReport(), ContainsRegex("noise check over [0-9]+ tracks"));
 
   auto off = cli_defaults_refined();
@@ -92,7 +92,7 @@ TEST_F(CalibrateDataset, NoiseCheckChoosesTheReportedCovarianceAndCanBeTurnedOff
   EXPECT_FALSE(json["noise_check"]["checked"].get<bool>());
   EXPECT_EQ(json["noise_check"]["refinement_model_covariance"][0].get<double>(),
             json["result"]["covariance"][0].get<double>());
-  EXPECT_FALSE(r_off.calibration.noise_checked);
+  EXPECT_FALSE(r_off.calibration.noise_check.checked);
   EXPECT_THAT(r_off.BriefReport(), HasSubstr("no noise check"));
 
   auto level = cli_defaults();

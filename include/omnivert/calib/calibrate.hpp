@@ -23,43 +23,67 @@
 
 namespace omnivert::calib {
 
+// What the data's check of the bearing noise found and did (CalibrationOptions::noise_check).
+struct NoiseCheckReport {
+  // The check of the reported estimate (the refinement's when refined, else the filter's),
+  // valid when `checked`; its verdict; `applied`: the reported covariance is the checked one
+  // (more noise than the model allows, or less where the tracker kept its lines); `ratio`:
+  // the overall variance ratio tr(model^-1 checked) / 3 then (1 when not applied).
+  bool checked = false;
+  bool applied = false;
+  NoiseVerdict verdict = NoiseVerdict::kAgrees;
+  BatchNoiseCheck check;
+  double ratio = 1.0;
+  // The check of the filter on its own tracks (split only where its window split them), its
+  // verdict, and the filter's variance ratio (1 when not applied).
+  BatchNoiseCheck filter_check;
+  NoiseVerdict filter_verdict = NoiseVerdict::kAgrees;
+  bool filter_applied = false;
+  double filter_ratio = 1.0;
+  // CalibrationOptions::noise_check.level and lower_level, as used.
+  double level = 0.01;
+  double lower_level = 0.2;
+  // The model's covariances before any check.
+  Eigen::Matrix3d filter_model_covariance = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d refinement_model_covariance = Eigen::Matrix3d::Zero();
+};
+
+// Each stage's wall time [s].
+struct CalibrationTiming {
+  double filter = 0.0, refinement = 0.0, observability = 0.0, noise_check = 0.0;
+};
+
 struct CalibrationResult {
-  FilterResult filter;
-  bool refined = false;
-  RefinementResult refinement;  // valid when refined
-  ObservabilityReport observability;
   // The answer: the refinement's when refined and its covariance exists, else the filter's.
   Extrinsics extrinsics;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  double bearing_sigma = 0.0;  // the bearing sigma used by the models [rad]
-  double track_bias_sigma =
-      0.0;  // CalibrationOptions::noise.track_bias_sigma used by the models [rad]
   // Refinement only: its covariance came from the Fisher information of the observability
   // analysis (the inverse of the same information) because ceres::Covariance failed.
   bool covariance_from_information = false;
-  // CalibrationOptions::noise_check. noise: the check of the reported estimate (the
-  // refinement's when refined, else the filter's), valid when noise_checked; noise_verdict:
-  // what it found; noise_applied: it showed more noise than the model allows and the
-  // reported covariance is the checked one (CalibrationOptions::noise_check); noise_ratio: the
-  // overall variance ratio tr(model^-1 checked) / 3 then (1 when not applied). filter_noise: the
-  // check of the filter on its own tracks (split only where its window split them), its
-  // verdict, and the filter's variance ratio (1 when not applied). The model's covariances
-  // before any check are kept.
-  bool noise_checked = false;
-  bool noise_applied = false;
-  NoiseVerdict noise_verdict = NoiseVerdict::kAgrees;
-  BatchNoiseCheck noise;
-  double noise_ratio = 1.0;
-  BatchNoiseCheck filter_noise;
-  NoiseVerdict filter_noise_verdict = NoiseVerdict::kAgrees;
-  bool filter_noise_applied = false;
-  double filter_noise_ratio = 1.0;
-  // CalibrationOptions::noise_check.level and lower_level, as used.
-  double noise_check_level = 0.01;
-  double noise_check_lower_level = 0.2;
-  Eigen::Matrix3d filter_model_covariance = Eigen::Matrix3d::Zero();
-  Eigen::Matrix3d refinement_model_covariance = Eigen::Matrix3d::Zero();
+  // The verdict of Sec. 8.1 and the Cramer-Rao bounds of this run.
+  ObservabilityReport observability;
+  // The estimators: the filter (with its window's association), the refinement (valid when
+  // refined, with its splits, joins and rejections).
+  FilterResult filter;
+  bool refined = false;
+  RefinementResult refinement;
+  BearingNoise model;  // the bearing noise the models used (CalibrationOptions::noise)
+  NoiseCheckReport noise_check;
+  CalibrationTiming seconds;
+
   bool observable() const { return observability.all_determined(); }
+  // A few lines: phi, rho, psi with their sigmas (degrees, millimetres), the camera's position
+  // and yaw, and the verdict of Sec. 8.1, e.g.
+  //   refined estimate: phi 12.345 +- 0.067 deg, rho 201.23 +- 0.45 mm, psi -3.210 +- 0.070 deg
+  //   camera in the robot frame: x 196.5 mm, y 43.0 mm, yaw 9.135 deg
+  //   phi, rho and psi are determined by this trajectory (...).
+  std::string BriefReport() const;
+  // Everything, one item a line: the brief report's lines, then the filter's and the
+  // refinement's estimates with their model covariances, the bounds, the bearing noise model
+  // and the noise check, the wheel check, the association (window, splits, joins, guarded and
+  // rejected bearings), the refinement's solver figures, each stage's time and the warnings
+  // (result_warnings).
+  std::string FullReport() const;
 };
 
 // The independent bearing noise [rad] that would do the harm the noise check found:

@@ -90,7 +90,7 @@ struct FilterOptions {
   double naive_distance_sigma = 2.0;   // [m] (kNaive)
   double min_feature_distance = 1.0;   // [m] (kInverseDistance: 2-sigma range of the prior)
   double max_feature_distance = 20.0;  // [m]
-  double convert_ratio = 0.05;  // sigma_D / D below which (q, theta) -> (D, theta); 0: never
+  double convert_ratio = 0.05;         // sigma_D / D below which (q, theta) -> (D, theta); 0: never
   // Delayed initialisation (kAnchoredInverseDepth only): the frames up to the first turn are
   // solved as a batch and the filter starts from that solution (bootstrap_filter_state).
   // While the robot drives straight the camera position is unobservable (Sec. 8.1) and the
