@@ -35,10 +35,10 @@ struct CalibrateDatasetOptions {
   std::string mask;
   // The tracker; its odometry gate takes the wheel base of wheel0/sensor.yaml.
   TrackerOptions tracker = recommended_dataset_tracker_options();
-  // Prior and models. The wheel base and Chong-Kleeman K come from wheel0/sensor.yaml
-  // (calib::options_from_dataset); everything else from here.
-  calib::Options calibration = calib::recommended_options();
-  calib::CalibrateOptions run;     // refinement, noise check, batch options
+  // The estimator's options: prior, models, filter, refinement, noise check. The wheel base and
+  // Chong-Kleeman K come from wheel0/sensor.yaml (calib::options_from_dataset); everything else
+  // from here.
+  calib::CalibrationOptions calibration = calib::recommended_options();
   calib::DatasetRunOptions input;  // wheel gaps, crowded lines
   std::string tracks_file;         // non-empty: calibrate from this earlier tracks.csv
   bool force = false;              // write extrinsics.yaml even when undetermined
@@ -57,7 +57,7 @@ struct CalibrateDatasetResult {
   std::vector<std::string> warnings;       // tracking's, the input's and the estimate's
   bool wrote_extrinsics = false;           // determined, or forced
   std::string out_dir;
-  bool noise_check_requested = true;  // CalibrateOptions::noise_check of the run
+  bool noise_check_requested = true;  // CalibrationOptions::noise_check.enabled of the run
 
   // The answer: the refinement's estimate when it ran and its covariance is usable, else the
   // filter's (the same as calibration.extrinsics / calibration.covariance).
