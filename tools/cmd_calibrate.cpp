@@ -46,6 +46,7 @@ struct CalibrateArgs {
   std::optional<double> track_bias_sigma_deg;
   double crossing_guard_deg = rad2deg(calib::Options{}.crossing_guard);
   FeaturePipelineOptions pipeline;
+  TiltCheckOptions tilt;
   TrackerFlags tracker;
 };
 
@@ -98,6 +99,7 @@ calib::Options calibration_options(const CalibrateArgs& a) {
 void run_calibrate(const CalibrateArgs& a) {
   pipeline::CalibrateDatasetOptions o;
   o.features = a.pipeline;
+  o.tilt = a.tilt;
   o.tracker = a.tracker.options();
   o.calibration = calibration_options(a);
   o.run = {.refine = a.refine,
@@ -127,6 +129,9 @@ void run_calibrate(const CalibrateArgs& a) {
       std::fprintf(stderr, "calibrate: filter%s...\n", a.refine ? " and refinement" : "");
   };
   const pipeline::CalibrateDatasetResult r = pipeline::calibrate_dataset(a.dataset, a.out, o);
+  if (r.tilt.valid) {
+    std::printf("%s%s\n", r.tilt.describe().c_str(), r.tilt_corrected ? "; frames rectified" : "");
+  }
   std::printf("%s", r.BriefReport().c_str());
   if (!r.wrote_extrinsics) {
     std::fprintf(stderr,
@@ -269,6 +274,7 @@ void add_calibrate_command(CLI::App& app) {
   add_prior_options(cmd, *a);
   add_model_options(cmd, *a);
   add_pipeline_options(cmd, a->pipeline);
+  add_tilt_options(cmd, a->tilt);
   add_tracker_options(cmd, a->tracker);
   cmd->callback([a, cmd] {
     // Extraction and tracking flags given with --tracks do nothing: say so.

@@ -17,7 +17,10 @@ FeaturePipeline::FeaturePipeline(CameraGeometry geometry, FeaturePipelineOptions
       options_(std::move(options)),
       center_(options_.center),
       lines_(options_.lines),
-      descriptors_(options_.descriptor) {}
+      descriptors_(options_.descriptor) {
+  if (!options_.tilt.isZero() && geometry_.has_projection())
+    rectifier_.emplace(geometry_, options_.tilt);
+}
 
 bool FeaturePipeline::to_gray8(const cv::Mat& image, cv::Mat& gray) {
   if (image.empty() || image.dims != 2) return false;
@@ -118,9 +121,14 @@ bool FeaturePipeline::process(const cv::Mat& image, FrameFeatures& out, std::str
     }
   }
   out.circle = *circle_;
-  lines_.extract(gray_, out.circle, out.lines);
+  const cv::Mat* frame = &gray_;
+  if (rectifier_) {
+    rectifier_->apply(gray_, out.circle, upright_);
+    frame = &upright_;
+  }
+  lines_.extract(*frame, out.circle, out.lines);
   for (VerticalLine& l : out.lines) l.bearing = geometry_.bearing_of_image_angle(l.image_angle);
-  descriptors_.compute(gray_, out.circle, out.lines, out.descriptors);
+  descriptors_.compute(*frame, out.circle, out.lines, out.descriptors);
   return true;
 }
 

@@ -171,6 +171,11 @@ void write_camera_sensor(const fs::path& path, const CatadioptricCamera& c, doub
        "   # dark beyond: the mirror's outer boundary\n";
   y += "xi: " + fmt("%.9g", c.xi) + "\n";
   y += "gamma: " + fmt("%.9g", c.gamma) + "\n";
+  if (c.tilt_deg != 0.0) {
+    y += "tilt_deg: " + fmt("%.9g", c.tilt_deg) + "   # true tilt of the mirror axis\n";
+    y += "tilt_direction_deg: " + fmt("%.9g", c.tilt_direction_deg) +
+         "   # camera bearing the axis leans towards (docs/theory/tilt.md)\n";
+  }
   y += "rate_hz: " + fmt("%.9g", frame_rate) + "\n";
   write_text(path, y);
 }
@@ -228,6 +233,10 @@ void write_simulation_settings(const fs::path& path,
   y += "exposure: " + fmt("%.9g", s.exposure) + "\n";
   y += "blur_sigma: " + fmt("%.9g", s.blur_sigma) + "\n";
   y += "min_line_px: " + fmt("%.9g", cfg.min_line_px) + "\n";
+  if (cfg.camera.tilt_deg != 0.0) {
+    y += "tilt_deg: " + fmt("%.9g", cfg.camera.tilt_deg) + "\n";
+    y += "tilt_direction_deg: " + fmt("%.9g", cfg.camera.tilt_direction_deg) + "\n";
+  }
   write_text(path, y);
 }
 
