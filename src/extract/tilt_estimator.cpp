@@ -164,8 +164,7 @@ TiltEstimate TiltEstimator::estimate() const {
       d[k].resize(lines_.size());
       for (std::size_t j = 0; j < lines_.size(); ++j) {
         d[k][j].resize(ep[j].size());
-        for (std::size_t i = 0; i < ep[j].size(); ++i)
-          d[k][j][i] = (ep[j][i] - em[j][i]) / (2 * h);
+        for (std::size_t i = 0; i < ep[j].size(); ++i) d[k][j][i] = (ep[j][i] - em[j][i]) / (2 * h);
       }
     }
     sse = 0.0;

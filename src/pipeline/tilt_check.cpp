@@ -21,9 +21,11 @@ TiltEstimate measure_tilt(const dataset::Dataset& data,
   if (!data.camera().has_projection() || data.size() == 0) return estimator.estimate();
   FeaturePipelineOptions po = pipeline;
   po.tilt.setZero();
-  po.lines.lateral_tolerance_px = std::max(po.lines.lateral_tolerance_px, options.lateral_tolerance_px);
+  po.lines.lateral_tolerance_px =
+      std::max(po.lines.lateral_tolerance_px, options.lateral_tolerance_px);
   FeaturePipeline pipe(data.camera(), po);
-  const std::size_t n = std::min<std::size_t>(static_cast<std::size_t>(options.frames), data.size());
+  const std::size_t n =
+      std::min<std::size_t>(static_cast<std::size_t>(options.frames), data.size());
   FrameFeatures f;
   for (std::size_t k = 0; k < n; ++k) {
     const std::size_t i = n == 1 ? 0 : k * (data.size() - 1) / (n - 1);
@@ -37,7 +39,9 @@ TiltEstimate measure_tilt(const dataset::Dataset& data,
   return estimator.estimate();
 }
 
-std::string tilt_warning(const TiltEstimate& tilt, const TiltCheckOptions& options, bool corrected) {
+std::string tilt_warning(const TiltEstimate& tilt,
+                         const TiltCheckOptions& options,
+                         bool corrected) {
   if (!tilt.valid || tilt.tilt_deg() <= options.estimator.warn_deg) return {};
   return "the mirror axis is tilted from the vertical: " + tilt.describe() +
          (corrected ? "; the frames were rectified to an upright camera"

@@ -14,8 +14,8 @@ TiltWarp::TiltWarp(const CatadioptricCamera& camera,
                    const std::vector<int>& px_index,
                    const std::vector<float>& px_weight)
     : px_index_(px_index), px_weight_(px_weight) {
-  const Eigen::Matrix3d R = tilt_rotation(camera.tilt_deg * M_PI / 180.0,
-                                          camera.tilt_direction_deg * M_PI / 180.0);
+  const Eigen::Matrix3d R =
+      tilt_rotation(camera.tilt_deg * M_PI / 180.0, camera.tilt_direction_deg * M_PI / 180.0);
   // Upright direction (bearing, elevation) of every warped pixel, and the radii they span.
   std::vector<Eigen::Vector2d> dirs(px_index_.size());
   double r_lo = 1e9, r_hi = 0.0;
@@ -52,9 +52,7 @@ TiltWarp::TiltWarp(const CatadioptricCamera& camera,
   }
 }
 
-void TiltWarp::render(const CameraPose& pose,
-                      const cv::Mat1f& background,
-                      cv::Mat1f& image) const {
+void TiltWarp::render(const CameraPose& pose, const cv::Mat1f& background, cv::Mat1f& image) const {
   cv::Mat1f src, warped;
   upright_->render(pose, src);
   cv::remap(src, warped, map_x_, map_y_, cv::INTER_LINEAR, cv::BORDER_REPLICATE);

@@ -165,11 +165,8 @@ TEST(Tilt, EstimatedFromRenderedFramesWithinOnePointFiveTenthsOfADegree) {
   for (const auto& [tilt, dir] : {std::pair{2.0, 40.0}, {1.0, -120.0}, {3.0, 170.0}}) {
     const Renderer r(tilted(tilt, dir), w);
     const TiltEstimate e = measure(r.camera(), frames(r, times));
-    std::printf("true %.1f deg towards %.0f: %s, rms %.3f px\n",
-                tilt,
-                dir,
-                e.describe().c_str(),
-                e.rms_px);
+    std::printf(
+        "true %.1f deg towards %.0f: %s, rms %.3f px\n", tilt, dir, e.describe().c_str(), e.rms_px);
     ASSERT_TRUE(e.valid);
     EXPECT_NEAR(e.tilt_deg(), tilt, 0.15);
     EXPECT_NEAR(rad2deg(angle_diff(e.direction(), deg2rad(dir))), 0.0, 3.0);
@@ -190,8 +187,8 @@ TEST(Tilt, RectifiedFramesGiveTheUprightBearings) {
   const World w = world_preset("office");
   const Renderer r(tilted(2.0, 40.0), w);
   const auto images = frames(r, {0.0, 6.0, 12.0, 18.0, 24.0});
-  const Eigen::Vector2d x = deg2rad(2.0) * Eigen::Vector2d(std::cos(deg2rad(40.0)),
-                                                           std::sin(deg2rad(40.0)));
+  const Eigen::Vector2d x =
+      deg2rad(2.0) * Eigen::Vector2d(std::cos(deg2rad(40.0)), std::sin(deg2rad(40.0)));
   const BearingErrors raw = bearing_errors(r, images, nullptr);
   const BearingErrors fixed = bearing_errors(r, images, &x);
   std::printf("2 deg: raw %d of %d lines, rms %.4f deg; rectified %d of %d, rms %.4f deg\n",
@@ -239,7 +236,9 @@ TEST(Tilt, TableOfExtractionAgainstTilt) {
     // Rectified, a tilted camera keeps most lines; the part of the upright view beyond the
     // tilted rim is missing, which shortens some lines below the 50% criterion.
     EXPECT_GE(fixed.found, found0 * 7 / 10) << tilt;
-    if (tilt >= 1.0) EXPECT_LT(fixed.rms_deg, raw.rms_deg / 2.5) << tilt;
+    if (tilt >= 1.0) {
+      EXPECT_LT(fixed.rms_deg, raw.rms_deg / 2.5) << tilt;
+    }
   }
 }
 

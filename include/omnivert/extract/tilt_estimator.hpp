@@ -33,16 +33,16 @@
 namespace omnivert {
 
 struct TiltEstimate {
-  bool valid = false;                          // enough lines, a solvable system
+  bool valid = false;                                // enough lines, a solvable system
   Eigen::Vector2d vector = Eigen::Vector2d::Zero();  // t (cos d, sin d) [rad]
-  double sigma = 0.0;                          // standard deviation of t [rad] (formal)
+  double sigma = 0.0;                                // standard deviation of t [rad] (formal)
   int frames = 0;
-  int lines = 0;   // lines used (with enough inlier pixels)
-  int pixels = 0;  // inlier edge pixels
+  int lines = 0;        // lines used (with enough inlier pixels)
+  int pixels = 0;       // inlier edge pixels
   double rms_px = 0.0;  // tangential RMS of the inliers about their curves [px]
 
-  double tilt() const { return vector.norm(); }       // t [rad]
-  double direction() const;                           // d, camera bearing [rad], (-pi, pi]
+  double tilt() const { return vector.norm(); }  // t [rad]
+  double direction() const;                      // d, camera bearing [rad], (-pi, pi]
   double tilt_deg() const;
   double direction_deg() const;
   // One line for people: "tilt 2.03 deg (+-0.02) towards bearing 44.8 deg, from 312 lines".
