@@ -43,6 +43,7 @@ struct CalibrateArgs {
   double crossing_guard_deg = rad2deg(calib::AssociationOptions{}.crossing_guard);
   FeaturePipelineOptions pipeline;
   std::string mask;
+  TiltCheckOptions tilt;
   TrackerFlags tracker;
 };
 
@@ -86,6 +87,7 @@ void run_calibrate(const CalibrateArgs& a) {
   pipeline::CalibrateDatasetOptions o;
   o.features = a.pipeline;
   o.mask = a.mask;
+  o.tilt = a.tilt;
   o.tracker = a.tracker.options();
   o.calibration = calibration_options(a);
   o.input = a.input;
@@ -112,6 +114,9 @@ void run_calibrate(const CalibrateArgs& a) {
                    a.calibration.refinement.enabled ? " and refinement" : "");
   };
   const pipeline::CalibrateDatasetResult r = pipeline::calibrate_dataset(a.dataset, a.out, o);
+  if (r.tilt.valid) {
+    std::printf("%s%s\n", r.tilt.describe().c_str(), r.tilt_corrected ? "; frames rectified" : "");
+  }
   std::printf("%s", r.BriefReport().c_str());
   if (!r.wrote_extrinsics) {
     std::fprintf(stderr,
@@ -255,6 +260,7 @@ void add_calibrate_command(CLI::App& app) {
   add_model_options(cmd, *a);
   add_pipeline_options(cmd, a->pipeline);
   add_mask_option(cmd, a->mask);
+  add_tilt_options(cmd, a->tilt);
   add_tracker_options(cmd, a->tracker);
   cmd->callback([a, cmd] {
     // Extraction and tracking flags given with --tracks do nothing: say so.

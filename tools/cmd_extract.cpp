@@ -1,5 +1,6 @@
 // omnivert extract IMAGE: the vertical lines of one catadioptric image (Sec. 2-3).
 
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -11,9 +12,11 @@
 #include "omnivert/core/camera_geometry.hpp"
 #include "omnivert/core/error.hpp"
 #include "omnivert/describe/feature_pipeline.hpp"
+#include "omnivert/extract/tilt_estimator.hpp"
 #include "omnivert/image/grey.hpp"
 #include "omnivert/image/image_io.hpp"
 #include "omnivert/image/image_mask.hpp"
+#include "omnivert/pipeline/tilt_check.hpp"
 #include "omnivert/viz/overlay.hpp"
 #include "pipeline_options.hpp"
 
@@ -30,8 +33,29 @@ struct ExtractArgs {
   std::string overlay;
   int highlight = -1;
   std::string mask;
+  double xi = 0.0, gamma = 0.0;  // 0: from --sensor
+  bool correct_tilt = false;
   FeaturePipelineOptions pipeline;
 };
+
+// The tilt of the mirror axis measured on this image (docs/extraction.md, "Tilt"): one pass
+// with the wider line support of the dataset check.
+TiltEstimate measure_image_tilt(const cv::Mat& image,
+                                const CameraGeometry& geometry,
+                                const FeaturePipelineOptions& pipeline) {
+  const TiltCheckOptions check;
+  TiltEstimator estimator(geometry, check.estimator);
+  if (!geometry.has_projection()) return estimator.estimate();
+  FeaturePipelineOptions po = pipeline;
+  po.lines.lateral_tolerance_px =
+      std::max(po.lines.lateral_tolerance_px, check.lateral_tolerance_px);
+  FeaturePipeline pipe(geometry, po);
+  FrameFeatures f;
+  if (pipe.process(image, f)) {
+    estimator.add_frame(pipe.line_extractor().last_edge_points(), f.circle, f.lines);
+  }
+  return estimator.estimate();
+}
 
 void run_extract(const ExtractArgs& a) {
   std::string why;
@@ -56,15 +80,32 @@ void run_extract(const ExtractArgs& a) {
       geometry.height = m.rows;
     }
   }
-  FeaturePipeline pipe(geometry, a.pipeline);
+  if (a.xi > 0.0) geometry.xi = a.xi;
+  if (a.gamma > 0.0) geometry.gamma = a.gamma;
+  const TiltEstimate tilt = measure_image_tilt(image, geometry, a.pipeline);
+  const TiltCheckOptions check;
+  FeaturePipelineOptions po = a.pipeline;
+  const bool corrected = a.correct_tilt && tilt.valid && tilt.tilt_deg() > check.correct_deg;
+  if (corrected) po.tilt = tilt.vector;
+  FeaturePipeline pipe(geometry, po);
   FrameFeatures f;
   if (!pipe.process(image, f, &why)) throw InputError(a.image, 0, why);
+  const std::string warning = tilt_warning(tilt, check, corrected);
+  if (!warning.empty()) std::fprintf(stderr, "warning: %s\n", warning.c_str());
 
   if (a.json) {
     nlohmann::json j;
     j["center"] = {f.circle.center.x(), f.circle.center.y()};
     j["r_min"] = f.circle.r_min;
     j["r_max"] = f.circle.r_max;
+    if (tilt.valid) {
+      j["tilt"] = {{"tilt_deg", tilt.tilt_deg()},
+                   {"direction_deg", tilt.direction_deg()},
+                   {"sigma_deg", rad2deg(tilt.sigma)},
+                   {"lines", tilt.lines},
+                   {"rms_px", tilt.rms_px},
+                   {"corrected", corrected}};
+    }
     j["lines"] = nlohmann::json::array();
     for (std::size_t i = 0; i < f.lines.size(); ++i) {
       const auto& l = f.lines[i];
@@ -91,6 +132,9 @@ void run_extract(const ExtractArgs& a) {
                 f.circle.r_min,
                 f.circle.r_max,
                 f.lines.size());
+    if (geometry.has_projection()) {
+      std::printf("%s%s\n", tilt.describe().c_str(), corrected ? "; bearings upright" : "");
+    }
     std::printf("%4s %12s %16s %11s %9s %9s %8s %8s\n",
                 "line",
                 "bearing[deg]",
@@ -152,6 +196,11 @@ void add_extract_command(CLI::App& app) {
   cmd->add_option("--highlight",
                   args->highlight,
                   "Line whose descriptor areas the overlay draws (default: the longest)");
+  cmd->add_option("--xi", args->xi, "Unified model xi, for the tilt measurement (else --sensor's)");
+  cmd->add_option("--gamma", args->gamma, "Unified model gamma [px] (else --sensor's)");
+  cmd->add_flag("--correct-tilt",
+                args->correct_tilt,
+                "Rectify the image to an upright camera when the measured tilt exceeds 0.25 deg");
   add_pipeline_options(cmd, args->pipeline);
   add_mask_option(cmd, args->mask);
   cmd->callback([args] { run_extract(*args); });

@@ -62,6 +62,14 @@ void add_camera_options(CLI::App* cmd, SimulateArgs& a) {
          "--bearing-sign", c.camera.bearing_sign, "+1: beta = a; -1: mirrored image (beta = -a)")
       ->check(CLI::IsMember({1, -1}))
       ->capture_default_str();
+  cmd->add_option("--tilt-deg",
+                  c.camera.tilt_deg,
+                  "Tilt of the mirror axis from the vertical [deg], 0..10 (docs/simulator.md)")
+      ->capture_default_str();
+  cmd->add_option("--tilt-direction-deg",
+                  c.camera.tilt_direction_deg,
+                  "Camera bearing the tilted axis leans towards [deg]")
+      ->capture_default_str();
   cmd->add_option("--camera-height", c.camera_height, "Camera centre above the floor [m]")
       ->capture_default_str();
   cmd->add_option("--phi", c.extrinsics.phi, "Extrinsics phi [rad]")->capture_default_str();

@@ -75,6 +75,16 @@ PixelFormat load_pixel_format(const YAML::Node& root, const std::string& path) {
 
 }  // namespace
 
+double CameraGeometry::elevation_of_radius(double r) const {
+  // r (xi - sin el) = gamma cos el  <=>  hypot(r, gamma) sin(el + atan2(gamma, r)) = r xi; the
+  // branch that is monotonic from el = -pi/2 at r = 0.
+  return std::asin(r * *xi / std::hypot(r, *gamma)) - std::atan2(*gamma, r);
+}
+
+double CameraGeometry::radius_of_elevation(double el) const {
+  return *gamma * std::cos(el) / (*xi - std::sin(el));
+}
+
 CameraGeometry load_camera_geometry(const std::string& path) {
   const YAML::Node root = yaml::load_file(path);
   CameraGeometry g;
@@ -130,6 +140,14 @@ CameraGeometry load_camera_geometry(const std::string& path) {
                            "; the path is relative to the folder of this file)");
     }
     g.mask = p.string();
+  }
+  g.xi = yaml::optional_number(root, "xi", path);
+  g.gamma = yaml::optional_number(root, "gamma", path);
+  if (g.xi && !(*g.xi > 0.0 && *g.xi < 1.0)) {
+    throw InputError(path, yaml::line_of(root["xi"]), "field 'xi' must lie in (0, 1)");
+  }
+  if (g.gamma && !(*g.gamma > 0.0)) {
+    throw InputError(path, yaml::line_of(root["gamma"]), "field 'gamma' must be positive");
   }
   return g;
 }

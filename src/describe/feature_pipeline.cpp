@@ -23,6 +23,8 @@ FeaturePipeline::FeaturePipeline(CameraGeometry geometry, FeaturePipelineOptions
       lines_(options_.lines),
       descriptors_(options_.descriptor) {
   if (geometry_.mask) set_mask(read_mask(*geometry_.mask, geometry_.width, geometry_.height));
+  if (!options_.tilt.isZero() && geometry_.has_projection())
+    rectifier_.emplace(geometry_, options_.tilt);
 }
 
 void FeaturePipeline::set_mask(const cv::Mat& usable) {
@@ -151,9 +153,14 @@ bool FeaturePipeline::process(const cv::Mat& image, FrameFeatures& out, std::str
     }
   }
   out.circle = *circle_;
-  lines_.extract(gray_, out.circle, out.lines);
+  const cv::Mat* frame = &gray_;
+  if (rectifier_) {
+    rectifier_->apply(gray_, out.circle, upright_);
+    frame = &upright_;
+  }
+  lines_.extract(*frame, out.circle, out.lines);
   for (VerticalLine& l : out.lines) l.bearing = geometry_.bearing_of_image_angle(l.image_angle);
-  descriptors_.compute(gray_, out.circle, out.lines, out.descriptors);
+  descriptors_.compute(*frame, out.circle, out.lines, out.descriptors);
   return true;
 }
 

@@ -60,6 +60,7 @@ TrackDatasetResult tracks_of(const dataset::Dataset& data,
   to.pipeline = o.features;
   to.mask = o.mask;
   to.tracker = o.tracker;
+  to.tilt = o.tilt;
   return track_dataset(data, to, [&](std::size_t done, std::size_t total) {
     if (o.progress) o.progress("track", done, total);
   });
@@ -98,6 +99,8 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
   const auto t0 = Clock::now();
   const TrackDatasetResult tracked = tracks_of(data, o, std::move(given));
   r.warnings = tracked.warnings;
+  r.tilt = tracked.tilt;
+  r.tilt_corrected = tracked.tilt_corrected;
   write_tracks_csv(out / "tracks.csv", tracked.rows);
   write_tracks_png(out / "tracks.png", tracked.rows);
   const auto t1 = Clock::now();

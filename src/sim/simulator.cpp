@@ -174,6 +174,11 @@ void write_camera_sensor(const fs::path& path,
        "   # dark beyond: the mirror's outer boundary\n";
   y += "xi: " + fmt("%.9g", c.xi) + "\n";
   y += "gamma: " + fmt("%.9g", c.gamma) + "\n";
+  if (c.tilt_deg != 0.0) {
+    y += "tilt_deg: " + fmt("%.9g", c.tilt_deg) + "   # true tilt of the mirror axis\n";
+    y += "tilt_direction_deg: " + fmt("%.9g", c.tilt_direction_deg) +
+         "   # camera bearing the axis leans towards (docs/theory/tilt.md)\n";
+  }
   y += "rate_hz: " + fmt("%.9g", frame_rate) + "\n";
   if (with_mask) y += "mask: mask.png   # the struts and the robot's reflection: 0\n";
   write_text(path, y);
@@ -250,6 +255,10 @@ void write_simulation_settings(const fs::path& path,
     y += "reflection_grey: " + fmt("%.9g", o.reflection_grey) + "\n";
   }
   if (o.write_mask) y += "mask_margin_px: " + fmt("%.9g", o.mask_margin_px) + "\n";
+  if (cfg.camera.tilt_deg != 0.0) {
+    y += "tilt_deg: " + fmt("%.9g", cfg.camera.tilt_deg) + "\n";
+    y += "tilt_direction_deg: " + fmt("%.9g", cfg.camera.tilt_direction_deg) + "\n";
+  }
   write_text(path, y);
 }
 

@@ -49,6 +49,18 @@ struct CameraGeometry {
   // others (robot, struts, cables). Absent: every pixel is usable. Read by the image stage
   // (read_mask): core has no image reader.
   std::optional<std::string> mask;
+  // Unified-model intrinsics (model: unified, docs/dataset-format.md): the projection
+  // r(el) = gamma cos(el) / (xi - sin(el)); absent when the file does not give them. Only the
+  // tilt estimate needs them (docs/theory/tilt.md).
+  std::optional<double> xi;
+  std::optional<double> gamma;
+
+  bool has_projection() const { return xi.has_value() && gamma.has_value(); }
+  // Elevation [rad] of the viewing direction drawn at radius r [px] from the centre; needs
+  // has_projection() (the inverse of r(el), docs/theory/tilt.md#projection).
+  double elevation_of_radius(double r) const;
+  // Radius [px] of elevation el [rad], r(el) above; needs has_projection().
+  double radius_of_elevation(double el) const;
 
   // Camera bearing of an image angle (docs/theory/conventions.md).
   double bearing_of_image_angle(double a) const;

@@ -13,6 +13,7 @@
 #include "omnivert/describe/frame_features.hpp"
 #include "omnivert/extract/line_extractor.hpp"
 #include "omnivert/extract/mirror_center.hpp"
+#include "omnivert/extract/tilt_estimator.hpp"
 
 namespace omnivert {
 
@@ -29,6 +30,11 @@ struct FeaturePipelineOptions {
   // calibrated camera 0.14 mm forward; docs/theory/extraction.md#a-given-centre). True: the given
   // centre only seeds the search, and the centre is fitted and tracked as without it.
   bool refine_given_center = false;
+  // Tilt vector t (cos d, sin d) [rad] of the mirror axis (core/tilt.hpp). Non-zero, with the
+  // camera's xi and gamma known: every frame is rectified to the upright camera before the
+  // lines are extracted and described, so that their bearings are the upright ones of
+  // eq. (16)-(17) (docs/theory/tilt.md). Zero: frames are used as they are.
+  Eigen::Vector2d tilt = Eigen::Vector2d::Zero();
 
   bool IsValid(std::string* why) const;
 };
@@ -72,6 +78,8 @@ class FeaturePipeline {
   std::optional<MirrorCircle> circle_;
   cv::Mat gray_;
   cv::Mat mask_;
+  std::optional<TiltRectifier> rectifier_;
+  cv::Mat upright_;
 };
 
 // Fraction of the annulus r_min..r_max around `circle.center` that lies inside a w x h image.

@@ -44,6 +44,7 @@ struct CalibrateDatasetOptions {
   bool force = false;              // write extrinsics.yaml even when undetermined
   std::string command;             // the command line, recorded in the report
   std::vector<std::string> notes;  // extra warnings of the caller, reported with the rest
+  TiltCheckOptions tilt;           // the tilt of the mirror axis (pipeline/tilt_check.hpp)
   // Called while tracking (stage "track", frames done, frames in all) and once before the
   // calibration (stage "calibrate", 0, 0).
   std::function<void(const std::string& stage, std::size_t done, std::size_t total)> progress;
@@ -58,6 +59,8 @@ struct CalibrateDatasetResult {
   bool wrote_extrinsics = false;           // determined, or forced
   std::string out_dir;
   bool noise_check_requested = true;  // CalibrationOptions::noise_check.enabled of the run
+  TiltEstimate tilt;                  // measured before tracking (not valid: not measured)
+  bool tilt_corrected = false;        // the frames were rectified with tilt.vector
 
   // The answer: the refinement's estimate when it ran and its covariance is usable, else the
   // filter's (the same as calibration.extrinsics / calibration.covariance).
