@@ -56,6 +56,7 @@ void run_extract(const ExtractArgs& a) {
       jl["r_outer"] = l.r_outer;
       jl["polarity"] = l.polarity;
       jl["crowded"] = l.crowded;
+      jl["significance"] = l.significance;
       const auto row = f.descriptors.row(static_cast<Eigen::Index>(i));
       jl["descriptor"] = std::vector<float>(row.data(), row.data() + row.size());
       j["lines"].push_back(std::move(jl));
@@ -71,7 +72,7 @@ void run_extract(const ExtractArgs& a) {
                 f.circle.r_min,
                 f.circle.r_max,
                 f.lines.size());
-    std::printf("%4s %12s %16s %11s %9s %9s %8s %8s\n",
+    std::printf("%4s %12s %16s %11s %9s %9s %8s %8s %8s\n",
                 "line",
                 "bearing[deg]",
                 "image_angle[deg]",
@@ -79,10 +80,11 @@ void run_extract(const ExtractArgs& a) {
                 "r_inner",
                 "r_outer",
                 "fit[px]",
-                "crowded");
+                "crowded",
+                "signif");
     for (std::size_t i = 0; i < f.lines.size(); ++i) {
       const auto& l = f.lines[i];
-      std::printf("%4zu %12.3f %16.3f %11d %9.1f %9.1f %8.2f %8s\n",
+      std::printf("%4zu %12.3f %16.3f %11d %9.1f %9.1f %8.2f %8s %8.1f\n",
                   i,
                   rad2deg(l.bearing),
                   rad2deg(l.image_angle),
@@ -90,7 +92,8 @@ void run_extract(const ExtractArgs& a) {
                   l.r_inner,
                   l.r_outer,
                   l.fit_rms_px,
-                  l.crowded ? "yes" : "");
+                  l.crowded ? "yes" : "",
+                  l.significance);
     }
   }
   if (!a.overlay.empty()) {
