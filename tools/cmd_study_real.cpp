@@ -60,7 +60,7 @@ void run_real_images(const RealImagesArgs& a) {
   if (!fs::is_directory(a.out)) throw InputError(a.out, 0, "cannot create the output folder");
   std::vector<RealImageResult> results;
   for (const fs::path& f : files) {
-    const std::string rel = fs::relative(f, a.dir).string();
+    const std::string rel = f.lexically_relative(a.dir).string();
     CameraGeometry g;
     const auto it = sensors.find(fs::path(rel).parent_path().lexically_normal().string());
     if (it != sensors.end()) g = it->second;

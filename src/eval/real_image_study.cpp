@@ -179,23 +179,24 @@ std::string real_image_table(const std::vector<RealImageResult>& results) {
     ++images;
     lines += r.lines;
     for (int m = 0; m < 2; ++m) tr[m] += r.rotation[m], tl[m] += r.lighting[m];
-    std::snprintf(b,
-                  sizeof b,
-                  "%-32s (%6.1f, %6.1f) %6d | %6.1f %5.1f %6.2f | %6.1f %5.1f        | %6.1f %5.1f  "
-                  "      | %6.1f %5.1f\n",
-                  r.label.c_str(),
-                  r.circle.center.x(),
-                  r.circle.center.y(),
-                  r.lines,
-                  r.rotation[0].found_percent(),
-                  r.rotation[0].nn_percent(),
-                  r.max_centre_shift_px,
-                  r.rotation[1].found_percent(),
-                  r.rotation[1].nn_percent(),
-                  r.lighting[0].found_percent(),
-                  r.lighting[0].nn_percent(),
-                  r.lighting[1].found_percent(),
-                  r.lighting[1].nn_percent());
+    std::snprintf(
+        b,
+        sizeof b,
+        "%-32s (%6.1f, %6.1f) %6d | %6.1f %5.1f %6.2f | %6.1f %5.1f        | %6.1f %5.1f  "
+        "      | %6.1f %5.1f\n",
+        r.label.c_str(),
+        r.circle.center.x(),
+        r.circle.center.y(),
+        r.lines,
+        r.rotation[0].found_percent(),
+        r.rotation[0].nn_percent(),
+        r.max_centre_shift_px,
+        r.rotation[1].found_percent(),
+        r.rotation[1].nn_percent(),
+        r.lighting[0].found_percent(),
+        r.lighting[0].nn_percent(),
+        r.lighting[1].found_percent(),
+        r.lighting[1].nn_percent());
     s << b;
   }
   std::snprintf(b,
@@ -220,7 +221,8 @@ std::string real_image_table(const std::vector<RealImageResult>& results) {
 std::string real_image_csv(const std::vector<RealImageResult>& results) {
   std::ostringstream s;
   s << "#image,ok,width,height,center_x,center_y,r_min,r_max,lines,max_centre_shift_px";
-  for (const char* t : {"rotation_detected", "rotation_given", "lighting_detected", "lighting_given"})
+  for (const char* t :
+       {"rotation_detected", "rotation_given", "lighting_detected", "lighting_given"})
     s << ',' << t << "_looked_for," << t << "_found," << t << "_nn_correct";
   s << '\n';
   for (const RealImageResult& r : results) {
