@@ -28,9 +28,10 @@ namespace {
 struct CalibrateArgs {
   std::string dataset;
   std::string out;
-  bool refine = false;
-  bool noise_check = true;
-  double noise_check_lower_level = calib::CalibrateOptions{}.noise_check_lower_level;
+  // The estimator's and the input's options: flags without a unit to convert are bound to
+  // their fields; the prior file and the flags that override it are applied in run_calibrate.
+  calib::CalibrationOptions calibration = calib::recommended_options();
+  calib::DatasetRunOptions input;
   bool force = false;
   std::string prior_file;
   std::string tracks_file;  // --tracks: an existing tracks.csv instead of tracking
@@ -38,74 +39,58 @@ struct CalibrateArgs {
   std::optional<double> phi, rho, psi, sigma_phi, sigma_rho, sigma_psi;
   std::optional<double> bearing_sigma_deg;
   std::optional<double> odometry_inflation;
-  double max_wheel_gap = 0.5;
-  double crowded_sigma = calib::DatasetRunOptions{}.crowded_sigma_scale;
-  double split_chi2 = calib::BatchOptions{}.split_chi2;
-  bool no_join = false;
-  double lateral_sigma = calib::BatchOptions{}.lateral_sigma;
   std::optional<double> track_bias_sigma_deg;
-  double crossing_guard_deg = rad2deg(calib::Options{}.crossing_guard);
+  double crossing_guard_deg = rad2deg(calib::AssociationOptions{}.crossing_guard);
   FeaturePipelineOptions pipeline;
+  std::string mask;
+  TiltCheckOptions tilt;
   TrackerFlags tracker;
 };
 
 // The prior from a YAML file: keys phi, rho, psi, sigma_phi, sigma_rho, sigma_psi [rad, m]
 // (the keys of extrinsics.yaml, so a previous result can be the next prior), and optionally
 // bearing_sigma [rad], track_bias_sigma [rad], odometry_inflation. Other keys are ignored.
-void read_prior_file(const std::string& path, calib::Options* o) {
+void read_prior_file(const std::string& path, calib::CalibrationOptions* o) {
   const YAML::Node y = yaml::load_file(path);
-  if (auto v = yaml::optional_number(y, "phi", path)) o->prior.phi = *v;
-  if (auto v = yaml::optional_number(y, "rho", path, true)) o->prior.rho = *v;
-  if (auto v = yaml::optional_number(y, "psi", path)) o->prior.psi = *v;
-  if (auto v = yaml::optional_number(y, "sigma_phi", path, true)) o->prior_sigma(0) = *v;
-  if (auto v = yaml::optional_number(y, "sigma_rho", path, true)) o->prior_sigma(1) = *v;
-  if (auto v = yaml::optional_number(y, "sigma_psi", path, true)) o->prior_sigma(2) = *v;
-  if (auto v = yaml::optional_number(y, "bearing_sigma", path, true)) o->bearing_sigma = *v;
-  if (auto v = yaml::optional_number(y, "track_bias_sigma", path)) o->track_bias_sigma = *v;
+  if (auto v = yaml::optional_number(y, "phi", path)) o->prior.mean.phi = *v;
+  if (auto v = yaml::optional_number(y, "rho", path, true)) o->prior.mean.rho = *v;
+  if (auto v = yaml::optional_number(y, "psi", path)) o->prior.mean.psi = *v;
+  if (auto v = yaml::optional_number(y, "sigma_phi", path, true)) o->prior.sigma(0) = *v;
+  if (auto v = yaml::optional_number(y, "sigma_rho", path, true)) o->prior.sigma(1) = *v;
+  if (auto v = yaml::optional_number(y, "sigma_psi", path, true)) o->prior.sigma(2) = *v;
+  if (auto v = yaml::optional_number(y, "bearing_sigma", path, true)) o->noise.bearing_sigma = *v;
+  if (auto v = yaml::optional_number(y, "track_bias_sigma", path)) o->noise.track_bias_sigma = *v;
   if (auto v = yaml::optional_number(y, "odometry_inflation", path, true))
-    o->odometry_inflation = *v;
+    o->filter.odometry_inflation = *v;
 }
 
-calib::BatchOptions batch_options(const CalibrateArgs& a) {
-  calib::BatchOptions b;
-  b.split_chi2 = a.split_chi2;
-  b.lateral_sigma = a.lateral_sigma;
-  b.merge_pieces = !a.no_join;
-  return b;
-}
-
-// The calibration's options: the recommended preset, then the prior file, then the flags
-// (the wheel base and K come from wheel0/sensor.yaml in the pipeline).
-calib::Options calibration_options(const CalibrateArgs& a) {
-  calib::Options opt = calib::recommended_options();
+// The calibration's options: the recommended preset with the bound flags, then the prior
+// file, then the flags that override it (the wheel base and K come from wheel0/sensor.yaml in
+// the pipeline).
+calib::CalibrationOptions calibration_options(const CalibrateArgs& a) {
+  calib::CalibrationOptions opt = a.calibration;
   if (!a.prior_file.empty()) read_prior_file(a.prior_file, &opt);
-  if (a.phi) opt.prior.phi = *a.phi;
-  if (a.rho) opt.prior.rho = *a.rho;
-  if (a.psi) opt.prior.psi = *a.psi;
-  if (a.sigma_phi) opt.prior_sigma(0) = *a.sigma_phi;
-  if (a.sigma_rho) opt.prior_sigma(1) = *a.sigma_rho;
-  if (a.sigma_psi) opt.prior_sigma(2) = *a.sigma_psi;
-  if (a.bearing_sigma_deg) opt.bearing_sigma = deg2rad(*a.bearing_sigma_deg);
-  if (a.track_bias_sigma_deg) opt.track_bias_sigma = deg2rad(*a.track_bias_sigma_deg);
-  if (a.odometry_inflation) opt.odometry_inflation = *a.odometry_inflation;
-  opt.split_chi2 = a.split_chi2;
-  opt.join_pieces = !a.no_join;
-  opt.lateral_sigma = a.lateral_sigma;
-  opt.crossing_guard = deg2rad(a.crossing_guard_deg);
+  if (a.phi) opt.prior.mean.phi = *a.phi;
+  if (a.rho) opt.prior.mean.rho = *a.rho;
+  if (a.psi) opt.prior.mean.psi = *a.psi;
+  if (a.sigma_phi) opt.prior.sigma(0) = *a.sigma_phi;
+  if (a.sigma_rho) opt.prior.sigma(1) = *a.sigma_rho;
+  if (a.sigma_psi) opt.prior.sigma(2) = *a.sigma_psi;
+  if (a.bearing_sigma_deg) opt.noise.bearing_sigma = deg2rad(*a.bearing_sigma_deg);
+  if (a.track_bias_sigma_deg) opt.noise.track_bias_sigma = deg2rad(*a.track_bias_sigma_deg);
+  if (a.odometry_inflation) opt.filter.odometry_inflation = *a.odometry_inflation;
+  opt.association.crossing_guard = deg2rad(a.crossing_guard_deg);
   return opt;
 }
 
 void run_calibrate(const CalibrateArgs& a) {
   pipeline::CalibrateDatasetOptions o;
   o.features = a.pipeline;
+  o.mask = a.mask;
+  o.tilt = a.tilt;
   o.tracker = a.tracker.options();
   o.calibration = calibration_options(a);
-  o.run = {.refine = a.refine,
-           .noise_check = a.noise_check,
-           .noise_check_lower_level = a.noise_check_lower_level,
-           .batch = batch_options(a)};
-  o.input.max_wheel_gap_s = a.max_wheel_gap;
-  o.input.crowded_sigma_scale = a.crowded_sigma;
+  o.input = a.input;
   o.tracks_file = a.tracks_file;
   o.force = a.force;
   o.command = command_line();
@@ -124,9 +109,14 @@ void run_calibrate(const CalibrateArgs& a) {
     }
     if (bar) bar->finish();
     if (Progress::enabled())
-      std::fprintf(stderr, "calibrate: filter%s...\n", a.refine ? " and refinement" : "");
+      std::fprintf(stderr,
+                   "calibrate: filter%s...\n",
+                   a.calibration.refinement.enabled ? " and refinement" : "");
   };
   const pipeline::CalibrateDatasetResult r = pipeline::calibrate_dataset(a.dataset, a.out, o);
+  if (r.tilt.valid) {
+    std::printf("%s%s\n", r.tilt.describe().c_str(), r.tilt_corrected ? "; frames rectified" : "");
+  }
   std::printf("%s", r.BriefReport().c_str());
   if (!r.wrote_extrinsics) {
     std::fprintf(stderr,
@@ -188,7 +178,7 @@ void add_model_options(CLI::App* cmd, CalibrateArgs& a) {
       ->check(kNonNegative)
       ->group(gm);
   cmd->add_option("--lateral-sigma",
-                  a.lateral_sigma,
+                  a.calibration.robot.lateral_sigma,
                   "Sideways slip per image step [m] allowed by the batch problems (the filter's "
                   "window and the refinement); eq. (14) has none. Raise it for a robot that "
                   "slips sideways (docs/theory/refinement.md#odometry-factor)")
@@ -196,14 +186,14 @@ void add_model_options(CLI::App* cmd, CalibrateArgs& a) {
       ->capture_default_str()
       ->group(gm);
   cmd->add_option("--crowded-sigma",
-                  a.crowded_sigma,
+                  a.input.crowded_sigma_scale,
                   "The bearing sigma of a crowded line (tracks.csv's crowded column: another edge "
                   "within a few pixels all along it) is --bearing-sigma times this")
       ->check(kPositive)
       ->capture_default_str()
       ->group(gm);
   cmd->add_option("--max-wheel-gap",
-                  a.max_wheel_gap,
+                  a.input.max_wheel_gap_s,
                   "Wheel samples further apart than this [s] are a gap: the bearings of the "
                   "images inside it are not used")
       ->check(kPositive)
@@ -224,17 +214,17 @@ void add_calibrate_command(CLI::App& app) {
   cmd->add_option("--out", a->out, "Output folder")->required();
   cmd->add_flag(
       "--refine",
-      a->refine,
+      a->calibration.refinement.enabled,
       "Refine the filter's result by batch maximum likelihood over the whole run (Ceres)");
   cmd->add_option("--split-chi2",
-                  a->split_chi2,
+                  a->calibration.association.split_chi2,
                   "Filter's window and refinement: split a track in two where two features "
                   "explain its bearings better than one by this likelihood-ratio statistic (a "
                   "track that slipped onto a neighbouring line); 0 turns splitting off")
       ->check(kNonNegative)
       ->capture_default_str();
-  cmd->add_flag("--no-join",
-                a->no_join,
+  cmd->add_flag("!--no-join",
+                a->calibration.association.join_pieces,
                 "Filter (window and after) and refinement: keep a track that starts where a line "
                 "the tracker lost is predicted as a line of its own, instead of joining it to that "
                 "line (docs/theory/association.md#pieces-of-one-line)");
@@ -246,11 +236,11 @@ void add_calibrate_command(CLI::App& app) {
       ->check(CLI::Range(0.0, 20.0))
       ->capture_default_str();
   cmd->add_flag("!--no-noise-check",
-                a->noise_check,
+                a->calibration.noise_check.enabled,
                 "Report the model's covariances as they are, without the data's check of the "
                 "bearing noise (errors summed along each track; docs/theory/noise-check.md)");
   cmd->add_option("--noise-check-lower-level",
-                  a->noise_check_lower_level,
+                  a->calibration.noise_check.lower_level,
                   "The noise check finds the bearings less noisy than the model assumes when "
                   "errors this small have at most this probability under the model, and then "
                   "shrinks the bearings' share of the covariance where the tracker kept its "
@@ -269,6 +259,8 @@ void add_calibrate_command(CLI::App& app) {
   add_prior_options(cmd, *a);
   add_model_options(cmd, *a);
   add_pipeline_options(cmd, a->pipeline);
+  add_mask_option(cmd, a->mask);
+  add_tilt_options(cmd, a->tilt);
   add_tracker_options(cmd, a->tracker);
   cmd->callback([a, cmd] {
     // Extraction and tracking flags given with --tracks do nothing: say so.

@@ -1,5 +1,6 @@
 // omnivert extract IMAGE: the vertical lines of one catadioptric image (Sec. 2-3).
 
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -11,7 +12,11 @@
 #include "omnivert/core/camera_geometry.hpp"
 #include "omnivert/core/error.hpp"
 #include "omnivert/describe/feature_pipeline.hpp"
+#include "omnivert/extract/tilt_estimator.hpp"
+#include "omnivert/image/grey.hpp"
 #include "omnivert/image/image_io.hpp"
+#include "omnivert/image/image_mask.hpp"
+#include "omnivert/pipeline/tilt_check.hpp"
 #include "omnivert/viz/overlay.hpp"
 #include "pipeline_options.hpp"
 
@@ -22,11 +27,35 @@ namespace {
 struct ExtractArgs {
   std::string image;
   std::string sensor;
+  std::string bayer;
+  int bit_depth = -1;
   bool json = false;
   std::string overlay;
   int highlight = -1;
+  std::string mask;
+  double xi = 0.0, gamma = 0.0;  // 0: from --sensor
+  bool correct_tilt = false;
   FeaturePipelineOptions pipeline;
 };
+
+// The tilt of the mirror axis measured on this image (docs/extraction.md, "Tilt"): one pass
+// with the wider line support of the dataset check.
+TiltEstimate measure_image_tilt(const cv::Mat& image,
+                                const CameraGeometry& geometry,
+                                const FeaturePipelineOptions& pipeline) {
+  const TiltCheckOptions check;
+  TiltEstimator estimator(geometry, check.estimator);
+  if (!geometry.has_projection()) return estimator.estimate();
+  FeaturePipelineOptions po = pipeline;
+  po.lines.lateral_tolerance_px =
+      std::max(po.lines.lateral_tolerance_px, check.lateral_tolerance_px);
+  FeaturePipeline pipe(geometry, po);
+  FrameFeatures f;
+  if (pipe.process(image, f)) {
+    estimator.add_frame(pipe.line_extractor().last_edge_points(), f.circle, f.lines);
+  }
+  return estimator.estimate();
+}
 
 void run_extract(const ExtractArgs& a) {
   std::string why;
@@ -36,15 +65,47 @@ void run_extract(const ExtractArgs& a) {
   if (!a.sensor.empty()) {
     geometry = load_camera_geometry(a.sensor);
   }
-  FeaturePipeline pipe(geometry, a.pipeline);
+  if (!a.bayer.empty()) {
+    const auto p = parse_bayer_pattern(a.bayer);
+    if (!p) throw InputError("--bayer " + a.bayer + ": expected RGGB, BGGR, GRBG, GBRG or none");
+    geometry.pixel_format.bayer = *p;
+  }
+  if (a.bit_depth >= 0) geometry.pixel_format.bit_depth = a.bit_depth;
+  if (!a.mask.empty()) {
+    // Without --sensor the mask gives the size the image must have.
+    geometry.mask = a.mask;
+    if (geometry.width == 0) {
+      const cv::Mat m = read_mask(a.mask);
+      geometry.width = m.cols;
+      geometry.height = m.rows;
+    }
+  }
+  if (a.xi > 0.0) geometry.xi = a.xi;
+  if (a.gamma > 0.0) geometry.gamma = a.gamma;
+  const TiltEstimate tilt = measure_image_tilt(image, geometry, a.pipeline);
+  const TiltCheckOptions check;
+  FeaturePipelineOptions po = a.pipeline;
+  const bool corrected = a.correct_tilt && tilt.valid && tilt.tilt_deg() > check.correct_deg;
+  if (corrected) po.tilt = tilt.vector;
+  FeaturePipeline pipe(geometry, po);
   FrameFeatures f;
   if (!pipe.process(image, f, &why)) throw InputError(a.image, 0, why);
+  const std::string warning = tilt_warning(tilt, check, corrected);
+  if (!warning.empty()) std::fprintf(stderr, "warning: %s\n", warning.c_str());
 
   if (a.json) {
     nlohmann::json j;
     j["center"] = {f.circle.center.x(), f.circle.center.y()};
     j["r_min"] = f.circle.r_min;
     j["r_max"] = f.circle.r_max;
+    if (tilt.valid) {
+      j["tilt"] = {{"tilt_deg", tilt.tilt_deg()},
+                   {"direction_deg", tilt.direction_deg()},
+                   {"sigma_deg", rad2deg(tilt.sigma)},
+                   {"lines", tilt.lines},
+                   {"rms_px", tilt.rms_px},
+                   {"corrected", corrected}};
+    }
     j["lines"] = nlohmann::json::array();
     for (std::size_t i = 0; i < f.lines.size(); ++i) {
       const auto& l = f.lines[i];
@@ -72,6 +133,9 @@ void run_extract(const ExtractArgs& a) {
                 f.circle.r_min,
                 f.circle.r_max,
                 f.lines.size());
+    if (geometry.has_projection()) {
+      std::printf("%s%s\n", tilt.describe().c_str(), corrected ? "; bearings upright" : "");
+    }
     std::printf("%4s %12s %16s %11s %9s %9s %8s %8s %8s\n",
                 "line",
                 "bearing[deg]",
@@ -97,7 +161,9 @@ void run_extract(const ExtractArgs& a) {
     }
   }
   if (!a.overlay.empty()) {
-    write_image_atomic(a.overlay, draw_overlay(image, f, pipe.descriptor_extractor(), a.highlight));
+    cv::Mat grey;  // the picture the lines were found in (a Bayer mosaic demosaiced)
+    to_grey8(image, geometry.pixel_format, grey, nullptr);
+    write_image_atomic(a.overlay, draw_overlay(grey, f, pipe.descriptor_extractor(), a.highlight));
     if (!a.json) std::printf("overlay written to %s\n", a.overlay.c_str());
   }
 }
@@ -108,10 +174,24 @@ void add_extract_command(CLI::App& app) {
   auto args = std::make_shared<ExtractArgs>();
   CLI::App* cmd = app.add_subcommand(
       "extract", "Vertical lines of one catadioptric image: centre, lines, bearings, descriptors");
-  cmd->add_option("IMAGE", args->image, "Image file (PNG, JPEG, ...; grey or colour)")->required();
+  cmd->add_option("IMAGE",
+                  args->image,
+                  "Image file (PNG, JPEG, TIFF, ...; grey or colour, 8 or 16 bits, or a raw "
+                  "Bayer mosaic with --bayer)")
+      ->required();
   cmd->add_option("--sensor",
                   args->sensor,
-                  "cam0/sensor.yaml: resolution, optional center, r_min, r_max, bearing_sign");
+                  "cam0/sensor.yaml: resolution, optional center, r_min, r_max, bearing_sign, "
+                  "bayer, bit_depth");
+  cmd->add_option("--bayer",
+                  args->bayer,
+                  "The image is a raw Bayer mosaic with this pattern (RGGB, BGGR, GRBG, GBRG; "
+                  "none: grey or colour); overrides sensor.yaml's bayer");
+  cmd->add_option("--bit-depth",
+                  args->bit_depth,
+                  "Significant bits of a 16-bit image (e.g. 12 for values 0..4095; 0: the full "
+                  "16 bits); overrides sensor.yaml's bit_depth")
+      ->check(CLI::IsMember({0, 9, 10, 11, 12, 13, 14, 15, 16}));
   cmd->add_flag("--json", args->json, "Print one JSON object instead of a table");
   cmd->add_option("--overlay",
                   args->overlay,
@@ -119,7 +199,13 @@ void add_extract_command(CLI::App& app) {
   cmd->add_option("--highlight",
                   args->highlight,
                   "Line whose descriptor areas the overlay draws (default: the longest)");
+  cmd->add_option("--xi", args->xi, "Unified model xi, for the tilt measurement (else --sensor's)");
+  cmd->add_option("--gamma", args->gamma, "Unified model gamma [px] (else --sensor's)");
+  cmd->add_flag("--correct-tilt",
+                args->correct_tilt,
+                "Rectify the image to an upright camera when the measured tilt exceeds 0.25 deg");
   add_pipeline_options(cmd, args->pipeline);
+  add_mask_option(cmd, args->mask);
   cmd->callback([args] { run_extract(*args); });
 }
 

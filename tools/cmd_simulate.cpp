@@ -22,6 +22,8 @@ struct SimulateArgs {
   std::string wheel_unit = "meters";
   std::vector<double> center;
   std::vector<double> ticks_per_meter;
+  std::vector<double> reflection;
+  std::vector<double> reflection_radii;
 };
 
 // World, trajectory, output and frames.
@@ -59,6 +61,14 @@ void add_camera_options(CLI::App* cmd, SimulateArgs& a) {
   cmd->add_option(
          "--bearing-sign", c.camera.bearing_sign, "+1: beta = a; -1: mirrored image (beta = -a)")
       ->check(CLI::IsMember({1, -1}))
+      ->capture_default_str();
+  cmd->add_option("--tilt-deg",
+                  c.camera.tilt_deg,
+                  "Tilt of the mirror axis from the vertical [deg], 0..10 (docs/simulator.md)")
+      ->capture_default_str();
+  cmd->add_option("--tilt-direction-deg",
+                  c.camera.tilt_direction_deg,
+                  "Camera bearing the tilted axis leans towards [deg]")
       ->capture_default_str();
   cmd->add_option("--camera-height", c.camera_height, "Camera centre above the floor [m]")
       ->capture_default_str();
@@ -115,6 +125,56 @@ void add_image_sensor_options(CLI::App* cmd, SimulateArgs& a) {
       ->check(kNonNegative);
 }
 
+// Struts, the robot's reflection and the ground-truth mask (docs/simulator.md).
+void add_overlay_options(CLI::App* cmd, SimulateArgs& a) {
+  sim::RobotOverlay& o = a.cfg.overlay;
+  const std::string g = "Struts and reflection";
+  cmd->add_option("--strut",
+                  o.strut_angles_deg,
+                  "Draw a dark mount strut from the rim inward at these image angles [deg]")
+      ->group(g);
+  cmd->add_option("--strut-width", o.strut_width_px, "Strut width [px]")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 100.0))
+      ->group(g);
+  cmd->add_option("--strut-inner",
+                  o.strut_inner_px,
+                  "Inner end of the struts [px from the centre] (0: r_min)")
+      ->capture_default_str()
+      ->check(kNonNegative)
+      ->group(g);
+  cmd->add_option("--strut-grey", o.strut_grey, "Grey level of the struts")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 255.0))
+      ->group(g);
+  cmd->add_option(
+         "--reflection",
+         a.reflection,
+         "Draw the robot's reflection: a sector at image angle ANGLE [deg], WIDTH [deg] wide")
+      ->expected(2)
+      ->group(g);
+  cmd->add_option("--reflection-radii",
+                  a.reflection_radii,
+                  "Inner and outer radius of the reflection [px] (default: r_min - 3 to r_min + "
+                  "30% of the annulus)")
+      ->expected(2)
+      ->check(kNonNegative)
+      ->group(g);
+  cmd->add_option("--reflection-grey", o.reflection_grey, "Grey level of the reflection")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 255.0))
+      ->group(g);
+  cmd->add_flag(
+         "--write-mask",
+         o.write_mask,
+         "Write the ground-truth mask cam0/mask.png and 'mask: mask.png' in cam0/sensor.yaml")
+      ->group(g);
+  cmd->add_option("--mask-margin", o.mask_margin_px, "The mask covers this much more [px]")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 20.0))
+      ->group(g);
+}
+
 void run_simulate(SimulateArgs& a) {
   sim::SimConfig& cfg = a.cfg;
   cfg.wheel.ticks = a.wheel_unit == "ticks";
@@ -125,6 +185,14 @@ void run_simulate(SimulateArgs& a) {
   if (!a.ticks_per_meter.empty()) {
     cfg.wheel.ticks_per_meter_left = a.ticks_per_meter.front();
     cfg.wheel.ticks_per_meter_right = a.ticks_per_meter.back();
+  }
+  if (a.reflection.size() == 2) {
+    cfg.overlay.reflection_angle_deg = a.reflection[0];
+    cfg.overlay.reflection_width_deg = a.reflection[1];
+  }
+  if (a.reflection_radii.size() == 2) {
+    cfg.overlay.reflection_r_inner_px = a.reflection_radii[0];
+    cfg.overlay.reflection_r_outer_px = a.reflection_radii[1];
   }
   const sim::World world = sim::load_world(a.world);
   const sim::Trajectory trajectory = sim::load_trajectory(a.trajectory);
@@ -158,6 +226,7 @@ void add_simulate_command(CLI::App& app) {
   add_camera_options(cmd, *args);
   add_wheel_options(cmd, *args);
   add_image_sensor_options(cmd, *args);
+  add_overlay_options(cmd, *args);
   cmd->callback([args]() { run_simulate(*args); });
 }
 

@@ -23,6 +23,8 @@ struct TrackArgs {
   std::string dataset;
   std::string out;
   FeaturePipelineOptions pipeline;
+  std::string mask;
+  TiltCheckOptions tilt;
   TrackerFlags tracker;
 };
 
@@ -40,6 +42,8 @@ void run_track(const TrackArgs& a) {
 
   TrackDatasetOptions o;
   o.pipeline = a.pipeline;
+  o.mask = a.mask;
+  o.tilt = a.tilt;
   o.tracker = a.tracker.options();
   Progress bar("track", data.size());
   const auto r = track_dataset(data, o, [&](std::size_t done, std::size_t) { bar.update(done); });
@@ -56,6 +60,9 @@ void run_track(const TrackArgs& a) {
               r.rows.size(),
               static_cast<long long>(r.stats.new_tracks),
               r.stats.BriefReport().c_str());
+  if (r.tilt.valid) {
+    std::printf("%s%s\n", r.tilt.describe().c_str(), r.tilt_corrected ? "; frames rectified" : "");
+  }
   std::printf("wrote %s and %s\n", csv.c_str(), png.c_str());
 }
 
@@ -68,6 +75,8 @@ void add_track_command(CLI::App& app) {
   cmd->add_option("DATASET", a->dataset, "Dataset folder (cam0/, optional wheel0/)")->required();
   cmd->add_option("--out", a->out, "Output folder")->required();
   add_pipeline_options(cmd, a->pipeline);
+  add_mask_option(cmd, a->mask);
+  add_tilt_options(cmd, a->tilt);
   add_tracker_options(cmd, a->tracker);
   cmd->callback([a] { run_track(*a); });
 }

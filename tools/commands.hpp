@@ -48,6 +48,8 @@ struct CommandExit {
 };
 
 void add_extract_command(CLI::App& app);
+// omnivert camera: centre, annulus and mask of a new camera (tools/cmd_camera.cpp).
+void add_camera_command(CLI::App& app);
 void add_pattern_command(CLI::App& app);
 // omnivert simulate: render a dataset with ground truth (tools/cmd_simulate.cpp).
 void add_simulate_command(CLI::App& app);

@@ -44,6 +44,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "omnivert 0.1.0");
 
   omnivert::cli::add_extract_command(app);
+  omnivert::cli::add_camera_command(app);
   omnivert::cli::add_pattern_command(app);
   omnivert::cli::add_simulate_command(app);
   omnivert::cli::add_track_command(app);

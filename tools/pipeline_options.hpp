@@ -10,12 +10,36 @@
 #include "commands.hpp"
 
 #include "omnivert/describe/feature_pipeline.hpp"
+#include "omnivert/pipeline/tilt_check.hpp"
 
 namespace omnivert::cli {
 
 // The help groups of these options (cmd_calibrate names them when --tracks makes them idle).
 inline constexpr const char* kExtractionGroup = "Extraction (Sec. 2)";
 inline constexpr const char* kDescriptorGroup = "Descriptor (Sec. 3)";
+
+// --mask FILE: the image mask of docs/dataset-format.md#image-mask, instead of sensor.yaml's.
+inline void add_mask_option(CLI::App* cmd, std::string& mask) {
+  cmd->add_option("--mask",
+                  mask,
+                  "Image mask: a one-channel image of the camera's size, non-zero = usable pixel "
+                  "(instead of the mask: of sensor.yaml)")
+      ->group(kExtractionGroup);
+}
+
+// The tilt check of a dataset (docs/extraction.md, "Tilt").
+inline void add_tilt_options(CLI::App* cmd, TiltCheckOptions& o) {
+  const std::string g = kExtractionGroup;
+  cmd->add_flag("!--no-tilt-check",
+                o.enabled,
+                "Do not measure the tilt of the mirror axis before tracking")
+      ->group(g);
+  cmd->add_option("--tilt-correct-above",
+                  o.correct_deg,
+                  "Rectify the frames when the measured tilt exceeds this [deg] (90: never)")
+      ->capture_default_str()
+      ->group(g);
+}
 
 inline void add_pipeline_options(CLI::App* cmd, FeaturePipelineOptions& o) {
   const std::string g = kExtractionGroup;

@@ -20,14 +20,15 @@
 // --model-sigma-deg S: the bearing sigma the filter and the batches assume (default: the
 //   simulated one), to study the noise check (docs/theory/noise-check.md).
 // --bias-deg B: a constant bearing error per line, sigma B degrees (SyntheticRunOptions::
-//   track_bias_sigma); --model-bias-deg B: the one the estimators assume (Options::
+//   track_bias_sigma); --model-bias-deg B: the one the estimators assume (CalibrationOptions::
 //   track_bias_sigma; default: the simulated one).
-// --lower-level L: the noise check's "less noise" level (CalibrateOptions::
-//   noise_check_lower_level; default: the tool's).
-// --no-merge: the refinement does not join the pieces of one line (BatchOptions::merge_pieces).
+// --lower-level L: the noise check's "less noise" level (CalibrationOptions::noise_check.
+//   lower_level; default: the tool's).
+// --no-merge: the pieces of one line are not joined, in the filter nor in the refinement
+//   (CalibrationOptions::association.join_pieces).
 // Diagnostics (environment): PRIOR_AT_TRUTH=s (prior centred on truth, sigma s), PRIOR_SIGMA=s,
 // DMIN/DMAX (feature distance prior), CONVERT (convert_ratio), NO_SECOND_ORDER,
-// NO_FILTER_JOIN (Options::join_pieces off), VERBOSE, WINDOW_NEES.
+// NO_FILTER_JOIN (CalibrationOptions::association.join_pieces off), VERBOSE, WINDOW_NEES.
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
@@ -128,13 +129,13 @@ void print(const char* name, const Stats& s, const Eigen::Vector3d& crlb, double
 struct Args {
   int runs = 50, iterations = 3;
   bool refine = false;
-  double bootstrap = Options{}.bootstrap_rotation;
+  double bootstrap = FilterOptions{}.bootstrap_rotation;
   bool merge = true;
   double sigma_deg = 0.3, model_sigma_deg = -1.0, inflation = 1.0, correlation = 0.0,
          break_probability = 0.0;
-  double lateral = Options{}.lateral_sigma;
+  double lateral = RobotModel{}.lateral_sigma;
   double bias_deg = 0.0, model_bias_deg = -1.0;
-  double lower_level = CalibrateOptions{}.noise_check_lower_level;
+  double lower_level = NoiseCheckOptions{}.lower_level;
   std::string init = "anchored", trajectory = "paper";
   std::uint64_t seed = 1;
 };
@@ -205,31 +206,32 @@ SyntheticRunOptions synthetic_options(const Args& a) {
 }
 
 // The estimators' options, with the diagnostics from the environment.
-Options filter_options(const Args& a, const SyntheticRunOptions& so) {
-  Options fo;
-  fo.wheel_base = so.wheel_base;
-  fo.odometry_K = so.odometry_K;
-  fo.odometry_inflation = a.inflation;
-  fo.bearing_sigma = a.model_sigma_deg > 0 ? deg2rad(a.model_sigma_deg) : so.bearing_sigma;
-  fo.track_bias_sigma = a.model_bias_deg >= 0 ? deg2rad(a.model_bias_deg) : so.track_bias_sigma;
-  fo.update_iterations = a.iterations;
-  fo.lateral_sigma = a.lateral;
-  fo.feature_init = a.init == "naive"     ? FeatureInit::kNaive
-                    : a.init == "inverse" ? FeatureInit::kInverseDistance
-                                          : FeatureInit::kAnchoredInverseDepth;
+CalibrationOptions filter_options(const Args& a, const SyntheticRunOptions& so) {
+  CalibrationOptions fo;
+  fo.robot.wheel_base = so.wheel_base;
+  fo.robot.odometry_K = so.odometry_K;
+  fo.filter.odometry_inflation = a.inflation;
+  fo.noise.bearing_sigma = a.model_sigma_deg > 0 ? deg2rad(a.model_sigma_deg) : so.bearing_sigma;
+  fo.noise.track_bias_sigma =
+      a.model_bias_deg >= 0 ? deg2rad(a.model_bias_deg) : so.track_bias_sigma;
+  fo.filter.update_iterations = a.iterations;
+  fo.robot.lateral_sigma = a.lateral;
+  fo.filter.feature_init = a.init == "naive"     ? FeatureInit::kNaive
+                           : a.init == "inverse" ? FeatureInit::kInverseDistance
+                                                 : FeatureInit::kAnchoredInverseDepth;
 
   if (const char* c = std::getenv("PRIOR_AT_TRUTH")) {  // diagnostics: prior centred on truth
-    fo.prior = so.truth;
-    fo.prior_sigma = Eigen::Vector3d(std::atof(c), std::atof(c) / 8, std::atof(c));
+    fo.prior.mean = so.truth;
+    fo.prior.sigma = Eigen::Vector3d(std::atof(c), std::atof(c) / 8, std::atof(c));
   }
   if (const char* c = std::getenv("PRIOR_SIGMA"))  // diagnostics
-    fo.prior_sigma = Eigen::Vector3d(std::atof(c), std::atof(c) / 8, std::atof(c));
-  if (const char* c = std::getenv("DMIN")) fo.min_feature_distance = std::atof(c);
-  if (const char* c = std::getenv("DMAX")) fo.max_feature_distance = std::atof(c);
-  if (const char* c = std::getenv("CONVERT")) fo.convert_ratio = std::atof(c);
-  if (std::getenv("NO_SECOND_ORDER")) fo.second_order_noise = false;
-  if (std::getenv("NO_FILTER_JOIN")) fo.join_pieces = false;
-  fo.bootstrap_rotation = a.bootstrap;
+    fo.prior.sigma = Eigen::Vector3d(std::atof(c), std::atof(c) / 8, std::atof(c));
+  if (const char* c = std::getenv("DMIN")) fo.filter.min_feature_distance = std::atof(c);
+  if (const char* c = std::getenv("DMAX")) fo.filter.max_feature_distance = std::atof(c);
+  if (const char* c = std::getenv("CONVERT")) fo.filter.convert_ratio = std::atof(c);
+  if (std::getenv("NO_SECOND_ORDER")) fo.filter.second_order_noise = false;
+  if (std::getenv("NO_FILTER_JOIN")) fo.association.join_pieces = false;
+  fo.filter.bootstrap_rotation = a.bootstrap;
   return fo;
 }
 
@@ -279,7 +281,7 @@ void print_window_nees(const SyntheticRun& run, const FilterResult& fr, const St
 
 // The Cramer-Rao bound of this run (Fisher information at the truth), and with --break the
 // bound with each line's pieces under one id (what joining them can reach).
-void add_crlb(const SyntheticRun& run, const Options& fo, const Args& a, Totals& t) {
+void add_crlb(const SyntheticRun& run, const CalibrationOptions& fo, const Args& a, Totals& t) {
   BatchPoint truth;
   truth.poses = run.true_poses;
   truth.extrinsics = run.truth;
@@ -305,11 +307,11 @@ void add_crlb(const SyntheticRun& run, const Options& fo, const Args& a, Totals&
 // With --refine: the refinement's errors, the noise check, and the joins of pieces.
 void add_refinement(int r, const SyntheticRun& run, const CalibrationResult& cr, Totals& t) {
   if (cr.refinement.covariance_ok) {
-    t.ref.add(cr.refinement.extrinsics, cr.refinement_model_covariance, run.truth);
-    if (cr.noise_checked) {
-      t.scales.push_back(cr.noise.scale);
-      t.applied += cr.noise_applied ? 1 : 0;
-      t.filter_applied += cr.filter_noise_applied ? 1 : 0;
+    t.ref.add(cr.refinement.extrinsics, cr.noise_check.refinement_model_covariance, run.truth);
+    if (cr.noise_check.checked) {
+      t.scales.push_back(cr.noise_check.check.scale);
+      t.applied += cr.noise_check.applied ? 1 : 0;
+      t.filter_applied += cr.noise_check.filter_applied ? 1 : 0;
       t.ref_checked.add(cr.refinement.extrinsics, cr.refinement.covariance, run.truth);
       t.filt_checked.add(cr.filter.extrinsics, cr.filter.covariance, run.truth);
     }
@@ -362,19 +364,21 @@ void add_refinement(int r, const SyntheticRun& run, const CalibrationResult& cr,
 // Run r: the filter (with --refine, the tool's pipeline calib::calibrate: the filter, the
 // refinement, and the noise checks of the filter (its tracks as its window split them) and of
 // the refinement; the model's covariances are kept aside; the filter is run once either way).
-void run_once(int r, const Args& a, SyntheticRunOptions& so, const Options& fo, Totals& t) {
+void run_once(
+    int r, const Args& a, SyntheticRunOptions& so, const CalibrationOptions& fo, Totals& t) {
   so.seed = a.seed + r;
   const SyntheticRun run = make_synthetic_run(so);
   CalibrationResult cr;
   if (a.refine) {
-    CalibrateOptions co{.refine = true};
-    co.batch.lateral_sigma = a.lateral;
-    co.batch.merge_pieces = a.merge;
-    co.noise_check_lower_level = a.lower_level;
-    cr = calibrate(run.run, fo, co);
+    CalibrationOptions co = fo;
+    co.refinement.enabled = true;
+    co.association.join_pieces = fo.association.join_pieces && a.merge;
+    co.noise_check.lower_level = a.lower_level;
+    cr = calibrate(run.run, co);
   }
   const FilterResult fr = a.refine ? cr.filter : run_filter(run.run, fo);
-  t.filt.add(fr.extrinsics, a.refine ? cr.filter_model_covariance : fr.covariance, run.truth);
+  t.filt.add(
+      fr.extrinsics, a.refine ? cr.noise_check.filter_model_covariance : fr.covariance, run.truth);
   if (std::getenv("MISSING")) print_missing_tracks(run, fr);
   if (std::getenv("WINDOW_NEES") && fr.window_frames > 0) print_window_nees(run, fr, t.filt);
   if (std::getenv("VERBOSE") && !t.filt.nees.empty())
@@ -389,7 +393,7 @@ void run_once(int r, const Args& a, SyntheticRunOptions& so, const Options& fo, 
 }
 
 // The settings and the Cramer-Rao bounds (RMS over runs).
-void print_settings_and_bounds(const Args& a, const Options& fo, const Totals& t) {
+void print_settings_and_bounds(const Args& a, const CalibrationOptions& fo, const Totals& t) {
   const int runs = a.runs;
   std::printf(
       "trajectory %s, bearing noise %.4f deg + per line %.4f (model %.4f + %.4f), init %s, "
@@ -398,8 +402,8 @@ void print_settings_and_bounds(const Args& a, const Options& fo, const Totals& t
       a.trajectory.c_str(),
       a.sigma_deg,
       a.bias_deg,
-      rad2deg(fo.bearing_sigma),
-      rad2deg(fo.track_bias_sigma),
+      rad2deg(fo.noise.bearing_sigma),
+      rad2deg(fo.noise.track_bias_sigma),
       a.init.c_str(),
       a.bootstrap,
       a.inflation,
@@ -469,7 +473,7 @@ void print_tables(const Args& a, const Totals& t) {
 int main(int argc, char** argv) {
   const Args a = parse_args(argc, argv);
   SyntheticRunOptions so = synthetic_options(a);
-  const Options fo = filter_options(a, so);
+  const CalibrationOptions fo = filter_options(a, so);
   Totals t;
   Progress progress("monte carlo", a.runs);
   for (int r = 0; r < a.runs; ++r) {

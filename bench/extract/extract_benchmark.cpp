@@ -3,6 +3,9 @@
 // in the same run on the same frame: ORB (500 keypoints, detect + describe) and OpenCV's
 // LSD/EDLines + LBD (BinaryDescriptor: detect + compute).
 //
+// The *_Masked variants run the same stages with an image mask (four struts 8 px wide across
+// the annulus and a 60-degree sector near the centre: 9% of the annulus; docs/extraction.md).
+//
 // Report: median real time per frame (run with --benchmark_repetitions=9
 // --benchmark_report_aggregates_only=true).
 
@@ -10,6 +13,9 @@
 #include <opencv2/features2d.hpp>
 #include <opencv2/line_descriptor.hpp>
 
+#include <opencv2/imgproc.hpp>
+
+#include "omnivert/core/angles.hpp"
 #include "omnivert/describe/feature_pipeline.hpp"
 #include "omnivert/sim/radial_pattern.hpp"
 
@@ -37,6 +43,25 @@ CameraGeometry geometry() {
   return g;
 }
 
+// Four struts and a sector of the robot's reflection masked.
+const cv::Mat& mask() {
+  static const cv::Mat m = [] {
+    cv::Mat u(frame().image.size(), CV_8U, cv::Scalar(255));
+    const cv::Point2d c(frame().circle.center.x(), frame().circle.center.y());
+    for (double deg : {10.0, 100.0, 190.0, 280.0}) {
+      const double a = deg2rad(deg);
+      cv::line(u,
+               c + 30 * cv::Point2d(std::cos(a), std::sin(a)),
+               c + 240 * cv::Point2d(std::cos(a), std::sin(a)),
+               cv::Scalar(0),
+               8);
+    }
+    cv::ellipse(u, c, cv::Size(90, 90), 0, 200, 260, cv::Scalar(0), cv::FILLED);
+    return u;
+  }();
+  return m;
+}
+
 // The whole front end in steady state: the centre is re-detected every frame (Sec. 2).
 void BM_FrontEnd(benchmark::State& state) {
   FeaturePipeline pipe(geometry());
@@ -49,6 +74,19 @@ void BM_FrontEnd(benchmark::State& state) {
   state.counters["lines"] = static_cast<double>(f.lines.size());
 }
 BENCHMARK(BM_FrontEnd)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_FrontEnd_Masked(benchmark::State& state) {
+  FeaturePipeline pipe(geometry());
+  pipe.set_mask(mask());
+  FrameFeatures f;
+  pipe.process(frame().image, f);
+  for (auto _ : state) {
+    pipe.process(frame().image, f);
+    benchmark::DoNotOptimize(f.descriptors.data());
+  }
+  state.counters["lines"] = static_cast<double>(f.lines.size());
+}
+BENCHMARK(BM_FrontEnd_Masked)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_MirrorCentre(benchmark::State& state) {
   MirrorCenterDetector det;
@@ -69,6 +107,19 @@ void BM_RadialLines(benchmark::State& state) {
 }
 BENCHMARK(BM_RadialLines)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+void BM_RadialLines_Masked(benchmark::State& state) {
+  LineExtractor ex;
+  ex.set_mask(mask());
+  std::vector<VerticalLine> lines;
+  ex.extract(frame().image, frame().circle, lines);
+  for (auto _ : state) {
+    ex.extract(frame().image, frame().circle, lines);
+    benchmark::DoNotOptimize(lines.data());
+  }
+  state.counters["lines"] = static_cast<double>(lines.size());
+}
+BENCHMARK(BM_RadialLines_Masked)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 void BM_Descriptors(benchmark::State& state) {
   LineExtractor ex;
   std::vector<VerticalLine> lines;
@@ -82,6 +133,21 @@ void BM_Descriptors(benchmark::State& state) {
   state.counters["lines"] = static_cast<double>(lines.size());
 }
 BENCHMARK(BM_Descriptors)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_Descriptors_Masked(benchmark::State& state) {
+  LineExtractor ex;
+  std::vector<VerticalLine> lines;
+  ex.extract(frame().image, frame().circle, lines);
+  DescriptorExtractor d;
+  d.set_mask(mask());
+  DescriptorMatrix m;
+  for (auto _ : state) {
+    d.compute(frame().image, frame().circle, lines, m);
+    benchmark::DoNotOptimize(m.data());
+  }
+  state.counters["lines"] = static_cast<double>(lines.size());
+}
+BENCHMARK(BM_Descriptors_Masked)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_Peer_ORB(benchmark::State& state) {
   auto orb = cv::ORB::create(500);

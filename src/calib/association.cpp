@@ -39,12 +39,14 @@ CalibrationRun split_round(const CalibrationRun& original,
 }
 
 bool merge_round(Built* b,
-                 const Options& options,
+                 const CalibrationOptions& options,
                  CalibrationRun* run,
                  BatchPoint* at,
                  std::vector<std::pair<int, int>>* joins) {
   const std::vector<std::pair<int, int>> found =
-      find_merges(b, options.max_missed_frames, chi2_quantile(options.gate_probability, 2));
+      find_merges(b,
+                  options.association.max_missed_frames,
+                  chi2_quantile(options.association.gate_probability, 2));
   if (found.empty()) return false;
   *at = point_of(*b);
   std::map<int, int> renamed;
@@ -54,17 +56,16 @@ bool merge_round(Built* b,
   return true;
 }
 
-Options association_options(const Options& options) {
-  Options a = options;
-  a.bearing_sigma = std::hypot(options.bearing_sigma, options.track_bias_sigma);
-  a.track_bias_sigma = 0.0;
+CalibrationOptions association_options(const CalibrationOptions& options) {
+  CalibrationOptions a = options;
+  a.noise.bearing_sigma = std::hypot(options.noise.bearing_sigma, options.noise.track_bias_sigma);
+  a.noise.track_bias_sigma = 0.0;
   return a;
 }
 
 Built final_with_bias(const CalibrationRun& run,
                       const Built& b,
-                      const Options& options,
-                      const BatchOptions& batch,
+                      const CalibrationOptions& options,
                       bool robust,
                       int min_track_length) {
   const std::set<std::pair<int, int>> keep(b.bearing_keys.begin(), b.bearing_keys.end());
@@ -78,9 +79,9 @@ Built final_with_bias(const CalibrationRun& run,
                              }),
               obs.end());
   }
-  Options o = options;
-  o.min_track_length = min_track_length;
-  Built f = build(kept, o, point_of(b), batch, robust);
+  CalibrationOptions o = options;
+  o.association.min_track_length = min_track_length;
+  Built f = build(kept, o, point_of(b), robust);
   f.guarded = b.guarded;
   return f;
 }
@@ -103,23 +104,23 @@ bool reject_and_solve(Built* b,
                       const AssociationSetup& setup,
                       const std::map<int, int>& tracker,
                       int* rejected) {
-  const Options& options = *setup.options;
+  const CalibrationOptions& options = *setup.options;
   // Bearings where lines cross out first (the outliers are judged without them).
   if (reject_crossings(b,
-                       options.crossing_guard,
-                       options.max_missed_frames,
+                       options.association.crossing_guard,
+                       options.association.max_missed_frames,
                        setup.min_bearings,
                        tracker,
-                       chi2_quantile(options.gate_probability, 2)) > 0) {
+                       chi2_quantile(options.association.gate_probability, 2)) > 0) {
     if (out_of_features(*b, setup)) return false;
     setup.solve(b);
   }
   *rejected = 0;
-  if (drop_collapsed_features(b, options.min_feature_range) > 0) {
+  if (drop_collapsed_features(b, options.association.min_feature_range) > 0) {
     if (out_of_features(*b, setup)) return false;
     setup.solve(b);
   }
-  const double gate = std::sqrt(chi2_quantile(options.gate_probability, 1));
+  const double gate = std::sqrt(chi2_quantile(options.association.gate_probability, 1));
   for (int round = 0; round < 3; ++round) {
     const int n = reject_outliers(b, gate, setup.min_bearings);
     *rejected += n;

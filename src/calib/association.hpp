@@ -41,10 +41,10 @@ double one_line_statistic(Built* b, int a, int c, FeatureCovariance* cache);
 
 bool one_line(Built* b, int a, int c, double chi2, FeatureCovariance* cache);
 
-// The crossing guard (Options::crossing_guard): removes the bearings of a feature at the
-// frames where another feature, over its track's span (first to last bearing) widened by
-// `margin` frames on each side, is predicted within `guard` of it as seen from the camera,
-// at the current solution. (The widening: a track often starts or ends where its line met
+// The crossing guard (CalibrationOptions::association.crossing_guard): removes the bearings of a
+// feature at the frames where another feature, over its track's span (first to last bearing)
+// widened by `margin` frames on each side, is predicted within `guard` of it as seen from the
+// camera, at the current solution. (The widening: a track often starts or ends where its line met
 // another, its detections given to the other track meanwhile; the tracker bridges gaps of
 // max_missed_frames, the margin used.) There the extractor
 // sees one line where there are two: the detection is pulled towards the other line, or
@@ -77,10 +77,10 @@ int reject_crossings(Built* b,
 // 0.00 (PiecesOfOneLine.AreJoinedOnlyWithTheirOwnLine).
 double one_point_statistic(Built* b, const std::vector<std::size_t>& blocks, int a, int c);
 
-// Pieces of one line (BatchOptions::merge_pieces, Options::join_pieces): a tracker that loses
-// a line and finds it again gives it a new id, and the batch then has two features where
-// there is one point. Each piece is estimated from its own few bearings, from little
-// parallax; with tracks broken every ~10 frames (synthetic paper runs, calib_monte_carlo
+// Pieces of one line (CalibrationOptions::association.join_pieces): a tracker that loses a line and
+// finds it again gives it a new id, and the batch then has two features where there is one point.
+// Each piece is estimated from its own few bearings, from little parallax; with tracks broken every
+// ~10 frames (synthetic paper runs, calib_monte_carlo
 // --break 0.1) the refinement's NEES is 4.1 over 100 runs unjoined where the unbroken tracks
 // give 2.9 (docs/theory/association.md#pieces-of-one-line). Candidates: two tracks that never share
 // a frame, at most `max_gap` frames apart (or interleaved: a chain of joins can skip a piece, which
@@ -94,17 +94,17 @@ double one_point_statistic(Built* b, const std::vector<std::size_t>& blocks, int
 // against 3.17). Returns (a, c) pairs, a the piece seen first: c's bearings are a's line.
 std::vector<std::pair<int, int>> find_merges(Built* b, int max_gap, double chi2);
 
-// Track splitting (BatchOptions::split_chi2). A track that slipped onto a neighbouring line
-// (a door leaf 6 cm inside its frame) is two features glued together: from the frame of the
-// slip on, its bearings follow another point. For each track and each split frame j, the
-// likelihood-ratio statistic of "two features, before and after j" against "one feature"
-// with poses and extrinsics held at the current solution, linearised there: with the whitened
-// residuals r_i and their Jacobians J_i (1x2) on the feature point, each segment's best
-// feature step reduces the squared residuals by g^T H^-1 g (g = sum J_i^T r_i,
-// H = sum J_i^T J_i), computed for every j at once from prefix sums. Under no slip the
-// statistic at a fixed j is chi-square with 2 degrees of freedom. Returns track id -> first
-// frame of the second segment for tracks whose best statistic exceeds the threshold.
-std::map<int, int> find_splits(const Built& b, const BatchOptions& batch);
+// Track splitting (CalibrationOptions::association.split_chi2). A track that slipped onto a
+// neighbouring line (a door leaf 6 cm inside its frame) is two features glued together: from the
+// frame of the slip on, its bearings follow another point. For each track and each split frame j,
+// the likelihood-ratio statistic of "two features, before and after j" against "one feature" with
+// poses and extrinsics held at the current solution, linearised there: with the whitened residuals
+// r_i and their Jacobians J_i (1x2) on the feature point, each segment's best feature step reduces
+// the squared residuals by g^T H^-1 g (g = sum J_i^T r_i, H = sum J_i^T J_i), computed for every j
+// at once from prefix sums. Under no slip the statistic at a fixed j is chi-square with 2 degrees
+// of freedom. Returns track id -> first frame of the second segment for tracks whose best statistic
+// exceeds the threshold.
+std::map<int, int> find_splits(const Built& b, const AssociationOptions& split);
 
 // One round of track splitting: `found` (find_splits, ids of `current`) is added to `splits`
 // (tracker's ids, frames of the runs), the run is split again from `original` (split_tracks),
@@ -126,27 +126,26 @@ inline constexpr int kMergeRounds = 10;
 // `at` the solution with the joined pieces' points dropped (each line starts at its first
 // piece's), the joins appended to *joins. Returns false when nothing joins.
 bool merge_round(Built* b,
-                 const Options& options,
+                 const CalibrationOptions& options,
                  CalibrationRun* run,
                  BatchPoint* at,
                  std::vector<std::pair<int, int>>* joins);
 
-// Options::track_bias_sigma: which bearings belong together (lines that cross, outliers,
-// pieces of one line joined, tracks split where they slipped) is decided under the white
+// CalibrationOptions::noise.track_bias_sigma: which bearings belong together (lines that cross,
+// outliers, pieces of one line joined, tracks split where they slipped) is decided under the white
 // model whose sigma is a bearing's whole error, sqrt(bearing_sigma^2 + track_bias_sigma^2);
 // the estimate and its covariance under the model with the per-track bias, on the bearings
 // those decisions kept (final_with_bias). With the bias in the decisions, a slip onto a
 // neighbouring line is partly taken up by the slipped track's bias and left in: from pixels,
 // office zigzag at 0.018 + 0.016 degree, 6 of 100 filter runs ended 0.25-0.36 degree off
 // (NEES 10-24).
-Options association_options(const Options& options);
+CalibrationOptions association_options(const CalibrationOptions& options);
 
 // The problem of `b`'s bearings (on `run`, the run its ids are of) with the per-track bias,
 // from b's solution. `min_track_length`: of the problem that made the decisions.
 Built final_with_bias(const CalibrationRun& run,
                       const Built& b,
-                      const Options& options,
-                      const BatchOptions& batch,
+                      const CalibrationOptions& options,
                       bool robust,
                       int min_track_length);
 
@@ -158,13 +157,13 @@ Built final_with_bias(const CalibrationRun& run,
 // each on the problem rebuilt from the last solution, solved, and judged again as above.
 struct AssociationSetup {
   // crossing_guard, max_missed_frames, gate_probability, min_feature_range.
-  const Options* options = nullptr;
+  const CalibrationOptions* options = nullptr;
   // A feature keeps at least this many bearings: 2 (two rays fix a point), 1 with a prior on
   // its depth (the window).
   int min_bearings = 2;
   bool join_pieces = true;
   // split_chi2 (0: no splitting), split_rounds, split_min_bearings, split_keep_fraction.
-  BatchOptions split;
+  AssociationOptions split;
   // The tracker's id of each renamed id of the run given (the window's parts after a gap).
   std::map<int, int> base_origin;
   // Whether a problem left without features ends the loop (AssociationEnd); otherwise it is

@@ -92,7 +92,7 @@ std::vector<std::pair<int, int>> find_merges(Built* b, int max_gap, double chi2)
   return out;
 }
 
-std::map<int, int> find_splits(const Built& b, const BatchOptions& batch) {
+std::map<int, int> find_splits(const Built& b, const AssociationOptions& split) {
   struct Row {
     int frame;
     double r;
@@ -113,7 +113,7 @@ std::map<int, int> find_splits(const Built& b, const BatchOptions& batch) {
         {b.bearing_keys[i].second, r, Eigen::Vector2d(jf[0], jf[1])});
   }
   std::vector<std::tuple<double, int, int>> candidates;  // (statistic, track id, split frame)
-  const int m = std::max(batch.split_min_bearings, 2);
+  const int m = std::max(split.split_min_bearings, 2);
   auto gain = [](const Eigen::Matrix2d& H, const Eigen::Vector2d& g) {
     const Eigen::Matrix2d Hr = H + 1e-9 * (H.trace() + 1e-12) * Eigen::Matrix2d::Identity();
     return g.dot(Hr.ldlt().solve(g));
@@ -138,7 +138,7 @@ std::map<int, int> find_splits(const Built& b, const BatchOptions& batch) {
         best_j = j;
       }
     }
-    if (best_j > 0 && best > batch.split_chi2) candidates.push_back({best, id, v[best_j].frame});
+    if (best_j > 0 && best > split.split_chi2) candidates.push_back({best, id, v[best_j].frame});
   }
   // A slip biases the extrinsics, and a biased solution leaves structure in the residuals of
   // clean tracks too: only the tracks within a factor split_keep_fraction of the strongest
@@ -146,7 +146,7 @@ std::map<int, int> find_splits(const Built& b, const BatchOptions& batch) {
   std::sort(candidates.begin(), candidates.end(), std::greater<>());
   std::map<int, int> out;
   for (const auto& [t, id, frame] : candidates)
-    if (t >= batch.split_keep_fraction * std::get<0>(candidates.front())) out[id] = frame;
+    if (t >= split.split_keep_fraction * std::get<0>(candidates.front())) out[id] = frame;
   return out;
 }
 

@@ -52,8 +52,8 @@ struct BearingResidual {
   }
 };
 
-// Options::track_bias_sigma: the bearing with the track's constant error b added to
-// eq. (30)'s prediction, and b's prior.
+// CalibrationOptions::noise.track_bias_sigma: the bearing with the track's constant error b added
+// to eq. (30)'s prediction, and b's prior.
 struct BiasedBearingResidual {
   double beta, inv_sigma;
   template <typename T>

@@ -19,10 +19,10 @@ std::vector<Eigen::Vector3d> dead_reckoning(const CalibrationRun& run, double wh
 }
 
 BatchPoint batch_point_from_filter(const CalibrationRun& run,
-                                   const Options& options,
+                                   const CalibrationOptions& options,
                                    const FilterResult& filter) {
   BatchPoint b;
-  b.poses = dead_reckoning(run, options.wheel_base);
+  b.poses = dead_reckoning(run, options.robot.wheel_base);
   b.extrinsics = filter.extrinsics;
   for (const auto& [id, t] : filter.tracks) {
     if (t.frame < 0 || t.frame >= static_cast<int>(b.poses.size())) continue;

@@ -99,9 +99,8 @@ std::vector<double*> variable_blocks(Built& b) {
 }
 
 Built build(const CalibrationRun& run,
-            const Options& options,
+            const CalibrationOptions& options,
             const BatchPoint& at,
-            const BatchOptions& batch,
             bool robust) {
   if (at.poses.size() != run.frames.size())
     throw InputError("batch: the starting point has " + std::to_string(at.poses.size()) +
@@ -120,7 +119,8 @@ Built build(const CalibrationRun& run,
     for (const BearingObservation& o : f.observations) ++length[o.track_id];
   for (const auto& [id, n] : length) {
     auto it = at.features.find(id);
-    if (n >= options.min_track_length && it != at.features.end() && it->second.allFinite())
+    if (n >= options.association.min_track_length && it != at.features.end() &&
+        it->second.allFinite())
       b.features[id] = {it->second(0), it->second(1)};
   }
 
@@ -128,7 +128,7 @@ Built build(const CalibrationRun& run,
   b.problem->SetParameterBlockConstant(b.poses[0].data());  // gauge: frame 0 is the origin
   b.problem->AddParameterBlock(b.ex.data(), 3);
 
-  const double K = options.odometry_K * batch.odometry_inflation;
+  const double K = options.robot.odometry_K * options.refinement.odometry_inflation;
   for (std::size_t k = 1; k < run.frames.size(); ++k) {
     const FrameInput& f = run.frames[k];
     // Covariance of (d_right, d_left, lateral): eq. (31) over the frame's wheel samples
@@ -137,27 +137,27 @@ Built build(const CalibrationRun& run,
     Eigen::Matrix3d S = Eigen::Matrix3d::Zero();
     if (!f.covariance_per_K.isZero()) {
       S = K * f.covariance_per_K;
-      S(0, 0) += options.odometry_variance_floor;
-      S(1, 1) += options.odometry_variance_floor;
+      S(0, 0) += options.robot.odometry_variance_floor;
+      S(1, 1) += options.robot.odometry_variance_floor;
     } else {
       S.topLeftCorner<2, 2>() =
-          chong_kleeman_covariance(f.d_right, f.d_left, K, options.odometry_variance_floor);
+          chong_kleeman_covariance(f.d_right, f.d_left, K, options.robot.odometry_variance_floor);
     }
-    S(2, 2) += batch.lateral_sigma * batch.lateral_sigma;
+    S(2, 2) += options.robot.lateral_sigma * options.robot.lateral_sigma;
     // W = L^-1 with S = L L^T: W^T W = S^-1.
     const Eigen::LLT<Eigen::Matrix3d> llt(S);
     const Eigen::Matrix3d W = llt.matrixL().solve(Eigen::Matrix3d::Identity());
     auto* cost = new ceres::AutoDiffCostFunction<OdometryResidual, 3, 3, 3>(
-        new OdometryResidual{f.d_right, f.d_left, f.lateral, options.wheel_base, W});
+        new OdometryResidual{f.d_right, f.d_left, f.lateral, options.robot.wheel_base, W});
     b.odometry_blocks.push_back(
         b.problem->AddResidualBlock(cost, nullptr, b.poses[k - 1].data(), b.poses[k].data()));
   }
-  if (options.track_bias_sigma > 0.0)
+  if (options.noise.track_bias_sigma > 0.0)
     for (const auto& [id, f] : b.features) {
       double* bias = &(b.biases[id] = 0.0);
       b.bias_priors[id] =
           b.problem->AddResidualBlock(new ceres::AutoDiffCostFunction<BiasPrior, 1, 1>(
-                                          new BiasPrior{1.0 / options.track_bias_sigma}),
+                                          new BiasPrior{1.0 / options.noise.track_bias_sigma}),
                                       nullptr,
                                       bias);
     }
@@ -165,8 +165,9 @@ Built build(const CalibrationRun& run,
     for (const BearingObservation& o : run.frames[k].observations) {
       auto it = b.features.find(o.track_id);
       if (it == b.features.end()) continue;
-      const double inv_sigma = 1.0 / (options.bearing_sigma * o.sigma_scale);
-      ceres::LossFunction* loss = robust ? new ceres::HuberLoss(batch.huber_sigmas) : nullptr;
+      const double inv_sigma = 1.0 / (options.noise.bearing_sigma * o.sigma_scale);
+      ceres::LossFunction* loss =
+          robust ? new ceres::HuberLoss(options.refinement.huber_sigmas) : nullptr;
       if (auto bias = b.biases.find(o.track_id); bias != b.biases.end())
         b.bearing_blocks.push_back(b.problem->AddResidualBlock(
             new ceres::AutoDiffCostFunction<BiasedBearingResidual, 1, 3, 2, 3, 1>(

@@ -22,7 +22,8 @@ namespace omnivert::calib::internal {
 struct Built {
   std::vector<std::array<double, 3>> poses;
   std::map<int, std::array<double, 2>> features;
-  std::map<int, double> biases;  // Options::track_bias_sigma (std::map: stable addresses)
+  std::map<int, double>
+      biases;  // CalibrationOptions::noise.track_bias_sigma (std::map: stable addresses)
   std::map<int, ceres::ResidualBlockId> bias_priors;  // their priors, by track
   // (phi, rho, psi); heap storage: moving a Built keeps the address Ceres holds.
   std::vector<double> ex = std::vector<double>(3, 0.0);
@@ -81,8 +82,9 @@ std::vector<std::pair<int, int>> unused_bearings(const CalibrationRun& run,
 int drop_unobserved_features(Built* b, int min_bearings);
 
 // Removes the features that the solution puts closer than `min_range` to the camera centre
-// (eq. 16-17) at a frame with one of their bearings (Options::min_feature_range), with their
-// bearings and any prior on them. Returns how many features.
+// (eq. 16-17) at a frame with one of their bearings
+// (CalibrationOptions::association.min_feature_range), with their bearings and any prior on them.
+// Returns how many features.
 int drop_collapsed_features(Built* b, double min_range);
 
 // Removes the bearings whose whitened residual exceeds `threshold` (the filter's chi-square
@@ -112,15 +114,14 @@ std::vector<double*> variable_blocks(Built& b);
 
 // The problem of `run` at `at` (the formulation of batch_point.hpp): a pose per frame (frame
 // 0 constant, the gauge), the extrinsics, a point per track with at least
-// options.min_track_length bearings and a finite starting point, and with
-// options.track_bias_sigma a bias per track with its prior; odometry factors between
-// consecutive frames (eq. 14-15, 31, with batch.lateral_sigma), a bearing factor per
+// options.association.min_track_length bearings and a finite starting point, and with
+// options.noise.track_bias_sigma a bias per track with its prior; odometry factors between
+// consecutive frames (eq. 14-15, 31, with robot.lateral_sigma), a bearing factor per
 // observation (eq. 16-17, Huber loss when `robust`). Throws InputError when `at` has not one
 // pose per frame.
 Built build(const CalibrationRun& run,
-            const Options& options,
+            const CalibrationOptions& options,
             const BatchPoint& at,
-            const BatchOptions& batch,
             bool robust);
 
 // The problem's current values, angles wrapped.

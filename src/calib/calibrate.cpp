@@ -43,46 +43,49 @@ CalibrationRun without_bearings(const CalibrationRun& run,
   return out;
 }
 
-// CalibrateOptions::noise_check_lower_max_joins: whether "less noise" may be applied to a
+// CalibrationOptions::noise_check.lower_max_joins: whether "less noise" may be applied to a
 // check over check.clusters tracks after `joins` pieces of lines were joined.
-bool lower_side_applies(const CalibrateOptions& co,
+bool lower_side_applies(const NoiseCheckOptions& nc,
                         std::size_t joins,
                         const BatchNoiseCheck& check) {
-  return co.noise_check_lower_max_joins >= 0.0 &&
-         static_cast<double>(joins) <= co.noise_check_lower_max_joins * check.clusters;
+  return nc.lower_max_joins >= 0.0 &&
+         static_cast<double>(joins) <= nc.lower_max_joins * check.clusters;
 }
 
 // Each stage's time, on the log's debug level (omnivert -v).
 class StageTimer {
  public:
-  void lap(const char* stage) {
+  // Logs and returns the time since the last lap [s].
+  double lap(const char* stage) {
     const auto now = std::chrono::steady_clock::now();
-    spdlog::debug("calibrate: {} {:.2f} s", stage, std::chrono::duration<double>(now - t_).count());
+    const double seconds = std::chrono::duration<double>(now - t_).count();
+    spdlog::debug("calibrate: {} {:.2f} s", stage, seconds);
     t_ = now;
+    return seconds;
   }
 
  private:
   std::chrono::steady_clock::time_point t_ = std::chrono::steady_clock::now();
 };
 
-// The refinement (CalibrateOptions::refine) from the filter's point, and Sec. 8.1 at the best
+// The refinement (CalibrationOptions::refinement) from the filter's point, and Sec. 8.1 at the best
 // estimate of the trajectory, the features and the extrinsics, on the bearings the estimate
 // used.
 void refine_and_analyse(const CalibrationRun& run,
-                        const Options& options,
-                        const CalibrateOptions& co,
+                        const CalibrationOptions& options,
                         const BatchPoint& filter_point,
                         StageTimer* timer,
                         CalibrationResult* r) {
   BatchPoint at = filter_point;
   // Sec. 8.1 on the bearings the estimate used: those left out where lines cross
-  // (Options::crossing_guard) do not follow eq. (30)'s model, and those the gate refused are
-  // taken for outliers; neither carries information the estimators use.
-  // Pieces of one line that the filter joined (Options::join_pieces) are one feature there.
+  // (CalibrationOptions::association.crossing_guard) do not follow eq. (30)'s model, and those the
+  // gate refused are taken for outliers; neither carries information the estimators use. Pieces of
+  // one line that the filter joined (CalibrationOptions::association.join_pieces) are one feature
+  // there.
   CalibrationRun analysed =
       join_tracks(without_bearings(run, r->filter.guarded, r->filter.rejected), r->filter.joins);
-  if (co.refine) {
-    r->refinement = refine_batch(run, options, at, co.batch);
+  if (options.refinement.enabled) {
+    r->refinement = refine_batch(run, options, at);
     r->refined = true;
     at = r->refinement.solution;
     // The same problem (split where the refinement split the tracks), without the guarded
@@ -92,10 +95,10 @@ void refine_and_analyse(const CalibrationRun& run,
     analysed = without_bearings(r->refinement.renamed() ? r->refinement.solved_run : run,
                                 r->refinement.guarded,
                                 r->refinement.rejected);
-    timer->lap("refinement");
+    r->seconds.refinement = timer->lap("refinement");
   }
-  r->observability = analyse_observability(analysed, options, at, co.batch, co.observability);
-  timer->lap("observability");
+  r->observability = analyse_observability(analysed, options, at);
+  r->seconds.observability = timer->lap("observability");
   if (r->refined && !r->refinement.covariance_ok && r->observability.all_determined() &&
       r->observability.crlb_covariance.allFinite()) {
     // ceres::Covariance gives up on badly scaled problems (poses in metres, bearings whitened
@@ -121,15 +124,14 @@ double ratio_of(const BatchNoiseCheck& n) {
 // track that slipped onto a neighbouring line as one feature, and the check should see
 // that). With no splits or joins anywhere, the refinement already solved this very problem.
 BatchNoiseCheck filter_noise_check(const CalibrationRun& run,
-                                   const Options& options,
-                                   const CalibrateOptions& co,
+                                   const CalibrationOptions& options,
                                    const BatchPoint& filter_point,
                                    const CalibrationResult& r) {
   if (r.refined && !r.refinement.renamed() && r.filter.splits.empty() && r.filter.joins.empty())
     return r.refinement.noise;
-  BatchOptions unsplit = co.batch;
-  unsplit.split_chi2 = 0.0;
-  unsplit.merge_pieces = false;
+  CalibrationOptions unsplit = options;
+  unsplit.association.split_chi2 = 0.0;
+  unsplit.association.join_pieces = false;
   std::map<int, int> origin;
   const CalibrationRun filter_run =
       split_tracks(join_tracks(run, r.filter.joins), r.filter.splits, &origin);
@@ -137,31 +139,31 @@ BatchNoiseCheck filter_noise_check(const CalibrationRun& run,
   for (const auto& [id, tracker] : origin)
     if (const auto it = filter_point.features.find(tracker); it != filter_point.features.end())
       start.features[id] = it->second;
-  return refine_batch(filter_run, options, start, unsplit).noise;
+  return refine_batch(filter_run, unsplit, start).noise;
 }
 
 // The filter's noise check applied to its covariance: scaled by the ratio when the check
 // shows more noise, the bearings' share shrunk when it shows less where the tracker kept its
-// lines (CalibrateOptions::noise_check).
-void apply_filter_noise(const CalibrateOptions& co, CalibrationResult* r) {
-  const double ratio = ratio_of(r->filter_noise);
+// lines (CalibrationOptions::noise_check).
+void apply_filter_noise(const NoiseCheckOptions& nc, CalibrationResult* r) {
+  const double ratio = ratio_of(r->noise_check.filter_check);
   if (!(ratio > 0.0)) return;
-  r->noise_checked = true;
-  r->noise = r->filter_noise;
-  r->filter_noise_verdict =
-      noise_check_verdict(r->filter_noise, co.noise_check_level, co.noise_check_lower_level);
-  r->noise_verdict = r->filter_noise_verdict;
+  r->noise_check.checked = true;
+  r->noise_check.check = r->noise_check.filter_check;
+  r->noise_check.filter_verdict =
+      noise_check_verdict(r->noise_check.filter_check, nc.level, nc.lower_level);
+  r->noise_check.verdict = r->noise_check.filter_verdict;
   auto apply = [&](const Eigen::Matrix3d& covariance) {
     r->filter.covariance = covariance;
-    r->filter_noise_applied = r->noise_applied = true;
-    r->filter_noise_ratio = r->noise_ratio = ratio;
+    r->noise_check.filter_applied = r->noise_check.applied = true;
+    r->noise_check.filter_ratio = r->noise_check.ratio = ratio;
   };
-  if (r->filter_noise_verdict == NoiseVerdict::kMoreNoise) {
+  if (r->noise_check.filter_verdict == NoiseVerdict::kMoreNoise) {
     apply(r->filter.covariance * ratio);
-  } else if (r->filter_noise_verdict == NoiseVerdict::kLessNoise &&
-             lower_side_applies(co, r->filter.joins.size(), r->filter_noise)) {
-    const Eigen::Matrix3d shrunk =
-        r->filter.covariance + r->filter_noise.covariance - r->filter_noise.model_covariance;
+  } else if (r->noise_check.filter_verdict == NoiseVerdict::kLessNoise &&
+             lower_side_applies(nc, r->filter.joins.size(), r->noise_check.filter_check)) {
+    const Eigen::Matrix3d shrunk = r->filter.covariance + r->noise_check.filter_check.covariance -
+                                   r->noise_check.filter_check.model_covariance;
     if (shrunk.allFinite() && Eigen::LLT<Eigen::Matrix3d>(shrunk).info() == Eigen::Success)
       apply(0.5 * (shrunk + shrunk.transpose()));
   }
@@ -169,42 +171,40 @@ void apply_filter_noise(const CalibrateOptions& co, CalibrationResult* r) {
 
 // The refinement's noise check (at its solution) applied to its covariance: the checked
 // covariance where the check shows more noise, or less where few pieces of lines were joined.
-void apply_refinement_noise(const CalibrateOptions& co, CalibrationResult* r) {
-  r->noise_checked = false;
-  r->noise_applied = false;
-  r->noise_verdict = NoiseVerdict::kAgrees;
-  r->noise_ratio = 1.0;
+void apply_refinement_noise(const NoiseCheckOptions& nc, CalibrationResult* r) {
+  r->noise_check.checked = false;
+  r->noise_check.applied = false;
+  r->noise_check.verdict = NoiseVerdict::kAgrees;
+  r->noise_check.ratio = 1.0;
   const double ratio = ratio_of(r->refinement.noise);
   if (!(ratio > 0.0)) return;
-  r->noise_checked = true;
-  r->noise = r->refinement.noise;
-  r->noise_verdict =
-      noise_check_verdict(r->noise, co.noise_check_level, co.noise_check_lower_level);
-  if (r->noise_verdict == NoiseVerdict::kMoreNoise ||
-      (r->noise_verdict == NoiseVerdict::kLessNoise &&
-       lower_side_applies(co, r->refinement.merges.size(), r->noise))) {
-    r->noise_applied = true;
-    r->noise_ratio = ratio;
-    r->refinement.covariance = r->noise.covariance;
+  r->noise_check.checked = true;
+  r->noise_check.check = r->refinement.noise;
+  r->noise_check.verdict = noise_check_verdict(r->noise_check.check, nc.level, nc.lower_level);
+  if (r->noise_check.verdict == NoiseVerdict::kMoreNoise ||
+      (r->noise_check.verdict == NoiseVerdict::kLessNoise &&
+       lower_side_applies(nc, r->refinement.merges.size(), r->noise_check.check))) {
+    r->noise_check.applied = true;
+    r->noise_check.ratio = ratio;
+    r->refinement.covariance = r->noise_check.check.covariance;
   }
 }
 
-CalibrationResult calibrate_once(const CalibrationRun& run,
-                                 const Options& options,
-                                 const CalibrateOptions& co) {
+CalibrationResult calibrate_once(const CalibrationRun& run, const CalibrationOptions& options) {
+  const NoiseCheckOptions& nc = options.noise_check;
   CalibrationResult r;
-  r.bearing_sigma = options.bearing_sigma;
-  r.track_bias_sigma = options.track_bias_sigma;
-  r.noise_check_level = co.noise_check_level;
-  r.noise_check_lower_level = co.noise_check_lower_level;
+  r.model.bearing_sigma = options.noise.bearing_sigma;
+  r.model.track_bias_sigma = options.noise.track_bias_sigma;
+  r.noise_check.level = nc.level;
+  r.noise_check.lower_level = nc.lower_level;
   StageTimer timer;
   r.filter = run_filter(run, options);
-  timer.lap("filter");
+  r.seconds.filter = timer.lap("filter");
   const BatchPoint filter_point = batch_point_from_filter(run, options, r.filter);
-  refine_and_analyse(run, options, co, filter_point, &timer, &r);
-  r.filter_model_covariance = r.filter.covariance;
-  r.refinement_model_covariance = r.refinement.covariance;
-  if (co.noise_check && r.observability.all_determined()) {
+  refine_and_analyse(run, options, filter_point, &timer, &r);
+  r.noise_check.filter_model_covariance = r.filter.covariance;
+  r.noise_check.refinement_model_covariance = r.refinement.covariance;
+  if (nc.enabled && r.observability.all_determined()) {
     // How large the errors really are, measured by the data (docs/theory/noise-check.md): at a
     // batch solution, the errors of each track summed before squaring. The
     // filter is checked on its own tracks, the refinement on the problem it solved (tracks
@@ -212,12 +212,12 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
     // noise than the model allows (noise_check_verdict): with 10-15 tracks one run's scale
     // is uncertain, and applied always it made the refinement's NEES worse where the model
     // is right (synthetic 0.3 degree, 50 runs: 3.50 -> 5.18). Less noise is applied only
-    // where few pieces of lines were joined (CalibrateOptions::noise_check,
+    // where few pieces of lines were joined (CalibrationOptions::noise_check,
     // noise_check_lower_max_joins).
-    r.filter_noise = filter_noise_check(run, options, co, filter_point, r);
-    timer.lap("the filter's noise check");
-    apply_filter_noise(co, &r);
-    if (r.refined && r.refinement.covariance_ok) apply_refinement_noise(co, &r);
+    r.noise_check.filter_check = filter_noise_check(run, options, filter_point, r);
+    r.seconds.noise_check = timer.lap("the filter's noise check");
+    apply_filter_noise(nc, &r);
+    if (r.refined && r.refinement.covariance_ok) apply_refinement_noise(nc, &r);
   }
   r.extrinsics = r.filter.extrinsics;
   r.covariance = r.filter.covariance;
@@ -229,25 +229,24 @@ CalibrationResult calibrate_once(const CalibrationRun& run,
 }
 }  // namespace
 
-CalibrationResult calibrate(const CalibrationRun& run,
-                            const Options& options,
-                            const CalibrateOptions& co) {
-  return calibrate_once(run, options, co);
+CalibrationResult calibrate(const CalibrationRun& run, const CalibrationOptions& options) {
+  return calibrate_once(run, options);
 }
 
 namespace {
 // A model sigma scaled as the noise check found the errors; NaN when not checked.
 double checked_sigma(const CalibrationResult& r, double sigma) {
-  return r.noise.ok ? sigma * std::sqrt(r.noise.scale) : std::numeric_limits<double>::quiet_NaN();
+  return r.noise_check.check.ok ? sigma * std::sqrt(r.noise_check.check.scale)
+                                : std::numeric_limits<double>::quiet_NaN();
 }
 }  // namespace
 
 double effective_bearing_sigma(const CalibrationResult& r) {
-  return checked_sigma(r, r.bearing_sigma);
+  return checked_sigma(r, r.model.bearing_sigma);
 }
 
 double effective_track_bias_sigma(const CalibrationResult& r) {
-  return checked_sigma(r, r.track_bias_sigma);
+  return checked_sigma(r, r.model.track_bias_sigma);
 }
 
 namespace {

@@ -16,25 +16,25 @@
 namespace omnivert::calib {
 
 namespace {
-Options checked(const Options& options) {
+CalibrationOptions checked(const CalibrationOptions& options) {
   std::string why;
   if (!options.IsValid(&why)) throw InputError("calibration options: " + why);
   return options;
 }
 }  // namespace
 
-CalibrationFilter::CalibrationFilter(const Options& options)
+CalibrationFilter::CalibrationFilter(const CalibrationOptions& options)
     : options_(checked(options)),
-      state_(options.prior,
-             options.prior_sigma,
-             options.feature_init == FeatureInit::kAnchoredInverseDepth
+      state_(options.prior.mean,
+             options.prior.sigma,
+             options.filter.feature_init == FeatureInit::kAnchoredInverseDepth
                  ? ExtrinsicsParam::kCameraPose
                  : ExtrinsicsParam::kPaper),
       propagator_(options),
       updater_(options),
       initializer_(options),
-      bootstrapping_(options.feature_init == FeatureInit::kAnchoredInverseDepth &&
-                     options.bootstrap_rotation > 0.0) {}
+      bootstrapping_(options.filter.feature_init == FeatureInit::kAnchoredInverseDepth &&
+                     options.filter.bootstrap_rotation > 0.0) {}
 
 void CalibrationFilter::process(const FrameInput& frame) {
   const std::string where = "frame " + std::to_string(frame_);
@@ -96,10 +96,11 @@ void CalibrationFilter::admit(const FrameInput& frame) {
     rec.extrinsics = state_.extrinsics();
     rec.covariance = state_.extrinsics_covariance();
     const int n = static_cast<int>(window_.frames.size());
-    window_heading_ += (frame.d_right - frame.d_left) / options_.wheel_base;  // eq. (15)
+    window_heading_ += (frame.d_right - frame.d_left) / options_.robot.wheel_base;  // eq. (15)
     if (n > 1) window_max_turn_ = std::max(window_max_turn_, std::abs(window_heading_));
-    if ((n < options_.bootstrap_min_frames || window_max_turn_ < options_.bootstrap_rotation) &&
-        n < options_.bootstrap_max_frames) {
+    if ((n < options_.filter.bootstrap_min_frames ||
+         window_max_turn_ < options_.filter.bootstrap_rotation) &&
+        n < options_.filter.bootstrap_max_frames) {
       history_.push_back(rec);
       ++frame_;
       return;
@@ -197,7 +198,8 @@ void CalibrationFilter::step(const FrameInput& frame) {
   std::vector<BearingMeasurement> z;
   std::vector<int> z_ids;  // each bearing's own track id (a joined track's, not its feature's)
   sort_bearings(frame, crossing, &rec, &fresh, &z, &z_ids);
-  if (options_.join_pieces && !fresh.empty()) fresh = join_pieces(std::move(fresh), &z, &z_ids);
+  if (options_.association.join_pieces && !fresh.empty())
+    fresh = join_pieces(std::move(fresh), &z, &z_ids);
   const std::vector<BearingUpdateResult> results = updater_.update(z, &state_);
   for (std::size_t k = 0; k < z.size(); ++k) {
     if (results[k].accepted) {
@@ -217,7 +219,7 @@ void CalibrationFilter::step(const FrameInput& frame) {
   record_tracks();
   // Tracks that ended leave the state (marginalisation).
   for (int s = state_.num_features() - 1; s >= 0; --s)
-    if (frame_ - state_.slots()[s].last_seen_frame > options_.max_missed_frames)
+    if (frame_ - state_.slots()[s].last_seen_frame > options_.association.max_missed_frames)
       state_.remove_feature(s);
 
   rec.extrinsics = state_.extrinsics();
@@ -227,19 +229,19 @@ void CalibrationFilter::step(const FrameInput& frame) {
   ++frame_;
 }
 
-// The crossing guard (Options::crossing_guard): a feature whose direction is within the
-// guard of another line's is not updated in this frame: the extractor sees the two lines as
-// one there, and the bearings are pulled or pushed (docs/theory/association.md#lines-that-cross).
-// The other line is a feature of the state (its track seen within the last
-// max_missed_frames frames) or a track that starts in this frame. A feature's direction is
-// its bearing in this frame where it has one, else its predicted bearing (eq. 27). A track
-// that starts within the guard of another line enters the state at its first bearing
-// outside it: entered inside, its first bearing is pulled towards the other line, and with
+// The crossing guard (CalibrationOptions::association.crossing_guard): a feature whose direction is
+// within the guard of another line's is not updated in this frame: the extractor sees the two lines
+// as one there, and the bearings are pulled or pushed
+// (docs/theory/association.md#lines-that-cross). The other line is a feature of the state (its
+// track seen within the last max_missed_frames frames) or a track that starts in this frame. A
+// feature's direction is its bearing in this frame where it has one, else its predicted bearing
+// (eq. 27). A track that starts within the guard of another line enters the state at its first
+// bearing outside it: entered inside, its first bearing is pulled towards the other line, and with
 // its depth unknown its prediction stays by the other line, which is then left out as long.
 std::vector<char> CalibrationFilter::crossing_entries(const FrameInput& frame) const {
   const int n = state_.num_features();
   std::vector<char> crossing(frame.observations.size() + static_cast<std::size_t>(n), 0);
-  if (options_.crossing_guard > 0.0) {
+  if (options_.association.crossing_guard > 0.0) {
     const Extrinsics ex = state_.extrinsics();
     // Entries: the state's features (ids 0 .. n - 1), then the frame's new tracks (n + their
     // index in the frame).
@@ -271,7 +273,8 @@ std::vector<char> CalibrationFilter::crossing_entries(const FrameInput& frame) c
       if (a > b) std::swap(a, b);
       return a < n && b >= n && unseen[static_cast<std::size_t>(a)];
     };
-    for (int e : crowded_directions(std::move(lines), options_.crossing_guard, maybe_same))
+    for (int e :
+         crowded_directions(std::move(lines), options_.association.crossing_guard, maybe_same))
       crossing[static_cast<std::size_t>(e)] = 1;
   }
   return crossing;
@@ -312,13 +315,13 @@ void CalibrationFilter::sort_bearings(const FrameInput& frame,
 
 // (D, theta) of eq. (28) for kInverseDistance, a robot-frame point for kAnchored.
 void CalibrationFilter::convert_known_depths() {
-  if (options_.convert_ratio > 0.0) {
+  if (options_.filter.convert_ratio > 0.0) {
     for (int s = 0; s < state_.num_features(); ++s) {
       const FeatureSlot& slot = state_.slots()[s];
       if (slot.param == FeatureParam::kInverseDistance) {
         const int i = slot.index;
         const double q = state_.x()(i);
-        if (std::sqrt(state_.P()(i, i)) < options_.convert_ratio * q) {
+        if (std::sqrt(state_.P()(i, i)) < options_.filter.convert_ratio * q) {
           const Eigen::Vector2d y(1.0 / q, state_.x()(i + 1));
           const Eigen::Matrix2d J = (Eigen::Matrix2d() << -1.0 / (q * q), 0, 0, 1).finished();
           state_.reparametrise(s, FeatureParam::kDistance, y, J);
@@ -326,7 +329,7 @@ void CalibrationFilter::convert_known_depths() {
       } else if (slot.param == FeatureParam::kAnchored) {
         const int i = slot.index;
         const double q = state_.x()(i + 3);
-        if (std::sqrt(state_.P()(i + 3, i + 3)) < options_.convert_ratio * q) {
+        if (std::sqrt(state_.P()(i + 3, i + 3)) < options_.filter.convert_ratio * q) {
           Eigen::Matrix<double, 2, 4> J;
           const Eigen::Vector2d y = anchored_to_point(state_.x().segment<4>(i), &J);
           state_.reparametrise(s, FeatureParam::kPoint, y, J);
@@ -344,9 +347,9 @@ int CalibrationFilter::slot_of(int track_id) const {
   return state_.find(track_id);
 }
 
-// Options::join_pieces. Candidates for a new track's first bearing: the features of the
-// state whose point is known (kPoint, kDistance: a feature still in inverse depth predicts a
-// wide fan of bearings, where any line would pass), not seen in this frame and with no
+// CalibrationOptions::association.join_pieces. Candidates for a new track's first bearing: the
+// features of the state whose point is known (kPoint, kDistance: a feature still in inverse depth
+// predicts a wide fan of bearings, where any line would pass), not seen in this frame and with no
 // feature seen in this frame predicted within the crossing guard of it, whose gate (eq. 30's
 // innovation, Updater::innovation_chi2) the bearing passes. A new track with exactly one
 // candidate, which no other new track has as a candidate, continues it. (Only the features
@@ -372,7 +375,7 @@ std::vector<const BearingObservation*> CalibrationFilter::join_pieces(
     if (!(d.allFinite() && d(0) > 0.0)) return true;
     const double b = predict_bearing(d(0), d(1), ex);
     for (double o : seen_now)
-      if (std::abs(angle_diff(o, b)) < options_.crossing_guard) return true;
+      if (std::abs(angle_diff(o, b)) < options_.association.crossing_guard) return true;
     return false;
   };
   // The features that may be continued, the same for every new track of the frame.
@@ -434,9 +437,9 @@ void CalibrationFilter::record_tracks() {
 }
 
 std::map<std::pair<int, int>, int> guard_before_starts(const CalibrationRun& run,
-                                                       const Options& options) {
+                                                       const CalibrationOptions& options) {
   std::map<std::pair<int, int>, int> out;
-  const double guard = options.crossing_guard;
+  const double guard = options.association.crossing_guard;
   if (!(guard > 0.0)) return out;
   std::map<int, std::map<int, double>> at;  // track id -> frame -> bearing
   for (int k = 0; k < static_cast<int>(run.frames.size()); ++k)
@@ -455,7 +458,7 @@ std::map<std::pair<int, int>, int> guard_before_starts(const CalibrationRun& run
            ++it)
         if (const auto ai = of_a.find(it->first); ai != of_a.end())
           rate = (angle_diff(it->second, ai->second) - sep0) / (it->first - k0);
-      for (auto it = of_a.lower_bound(k0 - options.max_missed_frames); it != a0; ++it)
+      for (auto it = of_a.lower_bound(k0 - options.association.max_missed_frames); it != a0; ++it)
         if (std::abs(sep0 - rate * (k0 - it->first)) < guard) {
           const auto [o, fresh] = out.emplace(std::make_pair(a, it->first), k0);
           if (!fresh) o->second = std::min(o->second, k0);
@@ -465,7 +468,7 @@ std::map<std::pair<int, int>, int> guard_before_starts(const CalibrationRun& run
   return out;
 }
 
-FilterResult run_filter(const CalibrationRun& run, const Options& options) {
+FilterResult run_filter(const CalibrationRun& run, const CalibrationOptions& options) {
   CalibrationFilter filter(options);
   filter.guard_ahead(guard_before_starts(run, options));
   for (const FrameInput& f : run.frames) filter.process(f);

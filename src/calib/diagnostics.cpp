@@ -14,10 +14,10 @@ namespace internal {
 
 WheelCheck wheel_check(const Built& b,
                        const CalibrationRun& run,
-                       const Options& options,
-                       const BatchOptions& batch) {
+                       const CalibrationOptions& options) {
   WheelCheck out;
-  const double K = options.odometry_K * batch.odometry_inflation, e = options.wheel_base;
+  const double K = options.robot.odometry_K * options.refinement.odometry_inflation,
+               e = options.robot.wheel_base;
   if (!(e > 0.0)) return out;
   Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
   Eigen::Vector2d g = Eigen::Vector2d::Zero();
@@ -33,7 +33,7 @@ WheelCheck wheel_check(const Built& b,
           (f.covariance_per_K(0, 0) + f.covariance_per_K(1, 1) - 2.0 * f.covariance_per_K(0, 1));
     else
       v = K * (std::abs(f.d_right) + std::abs(f.d_left));
-    v = (v + 2.0 * options.odometry_variance_floor) / (e * e);
+    v = (v + 2.0 * options.robot.odometry_variance_floor) / (e * e);
     if (!(v > 0.0)) continue;
     const double robot = angle_diff(b.poses[k][2], b.poses[k - 1][2]);
     const double r = angle_diff(turn, robot);

@@ -12,29 +12,30 @@ int FeatureInitializer::initialize(
   const Extrinsics ex = state->extrinsics();
   const int n = state->dim();
   const int e = state->extrinsics_index();
-  const double var_beta = std::pow(options_.bearing_sigma * sigma_scale, 2);
+  const double var_beta = std::pow(options_.noise.bearing_sigma * sigma_scale, 2);
 
   FeatureSlot slot;
   slot.track_id = track_id;
   slot.first_frame = frame;
   slot.last_seen_frame = frame;
-  const double q_lo = 1.0 / options_.max_feature_distance;
-  const double q_hi = 1.0 / options_.min_feature_distance;
+  const double q_lo = 1.0 / options_.filter.max_feature_distance;
+  const double q_hi = 1.0 / options_.filter.min_feature_distance;
   const double q0 = 0.5 * (q_lo + q_hi);
   const double sigma_q = 0.25 * (q_hi - q_lo);  // the range is +-2 sigma
   Eigen::VectorXd y;
   Eigen::MatrixXd G_ex;   // d y / d (extrinsics block)
   Eigen::MatrixXd G_n;    // d y / d (prior variable, beta)
   Eigen::Vector2d var_n;  // variances of (prior variable, beta)
-  switch (options_.feature_init) {
+  switch (options_.filter.feature_init) {
     case FeatureInit::kNaive: {
       // docs/theory/filter.md "naive": far-feature approximation of eq. (27),
       // beta ~ pi - theta - phi - psi, and a fixed distance prior.
       slot.param = FeatureParam::kDistance;
-      y = Eigen::Vector2d(options_.naive_distance, wrap_angle(kPi - beta - ex.phi - ex.psi));
+      y = Eigen::Vector2d(options_.filter.naive_distance, wrap_angle(kPi - beta - ex.phi - ex.psi));
       G_ex = (Eigen::Matrix<double, 2, 3>() << 0, 0, 0, -1, 0, -1).finished();
       G_n = (Eigen::Matrix2d() << 1, 0, 0, -1).finished();
-      var_n << options_.naive_distance_sigma * options_.naive_distance_sigma, var_beta;
+      var_n << options_.filter.naive_distance_sigma * options_.filter.naive_distance_sigma,
+          var_beta;
       break;
     }
     case FeatureInit::kInverseDistance: {
@@ -63,11 +64,11 @@ int FeatureInitializer::initialize(
     }
   }
   Eigen::VectorXd var_noise = var_n;
-  if (options_.track_bias_sigma > 0.0) {
-    // The track's constant bearing error b (Options::track_bias_sigma) enters as one more
-    // entry, at 0 with its prior. The first bearing is eq. (30) + b + noise, so the block was
-    // computed from beta - b: its column for b is minus the column for beta, and the block
-    // and b start correlated.
+  if (options_.noise.track_bias_sigma > 0.0) {
+    // The track's constant bearing error b (CalibrationOptions::noise.track_bias_sigma) enters as
+    // one more entry, at 0 with its prior. The first bearing is eq. (30) + b + noise, so the block
+    // was computed from beta - b: its column for b is minus the column for beta, and the block and
+    // b start correlated.
     slot.bias = true;
     const int k = static_cast<int>(y.size());
     y.conservativeResize(k + 1);
@@ -80,7 +81,7 @@ int FeatureInitializer::initialize(
     G.block(0, 2, k, 1) = -G_n.col(1);
     G(k, 2) = 1.0;
     G_n = G;
-    var_noise = Eigen::Vector3d(var_n(0), var_n(1), std::pow(options_.track_bias_sigma, 2));
+    var_noise = Eigen::Vector3d(var_n(0), var_n(1), std::pow(options_.noise.track_bias_sigma, 2));
   }
   const Eigen::MatrixXd& P = state->P();
   const Eigen::MatrixXd P_yx = G_ex * P.middleRows(e, 3);

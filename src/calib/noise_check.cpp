@@ -31,8 +31,8 @@ bool evaluate_clusters(Built& b, ClusteredRows* out) {
   eo.residual_blocks = b.odometry_blocks;
   eo.residual_blocks.insert(
       eo.residual_blocks.end(), b.bearing_blocks.begin(), b.bearing_blocks.end());
-  // A track's bias prior (Options::track_bias_sigma) is a row of that track's cluster: without
-  // it the bias is free and the check's information singular along it.
+  // A track's bias prior (CalibrationOptions::noise.track_bias_sigma) is a row of that track's
+  // cluster: without it the bias is free and the check's information singular along it.
   for (const auto& [id, block] : b.bias_priors) eo.residual_blocks.push_back(block);
   eo.apply_loss_function = false;
   if (!b.problem->Evaluate(eo, nullptr, &out->r, nullptr, &out->crs)) return false;

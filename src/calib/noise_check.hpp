@@ -14,8 +14,7 @@ namespace omnivert::calib::internal {
 // rolled).
 WheelCheck wheel_check(const Built& b,
                        const CalibrationRun& run,
-                       const Options& options,
-                       const BatchOptions& batch);
+                       const CalibrationOptions& options);
 
 // The error of the extrinsics measured by the data themselves (BatchNoiseCheck): at the
 // solution theta^ of the whitened problem (residuals r, Jacobian J, Fisher information

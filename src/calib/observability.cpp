@@ -117,21 +117,20 @@ void judge_information(const Eigen::Matrix3d& S,
 // accumulated over the run: below min_rotation_sigmas, the information about phi, rho and psi
 // individually comes from the estimated trajectory's noise, not from a turn.
 void check_rotation(const CalibrationRun& run,
-                    const Options& options,
+                    const CalibrationOptions& options,
                     const BatchPoint& at,
-                    const BatchOptions& batch,
-                    const ObservabilityOptions& obs,
                     ObservabilityReport* out) {
+  const ObservabilityOptions& obs = options.observability;
   ObservabilityReport& rep = *out;
   double lo = 0.0, hi = 0.0, var = 0.0;
   for (std::size_t k = 0; k < at.poses.size(); ++k) {
     lo = std::min(lo, at.poses[k](2) - at.poses[0](2));
     hi = std::max(hi, at.poses[k](2) - at.poses[0](2));
   }
-  const double K = options.odometry_K * batch.odometry_inflation;
+  const double K = options.robot.odometry_K * options.refinement.odometry_inflation;
   for (const FrameInput& f : run.frames) var += K * (std::abs(f.d_right) + std::abs(f.d_left));
   rep.heading_range = hi - lo;
-  rep.heading_noise = std::sqrt(var) / options.wheel_base;
+  rep.heading_noise = std::sqrt(var) / options.robot.wheel_base;
   if (rep.heading_range < obs.min_rotation_sigmas * rep.heading_noise)
     for (ParameterVerdict* p : {&rep.phi, &rep.rho, &rep.psi, &rep.x, &rep.y})
       p->determined = false;
@@ -172,18 +171,16 @@ std::string observability_message(const ObservabilityReport& rep, const Observab
 }  // namespace
 
 ObservabilityReport analyse_observability(const CalibrationRun& run,
-                                          const Options& options,
-                                          const BatchPoint& at,
-                                          const BatchOptions& batch,
-                                          const ObservabilityOptions& obs) {
+                                          const CalibrationOptions& options,
+                                          const BatchPoint& at) {
   std::string why;
   if (!options.IsValid(&why)) throw InputError("calibration options: " + why);
-  Built b = build(run, options, at, batch, /*robust=*/false);
+  Built b = build(run, options, at, /*robust=*/false);
   const Eigen::Matrix3d S = marginal_information(fisher_information(b));
   ObservabilityReport rep;
-  judge_information(S, at.extrinsics, obs, &rep);
-  check_rotation(run, options, at, batch, obs, &rep);
-  rep.message = observability_message(rep, obs);
+  judge_information(S, at.extrinsics, options.observability, &rep);
+  check_rotation(run, options, at, &rep);
+  rep.message = observability_message(rep, options.observability);
   return rep;
 }
 

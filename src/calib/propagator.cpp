@@ -35,21 +35,22 @@ void Propagator::propagate(const FrameInput& frame, FilterState* state) const {
   // over the frame, and the side slip the batch allows) is noise: one step of eq. (29), as
   // the paper. (Composed from noisy wheel samples nearly every frame has one, about 0.02 mm
   // on the simulator's straights; a straight that turns within the frame has 0.47 mm.)
-  const double K = options_.odometry_K * options_.odometry_inflation;
+  const double K = options_.robot.odometry_K * options_.filter.odometry_inflation;
   const double noise = std::sqrt(K * std::max(frame.covariance_per_K(2, 2), 0.0) +
-                                 options_.lateral_sigma * options_.lateral_sigma);
+                                 options_.robot.lateral_sigma * options_.robot.lateral_sigma);
   if (std::abs(frame.lateral) <= 3.0 * noise) {
     propagate(frame.d_right, frame.d_left, state);
     return;
   }
-  const auto steps = frame_steps(frame.d_right, frame.d_left, frame.lateral, options_.wheel_base);
+  const auto steps =
+      frame_steps(frame.d_right, frame.d_left, frame.lateral, options_.robot.wheel_base);
   propagate(steps[0](0), steps[0](1), state);
   if (!steps[1].isZero()) propagate(steps[1](0), steps[1](1), state);
 }
 
 void Propagator::propagate(double d_right, double d_left, FilterState* state) const {
   const int n = state->dim();
-  const double e = options_.wheel_base;
+  const double e = options_.robot.wheel_base;
   // F_x is block diagonal (A^i per feature, identity for the extrinsics); F_u stacks the
   // B^i with zeros for the extrinsics (appendix A.4).
   Eigen::MatrixXd F = Eigen::MatrixXd::Identity(n, n);
@@ -90,10 +91,11 @@ void Propagator::propagate(double d_right, double d_left, FilterState* state) co
     }
   }
   // Eq. (31) with the inflated K.
-  const Mat2 Q = chong_kleeman_covariance(d_right,
-                                          d_left,
-                                          options_.odometry_K * options_.odometry_inflation,
-                                          options_.odometry_variance_floor);
+  const Mat2 Q =
+      chong_kleeman_covariance(d_right,
+                               d_left,
+                               options_.robot.odometry_K * options_.filter.odometry_inflation,
+                               options_.robot.odometry_variance_floor);
   Eigen::MatrixXd& P = state->mutable_P();
   P = (F * P * F.transpose() + G * Q * G.transpose()).eval();
   state->normalise();

@@ -21,13 +21,13 @@ using namespace internal;
 
 namespace {
 
-ceres::Solver::Options solver_options(const BatchOptions& batch) {
+ceres::Solver::Options solver_options(const RefinementOptions& refinement) {
   ceres::Solver::Options so;
   // Sparse Cholesky of the whole normal equations: the poses form a chain and each feature
   // ties many poses, so the Schur complement on either is nearly dense (a 252-frame window
   // with 114 tracks: 17.7 s against 40.8 s with SPARSE_SCHUR, the same solution).
   so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-  so.max_num_iterations = batch.max_iterations;
+  so.max_num_iterations = refinement.max_iterations;
   so.function_tolerance = 1e-10;
   so.gradient_tolerance = 1e-12;
   so.parameter_tolerance = 1e-12;
@@ -39,17 +39,16 @@ ceres::Solver::Options solver_options(const BatchOptions& batch) {
 
 // The association loop of the refinement: the decisions under the bearing's whole error
 // (`assoc`, association_options), the problem rebuilt as it was first built.
-AssociationSetup association_setup(const Options& assoc,
-                                   const BatchOptions& batch,
+AssociationSetup association_setup(const CalibrationOptions& assoc,
                                    const ceres::Solver::Options& so,
                                    ceres::Solver::Summary* summary) {
   AssociationSetup s;
   s.options = &assoc;
   s.min_bearings = 2;  // two bearings at least determine a feature point
-  s.join_pieces = batch.merge_pieces;
-  s.split = batch;
-  s.rebuild = [&assoc, &batch](const CalibrationRun& run, const BatchPoint& at) {
-    return build(run, assoc, at, batch, batch.robust);
+  s.join_pieces = assoc.association.join_pieces;
+  s.split = assoc.association;
+  s.rebuild = [&assoc](const CalibrationRun& run, const BatchPoint& at) {
+    return build(run, assoc, at, assoc.refinement.robust);
   };
   s.solve = [&so, summary](Built* b) { ceres::Solve(so, b->problem.get(), summary); };
   return s;
@@ -128,29 +127,29 @@ bool extrinsics_covariance(Built* b, Eigen::Matrix3d* covariance) {
 }  // namespace
 
 RefinementResult refine_batch(const CalibrationRun& run,
-                              const Options& options,
-                              const BatchPoint& start,
-                              const BatchOptions& batch) {
+                              const CalibrationOptions& options,
+                              const BatchPoint& start) {
   std::string why;
   if (!options.IsValid(&why)) throw InputError("calibration options: " + why);
   // The decisions under the bearing's whole error; the bias, when modelled, at the end
   // (association_options).
-  const Options& model = options;
-  const Options assoc = association_options(model);
-  Built b = build(run, assoc, start, batch, batch.robust);
+  const CalibrationOptions& model = options;
+  const CalibrationOptions assoc = association_options(model);
+  Built b = build(run, assoc, start, options.refinement.robust);
   RefinementResult res;
   res.num_bearings = b.num_bearings;
 
-  const ceres::Solver::Options so = solver_options(batch);
+  const ceres::Solver::Options so = solver_options(options.refinement);
   ceres::Solver::Summary summary;
   ceres::Solve(so, b.problem.get(), &summary);
   // Lines that cross, outliers (false matches, at the filter's gate), pieces of one line,
   // slipped tracks; the problem solved again after each decision.
   Association association;
-  associate(&b, run, association_setup(assoc, batch, so, &summary), &association);
+  associate(&b, run, association_setup(assoc, so, &summary), &association);
   record_association(&association, &res);
-  if (model.track_bias_sigma > 0.0) {
-    b = final_with_bias(res.renamed() ? res.solved_run : run, b, model, batch, batch.robust, 2);
+  if (model.noise.track_bias_sigma > 0.0) {
+    b = final_with_bias(
+        res.renamed() ? res.solved_run : run, b, model, options.refinement.robust, 2);
     ceres::Solve(so, b.problem.get(), &summary);
   }
   res.guarded = b.guarded;
@@ -158,9 +157,10 @@ RefinementResult refine_batch(const CalibrationRun& run,
       unused_bearings(res.renamed() ? res.solved_run : run, b, [](int id) { return id; });
   res.num_bearings = b.num_bearings;
   res.num_features = static_cast<int>(b.features.size());
-  res.bearing_residual_sigma = bearing_residual_sigma(b, res.num_features, options.bearing_sigma);
-  res.noise = noise_check(b, batch.noise_check_dense_limit);
-  res.noise.wheels = wheel_check(b, run, options, batch);
+  res.bearing_residual_sigma =
+      bearing_residual_sigma(b, res.num_features, options.noise.bearing_sigma);
+  res.noise = noise_check(b, options.noise_check.dense_limit);
+  res.noise.wheels = wheel_check(b, run, options);
   res.converged = summary.termination_type == ceres::CONVERGENCE;
   res.initial_cost = summary.initial_cost;
   res.final_cost = summary.final_cost;

@@ -31,7 +31,7 @@ std::string noise_check_flags(const CalibrationResult& r) {
   char buf[96];
   std::snprintf(buf, sizeof buf, "--bearing-sigma %.3f", rad2deg(effective_bearing_sigma(r)));
   std::string out = buf;
-  if (r.track_bias_sigma > 0.0) {
+  if (r.model.track_bias_sigma > 0.0) {
     std::snprintf(
         buf, sizeof buf, " --track-bias-sigma %.3f", rad2deg(effective_track_bias_sigma(r)));
     out += buf;
@@ -99,11 +99,11 @@ void warn_window_failure(const CalibrationResult& r, std::vector<std::string>* o
 // The noise check shows more noise than the model allows.
 void warn_more_noise(const CalibrationResult& r, std::vector<std::string>* out) {
   char buf[1024];
-  if (r.noise_checked && r.noise.clusters >= 2) {
+  if (r.noise_check.checked && r.noise_check.check.clusters >= 2) {
     // noise_check_rejects_model at the level the run used: under the model the check's scale
     // is about chi-square(G) / G over G tracks.
-    const int g = r.noise.clusters;
-    if (noise_check_rejects_model(r.noise, r.noise_check_level)) {
+    const int g = r.noise_check.check.clusters;
+    if (noise_check_rejects_model(r.noise_check.check, r.noise_check.level)) {
       std::snprintf(buf,
                     sizeof(buf),
                     "To weight the bearings as the data say, run again with "
@@ -121,10 +121,10 @@ void warn_more_noise(const CalibrationResult& r, std::vector<std::string>* out) 
           "the bearings' errors, summed along each track, are larger than the bearing "
           "sigma of %s allows (variance x%.2f over %d tracks; %s): the sigmas "
           "reported include it (noise check). %s",
-          bearing_noise_text(r.bearing_sigma, r.track_bias_sigma).c_str(),
-          r.noise.scale,
+          bearing_noise_text(r.model.bearing_sigma, r.model.track_bias_sigma).c_str(),
+          r.noise_check.check.scale,
           g,
-          noise_check_chance(noise_check_limit(g, r.noise_check_level), "more", r.noise_check_level)
+          noise_check_chance(noise_check_limit(g, r.noise_check.level), "more", r.noise_check.level)
               .c_str(),
           remedy.c_str());
       out->emplace_back(buf);
@@ -217,7 +217,7 @@ std::vector<std::string> result_warnings(const CalibrationResult& r) {
 }
 
 const WheelCheck& wheel_check_of(const CalibrationResult& r) {
-  return r.refined ? r.refinement.noise.wheels : r.filter_noise.wheels;
+  return r.refined ? r.refinement.noise.wheels : r.noise_check.filter_check.wheels;
 }
 
 }  // namespace omnivert::calib

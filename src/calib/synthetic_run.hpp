@@ -38,7 +38,8 @@ struct SyntheticRunOptions {
   // the variance stays bearing_sigma^2): an extracted edge's error changes slowly. 0: white.
   double bearing_correlation = 0.0;
   // A constant bearing error per line, N(0, track_bias_sigma^2), added to all its bearings
-  // (Options::track_bias_sigma); drawn from its own generator, so 0 leaves the run as before.
+  // (CalibrationOptions::noise.track_bias_sigma); drawn from its own generator, so 0 leaves the run
+  // as before.
   double track_bias_sigma = 0.0;        // [rad]
   Extrinsics truth{-0.34, 0.23, 0.33};  // the paper's estimate (Sec. 9.2)
   // Each track is cut into pieces (new track ids) with this probability per frame; 0: every

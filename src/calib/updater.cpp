@@ -81,8 +81,8 @@ double chi2_quantile(double p, int dof) {
   return 0.5 * (lo + hi);
 }
 
-Updater::Updater(const Options& options)
-    : options_(options), gate_(chi2_quantile(options.gate_probability, 1)) {}
+Updater::Updater(const CalibrationOptions& options)
+    : options_(options), gate_(chi2_quantile(options.association.gate_probability, 1)) {}
 
 Eigen::VectorXd Updater::predict(const FilterState& state,
                                  const Eigen::VectorXd& x,
@@ -130,7 +130,8 @@ Eigen::VectorXd Updater::predict(const FilterState& state,
         break;
       }
     }
-    if (s.bias) {  // Options::track_bias_sigma: eq. (30) + the track's constant error b
+    if (s.bias) {  // CalibrationOptions::noise.track_bias_sigma: eq. (30) + the track's constant
+                   // error b
       h(k) += x(s.bias_index());
       (*H)(k, s.bias_index()) = 1.0;
     }
@@ -178,9 +179,9 @@ double Updater::second_order_variance(const FilterState& state, const BearingMea
 }
 
 double Updater::measurement_variance(const FilterState& state, const BearingMeasurement& z) const {
-  const double var = options_.bearing_sigma * options_.bearing_sigma;
+  const double var = options_.noise.bearing_sigma * options_.noise.bearing_sigma;
   return var * z.sigma_scale * z.sigma_scale +
-         (options_.second_order_noise ? second_order_variance(state, z) : 0.0);
+         (options_.filter.second_order_noise ? second_order_variance(state, z) : 0.0);
 }
 
 double Updater::innovation_chi2(const FilterState& state, const BearingMeasurement& z) const {
@@ -189,7 +190,8 @@ double Updater::innovation_chi2(const FilterState& state, const BearingMeasureme
   const double var = measurement_variance(state, z);
   const double r = angle_diff(z.beta, h(0));
   // H P H^T over H's nonzero entries (the feature's block and the extrinsics): O(1), not
-  // O(dim^2), for the filter's search among the features (Options::join_pieces).
+  // O(dim^2), for the filter's search among the features
+  // (CalibrationOptions::association.join_pieces).
   std::vector<int> nz;
   for (int i = 0; i < H.cols(); ++i)
     if (H(0, i) != 0.0) nz.push_back(i);
@@ -230,7 +232,7 @@ std::vector<BearingUpdateResult> Updater::update(const std::vector<BearingMeasur
 
   // Iterated EKF: x_{j+1} = x0 + K_j (z - h(x_j) - H_j (x0 - x_j)), K_j from H_j and P0.
   Eigen::VectorXd xj = x0;
-  for (int it = 0; it < options_.update_iterations; ++it) {
+  for (int it = 0; it < options_.filter.update_iterations; ++it) {
     const Eigen::VectorXd hj = predict(*state, xj, z, &H);
     Eigen::VectorXd r(m);
     for (int k = 0; k < m; ++k) r(k) = angle_diff(z[k].beta, hj(k));  // wrapped innovation

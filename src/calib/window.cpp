@@ -71,7 +71,7 @@ namespace {
 // the window overconfident (BootstrapWindowEndsATrackAfterALongGap). `gap_origin`: new id ->
 // the tracker's.
 CalibrationRun split_at_gaps(const CalibrationRun& window_in,
-                             const Options& options,
+                             const CalibrationOptions& options,
                              std::map<int, int>* gap_origin) {
   std::map<int, int> last;
   std::vector<std::pair<int, int>> gaps;
@@ -80,7 +80,7 @@ CalibrationRun split_at_gaps(const CalibrationRun& window_in,
       const auto it = last.find(o.track_id);
       // (The filter marginalises a track after the frame that is max_missed_frames + 1 past
       // its last bearing.)
-      if (it != last.end() && k - it->second > options.max_missed_frames + 1)
+      if (it != last.end() && k - it->second > options.association.max_missed_frames + 1)
         gaps.emplace_back(o.track_id, k);
       last[o.track_id] = k;
     }
@@ -88,25 +88,24 @@ CalibrationRun split_at_gaps(const CalibrationRun& window_in,
 }
 
 // The window's problem: odometry and bearings (build, with the decisions' options), the
-// priors on the extrinsics (options.prior) and on each track's inverse depth along its first
+// priors on the extrinsics (options.prior.mean) and on each track's inverse depth along its first
 // ray; and its solve.
 struct WindowProblem {
-  WindowProblem(const Options& options, const CalibrationRun& window)
+  WindowProblem(const CalibrationOptions& options, const CalibrationRun& window)
       : options(options), window(window) {
-    const double q_lo = 1.0 / options.max_feature_distance;
-    const double q_hi = 1.0 / options.min_feature_distance;
+    const double q_lo = 1.0 / options.filter.max_feature_distance;
+    const double q_hi = 1.0 / options.filter.min_feature_distance;
     q0 = 0.5 * (q_lo + q_hi);
     sigma_q = 0.25 * (q_hi - q_lo);
     // The decisions (crossings, outliers, joins, splits) under the bearing's whole error; the
     // per-track bias, when modelled, in the final solve (association_options).
     decisions = association_options(options);
-    decisions.min_track_length = 2;
+    decisions.association.min_track_length = 2;
     so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;  // as the refinement
     so.max_num_iterations = 100;
     so.num_threads = 1;
     so.logging_type = ceres::SILENT;
     so.minimizer_progress_to_stdout = false;
-    batch.lateral_sigma = options.lateral_sigma;
     tracks.index(window);
   }
 
@@ -114,13 +113,13 @@ struct WindowProblem {
     if (b.features.empty()) return b;
     b.problem->AddResidualBlock(
         new ceres::AutoDiffCostFunction<ExtrinsicsPrior, 3, 3>(
-            new ExtrinsicsPrior{options.prior.vec(), options.prior_sigma.cwiseInverse()}),
+            new ExtrinsicsPrior{options.prior.mean.vec(), options.prior.sigma.cwiseInverse()}),
         nullptr,
         b.ex.data());
     for (auto& [id, f] : b.features)
       b.problem->AddResidualBlock(
-          new ceres::AutoDiffCostFunction<InverseDepthPrior, 1, 3, 2, 3>(
-              new InverseDepthPrior{q0, 1.0 / (options.bootstrap_depth_prior_scale * sigma_q)}),
+          new ceres::AutoDiffCostFunction<InverseDepthPrior, 1, 3, 2, 3>(new InverseDepthPrior{
+              q0, 1.0 / (options.filter.bootstrap_depth_prior_scale * sigma_q)}),
           nullptr,
           b.poses[tracks.first_frame.at(id)].data(),
           f.data(),
@@ -129,14 +128,14 @@ struct WindowProblem {
   }
 
   Built build_from(const CalibrationRun& w, const BatchPoint& start) const {
-    return with_priors(build(w, decisions, start, batch, /*robust=*/false));
+    return with_priors(build(w, decisions, start, /*robust=*/false));
   }
 
   // Solved from extrinsics ex0: dead-reckoned poses, each track on its first ray at depth
   // 1/q0. false when no track has two bearings.
   bool solve_from(const Extrinsics& ex0, Built* out, ceres::Solver::Summary* sum) const {
     BatchPoint start;
-    start.poses = dead_reckoning(window, options.wheel_base);
+    start.poses = dead_reckoning(window, options.robot.wheel_base);
     start.extrinsics = ex0;
     for (const auto& [id, k] : tracks.first_frame) {
       for (const BearingObservation& o : window.frames[k].observations) {
@@ -163,8 +162,8 @@ struct WindowProblem {
     AssociationSetup s;
     s.options = &options;
     s.min_bearings = 1;
-    s.join_pieces = options.join_pieces;
-    s.split.split_chi2 = options.split_chi2;
+    s.join_pieces = options.association.join_pieces;
+    s.split = options.association;
     s.base_origin = gap_origin;
     s.stop_when_empty = true;
     s.rebuild = [this](const CalibrationRun& w, const BatchPoint& at) {
@@ -175,11 +174,10 @@ struct WindowProblem {
     return s;
   }
 
-  const Options& options;
+  const CalibrationOptions& options;
   const CalibrationRun& window;
   double q0 = 0.0, sigma_q = 0.0;  // the inverse-depth prior
-  Options decisions;
-  BatchOptions batch;
+  CalibrationOptions decisions;
   ceres::Solver::Options so;
   WindowTracks tracks;  // of the run last built
 };
@@ -195,10 +193,11 @@ struct WindowProblem {
 // error from pixels is 0.03-0.10 rad on average, 0.21 at most, over 60 runs of the paper's
 // mounting: those runs keep their five starts (test: WindowStarts.CameraYawFromTheBearingsFlow
 // and the rendered window starts of calibrate_cases.cmake).
-std::vector<Extrinsics> window_starts(const Options& options, const CalibrationRun& window) {
+std::vector<Extrinsics> window_starts(const CalibrationOptions& options,
+                                      const CalibrationRun& window) {
   constexpr double kFlowYawGap = 0.35;  // rad
-  const double prior_yaw = options.prior.phi + options.prior.psi;
-  const double flow_yaw = camera_yaw_from_flow(window, options.wheel_base);
+  const double prior_yaw = options.prior.mean.phi + options.prior.mean.psi;
+  const double flow_yaw = camera_yaw_from_flow(window, options.robot.wheel_base);
   const bool flow_starts =
       std::isfinite(flow_yaw) && std::abs(wrap_angle(flow_yaw - prior_yaw)) > kFlowYawGap;
   spdlog::debug("window: camera yaw from the bearings' flow {:.4f} rad (prior {:.4f}){}",
@@ -206,12 +205,13 @@ std::vector<Extrinsics> window_starts(const Options& options, const CalibrationR
                 prior_yaw,
                 flow_starts ? ": starts at both" : "");
   constexpr std::array<double, 5> kStarts{0.0, -0.5, 0.5, -1.0, 1.0};
-  const int per_yaw = std::min<int>(options.bootstrap_starts, static_cast<int>(kStarts.size()));
+  const int per_yaw =
+      std::min<int>(options.filter.bootstrap_starts, static_cast<int>(kStarts.size()));
   const int starts = flow_starts ? 2 * per_yaw : per_yaw;
   std::vector<Extrinsics> out;
   for (int i = 0; i < starts; ++i) {
     const double d = kStarts[static_cast<std::size_t>(i % per_yaw)];
-    Extrinsics ex0 = options.prior;
+    Extrinsics ex0 = options.prior.mean;
     if (i >= per_yaw) ex0.psi = wrap_angle(flow_yaw - ex0.phi);
     ex0.phi += d;
     ex0.psi -= d;
@@ -290,7 +290,7 @@ std::string association_failure(AssociationEnd end) {
 // joined piece takes the id of its line's first piece, the later part of a split track a new id;
 // the filter continues each under the tracker's ids (BootstrapDetails).
 bool bootstrap_filter_state(const CalibrationRun& window_in,
-                            const Options& options,
+                            const CalibrationOptions& options,
                             FilterState* state,
                             std::string* why,
                             BootstrapDetails* details) {
@@ -313,9 +313,8 @@ bool bootstrap_filter_state(const CalibrationRun& window_in,
           associate(&b, window, problem.association_setup(gap_origin, &summary), &association);
       end != AssociationEnd::kDone)
     return fail(association_failure(end));
-  if (options.track_bias_sigma > 0.0) {
-    b = problem.with_priors(
-        final_with_bias(association.solved(), b, options, problem.batch, false, 1));
+  if (options.noise.track_bias_sigma > 0.0) {
+    b = problem.with_priors(final_with_bias(association.solved(), b, options, false, 1));
     if (b.features.empty()) return fail(association_failure(AssociationEnd::kNoTrackLeft));
     ceres::Solve(problem.so, b.problem.get(), &summary);
   }

@@ -29,29 +29,31 @@ namespace omnivert::calib {
 // docs/theory/window.md#why-a-window: one linearisation per frame while depth and camera yaw are
 // both unknown. Tracks with fewer than 2 bearings in the window are left out (they enter
 // afterwards). Outlying bearings are removed as in refine_batch. Tracks that slipped onto a
-// neighbouring line are split as in refine_batch (options.split_chi2); the later part of such a
-// track enters the state under the tracker's id. Returns false (state untouched, reason in *why)
-// when the window cannot be solved.
+// neighbouring line are split as in refine_batch (options.association.split_chi2); the later part
+// of such a track enters the state under the tracker's id. Returns false (state untouched, reason
+// in *why) when the window cannot be solved.
 struct BootstrapDetails {
   // Every track of the window's solution as (D, theta) from the robot at its last window
   // frame (frame = index in the window), with covariance: tracks that ended inside the window
   // never enter the state, and the refinement starts from these. A split track: its latest
   // part.
   std::map<int, TrackEstimate> tracks;
-  std::vector<std::pair<int, int>> splits;   // (tracker's track id, window frame of the new part)
-  std::vector<std::pair<int, int>> guarded;  // (tracker's track id, window frame) left out
-                                             // where lines cross (Options::crossing_guard)
+  std::vector<std::pair<int, int>> splits;  // (tracker's track id, window frame of the new part)
+  std::vector<std::pair<int, int>>
+      guarded;  // (tracker's track id, window frame) left out
+                // where lines cross (CalibrationOptions::association.crossing_guard)
   // (tracker's track id, window frame) removed as outliers (the gate) or with a feature left
   // without bearings: with `guarded`, what the window's solution did not use.
   std::vector<std::pair<int, int>> rejected;
-  // Pieces of one line joined in the window (find_merges, Options::join_pieces): (tracker's
-  // id of an earlier piece, of the piece joined to it). The line's feature is in the state
-  // under its first piece's id; the filter takes later bearings of any of its pieces for it.
+  // Pieces of one line joined in the window (find_merges,
+  // CalibrationOptions::association.join_pieces): (tracker's id of an earlier piece, of the piece
+  // joined to it). The line's feature is in the state under its first piece's id; the filter takes
+  // later bearings of any of its pieces for it.
   std::vector<std::pair<int, int>> joins;
 };
 
 bool bootstrap_filter_state(const CalibrationRun& window,
-                            const Options& options,
+                            const CalibrationOptions& options,
                             FilterState* state,
                             std::string* why = nullptr,
                             BootstrapDetails* details = nullptr);
@@ -93,7 +95,7 @@ WindowIds window_ids(const CalibrationRun& solved,
 // filter's state at its last frame, and the details. false (reason in *why) when its
 // information is singular or the result not finite.
 bool window_to_filter(Built& b,
-                      const Options& options,
+                      const CalibrationOptions& options,
                       int W,
                       const WindowTracks& tracks,
                       const WindowIds& ids,

@@ -38,8 +38,8 @@ Eigen::MatrixXd central_jacobian(const F& f,
 }
 
 // The window's variables in the order of its Jacobian's columns: poses of frames 1..W-1
-// (frame 0 is the gauge), features (2 columns each), track biases (Options::track_bias_sigma),
-// extrinsics (3).
+// (frame 0 is the gauge), features (2 columns each), track biases
+// (CalibrationOptions::noise.track_bias_sigma), extrinsics (3).
 struct WindowColumns {
   std::vector<double*> blocks;
   std::map<int, int> feature;  // track id -> first column
@@ -213,7 +213,7 @@ void window_decisions(const Built& b,
 }
 
 // The filter's state from the window: the kept tracks as anchored features.
-FilterState filter_state(const Options& options,
+FilterState filter_state(const CalibrationOptions& options,
                          const std::vector<int>& ids,
                          const WindowIds& names,
                          const WindowTracks& tracks,
@@ -224,13 +224,13 @@ FilterState filter_state(const Options& options,
     FeatureSlot slot;
     slot.track_id = names.tracker_id(id);
     slot.param = FeatureParam::kAnchored;
-    slot.bias = options.track_bias_sigma > 0.0;
+    slot.bias = options.noise.track_bias_sigma > 0.0;
     slot.first_frame = tracks.first(id);
     slot.last_seen_frame = tracks.last(id);
     slot.num_updates = tracks.bearings(id);
     slots.push_back(slot);
   }
-  FilterState fresh(options.prior, options.prior_sigma, ExtrinsicsParam::kCameraPose);
+  FilterState fresh(options.prior.mean, options.prior.sigma, ExtrinsicsParam::kCameraPose);
   fresh.reset(s0, Ps, slots);
   fresh.normalise();
   return fresh;
@@ -239,7 +239,7 @@ FilterState filter_state(const Options& options,
 }  // namespace
 
 bool window_to_filter(Built& b,
-                      const Options& options,
+                      const CalibrationOptions& options,
                       int W,
                       const WindowTracks& tracks,
                       const WindowIds& ids,
@@ -259,11 +259,11 @@ bool window_to_filter(Built& b,
   const std::map<int, int> latest = latest_parts(b, ids, tracks);
   std::vector<int> kept;
   for (const auto& [tid, id] : latest)
-    if (W - 1 - tracks.last(id) <= options.max_missed_frames) kept.push_back(id);
+    if (W - 1 - tracks.last(id) <= options.association.max_missed_frames) kept.push_back(id);
   const Eigen::VectorXd v0 = window_values(b, c, W, static_cast<int>(Pv.rows()));
   Eigen::VectorXd s0;
   Eigen::MatrixXd Ps;
-  if (!filter_coordinates(v0, Pv, c, kept, options.track_bias_sigma > 0.0, W, &s0, &Ps)) {
+  if (!filter_coordinates(v0, Pv, c, kept, options.noise.track_bias_sigma > 0.0, W, &s0, &Ps)) {
     *why = "window solution is not finite";
     return false;
   }

@@ -1,6 +1,9 @@
 #include "omnivert/core/camera_geometry.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <filesystem>
 
 #include <yaml-cpp/yaml.h>
 
@@ -16,6 +19,70 @@ double CameraGeometry::bearing_of_image_angle(double a) const {
 
 double CameraGeometry::image_angle_of_bearing(double beta) const {
   return wrap_angle(bearing_sign * beta);
+}
+
+std::optional<BayerPattern> parse_bayer_pattern(const std::string& name) {
+  std::string n = name;
+  std::transform(n.begin(), n.end(), n.begin(), [](unsigned char c) { return std::toupper(c); });
+  if (n == "NONE") return BayerPattern::kNone;
+  if (n == "RGGB") return BayerPattern::kRGGB;
+  if (n == "BGGR") return BayerPattern::kBGGR;
+  if (n == "GRBG") return BayerPattern::kGRBG;
+  if (n == "GBRG") return BayerPattern::kGBRG;
+  return std::nullopt;
+}
+
+const char* bayer_pattern_name(BayerPattern pattern) {
+  switch (pattern) {
+    case BayerPattern::kRGGB:
+      return "RGGB";
+    case BayerPattern::kBGGR:
+      return "BGGR";
+    case BayerPattern::kGRBG:
+      return "GRBG";
+    case BayerPattern::kGBRG:
+      return "GBRG";
+    case BayerPattern::kNone:
+      break;
+  }
+  return "none";
+}
+
+namespace {
+
+PixelFormat load_pixel_format(const YAML::Node& root, const std::string& path) {
+  PixelFormat f;
+  if (const auto b = yaml::optional_string(root, "bayer", path)) {
+    const auto p = parse_bayer_pattern(*b);
+    if (!p) {
+      throw InputError(path,
+                       yaml::line_of(root["bayer"]),
+                       "field 'bayer' is '" + *b + "'; expected RGGB, BGGR, GRBG, GBRG or none");
+    }
+    f.bayer = *p;
+  }
+  if (const auto d = yaml::optional_number(root, "bit_depth", path)) {
+    if (*d != std::floor(*d) || *d < 9 || *d > 16) {
+      throw InputError(path,
+                       yaml::line_of(root["bit_depth"]),
+                       "field 'bit_depth' must be a whole number of bits from 9 to 16 (the "
+                       "significant bits of a 16-bit image)");
+    }
+    f.bit_depth = static_cast<int>(*d);
+  }
+  return f;
+}
+
+}  // namespace
+
+double CameraGeometry::elevation_of_radius(double r) const {
+  // r (xi - sin el) = gamma cos el  <=>  hypot(r, gamma) sin(el + atan2(gamma, r)) = r xi; the
+  // branch that is monotonic from el = -pi/2 at r = 0.
+  return std::asin(r * *xi / std::hypot(r, *gamma)) - std::atan2(*gamma, r);
+}
+
+double CameraGeometry::radius_of_elevation(double el) const {
+  return *gamma * std::cos(el) / (*xi - std::sin(el));
 }
 
 CameraGeometry load_camera_geometry(const std::string& path) {
@@ -57,6 +124,30 @@ CameraGeometry load_camera_geometry(const std::string& path) {
           path, yaml::line_of(root["bearing_sign"]), "field 'bearing_sign' must be 1 or -1");
     }
     g.bearing_sign = static_cast<int>(*s);
+  }
+  g.pixel_format = load_pixel_format(root, path);
+  if (const auto m = yaml::optional_string(root, "mask", path)) {
+    namespace fs = std::filesystem;
+    const int line = yaml::line_of(root["mask"]);
+    if (m->empty()) throw InputError(path, line, "field 'mask' must name an image file");
+    fs::path p(*m);
+    if (p.is_relative()) p = fs::path(path).parent_path() / p;
+    std::error_code ec;
+    if (!fs::is_regular_file(p, ec)) {
+      throw InputError(path,
+                       line,
+                       "field 'mask': file '" + *m + "' not found (looked for " + p.string() +
+                           "; the path is relative to the folder of this file)");
+    }
+    g.mask = p.string();
+  }
+  g.xi = yaml::optional_number(root, "xi", path);
+  g.gamma = yaml::optional_number(root, "gamma", path);
+  if (g.xi && !(*g.xi > 0.0 && *g.xi < 1.0)) {
+    throw InputError(path, yaml::line_of(root["xi"]), "field 'xi' must lie in (0, 1)");
+  }
+  if (g.gamma && !(*g.gamma > 0.0)) {
+    throw InputError(path, yaml::line_of(root["gamma"]), "field 'gamma' must be positive");
   }
   return g;
 }

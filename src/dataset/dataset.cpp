@@ -14,6 +14,7 @@
 
 #include "core/yaml_fields.hpp"
 #include "omnivert/core/error.hpp"
+#include "omnivert/image/grey.hpp"
 
 namespace omnivert::dataset {
 
@@ -141,13 +142,6 @@ std::string rel(const std::string& root, const std::string& sub) {
 cv::Mat1b read_checked_image(const std::string& path, const CameraGeometry& cam) {
   const cv::Mat raw = cv::imread(path, cv::IMREAD_UNCHANGED);
   if (raw.empty()) throw InputError(path, 0, "cannot be read as an image");
-  if (raw.depth() != CV_8U) {
-    const int bits = raw.depth() == CV_16U || raw.depth() == CV_16S ? 16 : 32;
-    throw InputError(path,
-                     0,
-                     "image is " + std::to_string(bits) +
-                         " bits deep; expected 8-bit grey (convert it, e.g. to 8-bit PNG)");
-  }
   if (raw.cols != cam.width || raw.rows != cam.height) {
     throw InputError(path,
                      0,
@@ -155,17 +149,9 @@ cv::Mat1b read_checked_image(const std::string& path, const CameraGeometry& cam)
                          " pixels but cam0/sensor.yaml gives resolution " +
                          std::to_string(cam.width) + "x" + std::to_string(cam.height));
   }
-  cv::Mat1b grey;
-  if (raw.channels() == 1) {
-    grey = raw;
-  } else if (raw.channels() == 3) {
-    cv::cvtColor(raw, grey, cv::COLOR_BGR2GRAY);
-  } else if (raw.channels() == 4) {
-    cv::cvtColor(raw, grey, cv::COLOR_BGRA2GRAY);
-  } else {
-    throw InputError(
-        path, 0, "image has " + std::to_string(raw.channels()) + " channels; expected grey");
-  }
+  cv::Mat grey;
+  std::string why;
+  if (!to_grey8(raw, cam.pixel_format, grey, &why)) throw InputError(path, 0, why);
   return grey;
 }
 

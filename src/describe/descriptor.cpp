@@ -7,6 +7,7 @@
 
 #include "describe/fast_math.hpp"
 #include "omnivert/core/angles.hpp"
+#include "omnivert/image/image_mask.hpp"
 
 namespace omnivert {
 
@@ -25,6 +26,11 @@ bool DescriptorOptions::IsValid(std::string* why) const {
 
 DescriptorExtractor::DescriptorExtractor(DescriptorOptions options)
     : options_(std::move(options)) {}
+
+void DescriptorExtractor::set_mask(const cv::Mat& usable) {
+  CV_Assert(usable.empty() || usable.type() == CV_8UC1);
+  usable_ = usable.empty() || mask_all_usable(usable) ? cv::Mat() : usable.clone();
+}
 
 double DescriptorExtractor::area_radius(const MirrorCircle& circle) const {
   return (circle.r_max - circle.r_min) / 6.0;  // r_a, Sec. 3.1
@@ -81,9 +87,20 @@ void DescriptorExtractor::prepare(const cv::Mat& gray, const MirrorCircle& circl
       log_lut_log_ = options_.log_intensity;
     }
     cv::LUT(src, log_lut_, full_);
+    const cv::Size samples(full_.cols / step_, full_.rows / step_);
+    if (!usable_.empty()) {
+      // Normalised convolution, blur(I M) / blur(M) with M = 1 - masked: the masked pixels
+      // are zeroed and the masked fraction is blurred alongside. Far from the mask both are
+      // exact (zero masked fraction), so the descriptors there are bit-identical.
+      full_.setTo(0.0f, usable_(roi_) == 0);
+      cv::Mat masked;
+      cv::compare(usable_(roi_), 0, masked, cv::CMP_EQ);
+      masked.convertTo(mask_f_, CV_32F, 1.0 / 255.0);
+      if (step_ > 1) cv::resize(mask_f_, mask_f_, samples, 0, 0, cv::INTER_AREA);
+      sample_usable_ = 1.0f - mask_f_;
+    }
     if (step_ > 1) {
-      cv::resize(
-          full_, blurred_, cv::Size(full_.cols / step_, full_.rows / step_), 0, 0, cv::INTER_AREA);
+      cv::resize(full_, blurred_, samples, 0, 0, cv::INTER_AREA);
     } else {
       blurred_ = full_;
     }
@@ -91,12 +108,28 @@ void DescriptorExtractor::prepare(const cv::Mat& gray, const MirrorCircle& circl
     const double rest =
         std::sqrt(std::max(0.25, sigma * sigma - (step_ * step_ - 1) / 12.0)) / step_;
     cv::GaussianBlur(blurred_, blurred_, cv::Size(), rest, 0, cv::BORDER_REPLICATE);
+    if (!usable_.empty()) {
+      cv::GaussianBlur(mask_f_, weight_, cv::Size(), rest, 0, cv::BORDER_REPLICATE);
+      for (int v = 0; v < blurred_.rows; ++v) {
+        float* b = blurred_.ptr<float>(v);
+        const float* w = weight_.ptr<float>(v);
+        // Where no usable pixel is near, the value stays 0 (and so does the samples' weight).
+        for (int u = 0; u < blurred_.cols; ++u)
+          if (w[u] > 0.0f) b[u] /= std::max(1e-6f, 1.0f - w[u]);
+      }
+    }
     cv::Sobel(blurred_, gx_, CV_32F, 1, 0, 3);
     cv::Sobel(blurred_, gy_, CV_32F, 0, 1, 3);
   } else {
     cv::Sobel(src, gx_, CV_32F, 1, 0, 3);
     cv::Sobel(src, gy_, CV_32F, 0, 1, 3);
+    // A pixel votes only when its whole Sobel window is usable.
+    if (!usable_.empty()) {
+      sample_usable_ = cv::Mat::zeros(gx_.size(), CV_32F);
+      sample_usable_.setTo(1.0f, erode_mask(usable_(roi_), 1));
+    }
   }
+  if (usable_.empty()) sample_usable_.release();
 }
 
 void DescriptorExtractor::describe_one(const MirrorCircle& circle,
@@ -130,6 +163,7 @@ void DescriptorExtractor::describe_one(const MirrorCircle& circle,
     for (int v = v0; v <= v1; ++v) {
       const float* px = gx_.ptr<float>(v);
       const float* py = gy_.ptr<float>(v);
+      const float* pu = sample_usable_.empty() ? nullptr : sample_usable_.ptr<float>(v);
       const float ry = v * st + off - cy;
       for (int u = u0; u <= u1; ++u) {
         const float rx = u * st + off - cx;
@@ -137,6 +171,7 @@ void DescriptorExtractor::describe_one(const MirrorCircle& circle,
         if (d2 > ra2) continue;
         const float gx = px[u], gy = py[u];
         float m = std::sqrt(gx * gx + gy * gy);
+        if (pu) m *= pu[u];  // masked pixels add nothing
         if (m == 0.0f) continue;
         // A sample stands for a step x step cell: it belongs to the area, and to each side
         // of the line, by the fraction of the cell inside (linear ramps one cell wide), so

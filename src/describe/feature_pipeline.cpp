@@ -1,10 +1,14 @@
 #include "omnivert/describe/feature_pipeline.hpp"
 
 #include <cmath>
+#include <cstdio>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
 #include "omnivert/core/angles.hpp"
+#include "omnivert/image/grey.hpp"
+#include "omnivert/image/image_mask.hpp"
 
 namespace omnivert {
 
@@ -17,38 +21,22 @@ FeaturePipeline::FeaturePipeline(CameraGeometry geometry, FeaturePipelineOptions
       options_(std::move(options)),
       center_(options_.center),
       lines_(options_.lines),
-      descriptors_(options_.descriptor) {}
+      descriptors_(options_.descriptor) {
+  if (geometry_.mask) set_mask(read_mask(*geometry_.mask, geometry_.width, geometry_.height));
+  if (!options_.tilt.isZero() && geometry_.has_projection())
+    rectifier_.emplace(geometry_, options_.tilt);
+}
+
+void FeaturePipeline::set_mask(const cv::Mat& usable) {
+  CV_Assert(usable.empty() || usable.type() == CV_8UC1);
+  mask_ = usable;
+  center_.set_mask(usable);
+  lines_.set_mask(usable);
+  descriptors_.set_mask(usable);
+}
 
 bool FeaturePipeline::to_gray8(const cv::Mat& image, cv::Mat& gray) {
-  if (image.empty() || image.dims != 2) return false;
-  cv::Mat g;
-  switch (image.channels()) {
-    case 1:
-      g = image;
-      break;
-    case 3:
-      cv::cvtColor(image, g, cv::COLOR_BGR2GRAY);
-      break;
-    case 4:
-      cv::cvtColor(image, g, cv::COLOR_BGRA2GRAY);
-      break;
-    default:
-      return false;
-  }
-  switch (g.depth()) {
-    case CV_8U:
-      gray = g.isContinuous() ? g : g.clone();
-      return true;
-    case CV_16U:
-      g.convertTo(gray, CV_8U, 1.0 / 257.0);
-      return true;
-    case CV_32F:
-    case CV_64F:
-      g.convertTo(gray, CV_8U, 255.0);
-      return true;
-    default:
-      return false;
-  }
+  return to_grey8(image, PixelFormat{}, gray, nullptr);
 }
 
 double annulus_fraction_inside(const MirrorCircle& c, int width, int height) {
@@ -66,17 +54,37 @@ double annulus_fraction_inside(const MirrorCircle& c, int width, int height) {
   return total ? static_cast<double>(in) / total : 0.0;
 }
 
+double annulus_fraction_usable(const MirrorCircle& c, const cv::Mat& usable) {
+  double in = 0, ok = 0;
+  for (int i = 0; i < 32; ++i) {
+    const double r = c.r_min + (c.r_max - c.r_min) * (i + 0.5) / 32.0;
+    for (int k = 0; k < 360; ++k) {
+      const double a = kTwoPi * k / 360.0;
+      const int x = static_cast<int>(std::lround(c.center.x() + r * std::cos(a)));
+      const int y = static_cast<int>(std::lround(c.center.y() + r * std::sin(a)));
+      if (x < 0 || y < 0 || x >= usable.cols || y >= usable.rows) continue;
+      in += r;  // area element grows with r
+      if (usable.at<uchar>(y, x)) ok += r;
+    }
+  }
+  return in > 0 ? ok / in : 0.0;
+}
+
 bool FeaturePipeline::process(const cv::Mat& image, FrameFeatures& out, std::string* why) {
   if (why) why->clear();
-  if (!to_gray8(image, gray_)) {
-    if (why) *why = "unsupported image type (expected 8- or 16-bit grey or colour)";
-    return false;
-  }
+  if (!to_grey8(image, geometry_.pixel_format, gray_, why)) return false;
   if (geometry_.width > 0 && (gray_.cols != geometry_.width || gray_.rows != geometry_.height)) {
     if (why)
       *why = "image is " + std::to_string(gray_.cols) + "x" + std::to_string(gray_.rows) +
              " but the camera's resolution is " + std::to_string(geometry_.width) + "x" +
              std::to_string(geometry_.height);
+    return false;
+  }
+  const std::string mask_name = geometry_.mask ? "the mask " + *geometry_.mask : "the mask";
+  if (!mask_.empty() && mask_.size() != gray_.size()) {
+    if (why)
+      *why = mask_name + " is " + std::to_string(mask_.cols) + "x" + std::to_string(mask_.rows) +
+             " but the image is " + std::to_string(gray_.cols) + "x" + std::to_string(gray_.rows);
     return false;
   }
   // A centre given in sensor.yaml is used as it is (FeaturePipelineOptions).
@@ -85,7 +93,15 @@ bool FeaturePipeline::process(const cv::Mat& image, FrameFeatures& out, std::str
     std::string reason;
     auto c = center_.estimate(gray_, geometry_, &reason);
     if (!c) {
-      if (why) *why = reason;
+      if (why) {
+        *why = reason;
+        if (!mask_.empty()) {
+          const double usable = static_cast<double>(cv::countNonZero(mask_)) / mask_.total();
+          *why += " (" + mask_name + " leaves " + std::to_string(std::lround(100 * usable)) +
+                  "% of the image usable; the mirror rim must be usable, or sensor.yaml must "
+                  "give center and r_max)";
+        }
+      }
       return false;
     }
     const double inside = annulus_fraction_inside(*c, gray_.cols, gray_.rows);
@@ -108,6 +124,25 @@ bool FeaturePipeline::process(const cv::Mat& image, FrameFeatures& out, std::str
       return false;
     }
     if (center_as_given) c->center = *geometry_.center;
+    if (!mask_.empty()) {
+      const double usable = annulus_fraction_usable(*c, mask_);
+      if (usable < kMinUsableAnnulus) {
+        if (why) {
+          std::vector<char> buf(mask_name.size() + 200);
+          std::snprintf(buf.data(),
+                        buf.size(),
+                        "%s leaves only %.0f%% of the annulus r_min..r_max = %.1f..%.1f px "
+                        "usable (at least %.0f%% is needed)",
+                        mask_name.c_str(),
+                        100 * usable,
+                        c->r_min,
+                        c->r_max,
+                        100 * kMinUsableAnnulus);
+          *why = buf.data();
+        }
+        return false;
+      }
+    }
     circle_ = c;
   } else if (options_.track_center && circle_->rim_radius > 0 && !center_as_given) {
     std::string reason;
@@ -118,9 +153,14 @@ bool FeaturePipeline::process(const cv::Mat& image, FrameFeatures& out, std::str
     }
   }
   out.circle = *circle_;
-  lines_.extract(gray_, out.circle, out.lines);
+  const cv::Mat* frame = &gray_;
+  if (rectifier_) {
+    rectifier_->apply(gray_, out.circle, upright_);
+    frame = &upright_;
+  }
+  lines_.extract(*frame, out.circle, out.lines);
   for (VerticalLine& l : out.lines) l.bearing = geometry_.bearing_of_image_angle(l.image_angle);
-  descriptors_.compute(gray_, out.circle, out.lines, out.descriptors);
+  descriptors_.compute(*frame, out.circle, out.lines, out.descriptors);
   return true;
 }
 

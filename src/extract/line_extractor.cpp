@@ -6,6 +6,7 @@
 #include <numeric>
 
 #include "omnivert/core/angles.hpp"
+#include "omnivert/image/image_mask.hpp"
 
 namespace omnivert {
 
@@ -35,6 +36,12 @@ bool LineExtractorOptions::IsValid(std::string* why) const {
 }
 
 LineExtractor::LineExtractor(LineExtractorOptions options) : options_(std::move(options)) {}
+
+void LineExtractor::set_mask(const cv::Mat& usable) {
+  CV_Assert(usable.empty() || usable.type() == CV_8UC1);
+  // Radius 1: the 3x3 Sobel window of eq. (1).
+  sobel_usable_ = usable.empty() || mask_all_usable(usable) ? cv::Mat() : erode_mask(usable, 1);
+}
 
 void LineExtractor::build_lut(const MirrorCircle& circle) {
   lut_.clear();
@@ -242,8 +249,19 @@ void LineExtractor::extract(const cv::Mat& gray,
 }
 
 void LineExtractor::edge_pass(const cv::Mat& gray, int cxi, int cyi) {
+  if (sobel_usable_.empty()) {
+    edge_pass_impl<false>(gray, cxi, cyi);
+  } else {
+    CV_Assert(sobel_usable_.size() == gray.size());
+    edge_pass_impl<true>(gray, cxi, cyi);
+  }
+}
+
+template <bool kMasked>
+void LineExtractor::edge_pass_impl(const cv::Mat& gray, int cxi, int cyi) {
   // Step 2: one pass over the annulus: Sobel (eq. 1), magnitude threshold, orientation test.
   const int W = gray.cols, H = gray.rows;
+  const uchar* usable = kMasked ? sobel_usable_.ptr<uchar>() : nullptr;
   float* mag = mag_.ptr<float>();
   const uchar* img = gray.ptr<uchar>();
   const float t2 = static_cast<float>(options_.gradient_threshold * options_.gradient_threshold);
@@ -256,6 +274,9 @@ void LineExtractor::edge_pass(const cv::Mat& gray, int cxi, int cyi) {
     const int u = cxi + e.du, v = cyi + e.dv;
     if (u < 1 || v < 1 || u >= W - 1 || v >= H - 1) continue;
     const int idx = v * W + u;
+    if constexpr (kMasked) {
+      if (!usable[idx]) continue;  // the Sobel window touches a masked pixel
+    }
     const uchar* p = img + idx;
     const int gx = (p[-W + 1] + 2 * p[1] + p[W + 1]) - (p[-W - 1] + 2 * p[-1] + p[W - 1]);
     const int gy = (p[W - 1] + 2 * p[W] + p[W + 1]) - (p[-W - 1] + 2 * p[-W] + p[-W + 1]);

@@ -7,7 +7,9 @@
 #include <Eigen/Dense>
 #include <opencv2/imgproc.hpp>
 
+#include "extract/rim_geometry.hpp"
 #include "omnivert/core/angles.hpp"
+#include "omnivert/image/image_mask.hpp"
 
 namespace omnivert {
 
@@ -36,134 +38,22 @@ void set_why(std::string* why, const std::string& m) {
   if (why) *why = m;
 }
 
-// Bilinear sample of an 8-bit image; false outside.
-inline bool sample(const cv::Mat& img, double x, double y, double& out) {
-  if (x < 0 || y < 0 || x > img.cols - 1.001 || y > img.rows - 1.001) return false;
-  const int x0 = static_cast<int>(x);
-  const int y0 = static_cast<int>(y);
-  const double fx = x - x0;
-  const double fy = y - y0;
-  const uchar* r0 = img.ptr<uchar>(y0);
-  const uchar* r1 = img.ptr<uchar>(y0 + 1);
-  out =
-      (1 - fy) * ((1 - fx) * r0[x0] + fx * r0[x0 + 1]) + fy * ((1 - fx) * r1[x0] + fx * r1[x0 + 1]);
-  return true;
-}
-
-// Least-squares circle through points: algebraic (Kasa) start, then Gauss-Newton on the
-// geometric distance, with outliers beyond 3 robust sigmas removed between passes.
-bool fit_circle(std::vector<Eigen::Vector2d> pts, Eigen::Vector2d& c, double& r) {
-  for (int pass = 0; pass < 3; ++pass) {
-    if (pts.size() < 8) return false;
-    if (pass == 0) {
-      Eigen::MatrixXd A(pts.size(), 3);
-      Eigen::VectorXd b(pts.size());
-      for (std::size_t i = 0; i < pts.size(); ++i) {
-        A(i, 0) = pts[i].x();
-        A(i, 1) = pts[i].y();
-        A(i, 2) = 1.0;
-        b(i) = -(pts[i].squaredNorm());
-      }
-      const Eigen::Vector3d s = A.colPivHouseholderQr().solve(b);
-      c = Eigen::Vector2d(-s(0) / 2, -s(1) / 2);
-      const double rr = c.squaredNorm() - s(2);
-      if (!(rr > 0)) return false;
-      r = std::sqrt(rr);
-    }
-    for (int it = 0; it < 10; ++it) {
-      Eigen::Matrix3d JtJ = Eigen::Matrix3d::Zero();
-      Eigen::Vector3d Jtr = Eigen::Vector3d::Zero();
-      for (const auto& p : pts) {
-        const Eigen::Vector2d d = p - c;
-        const double n = d.norm();
-        if (n < 1e-9) continue;
-        const double res = n - r;
-        const Eigen::Vector3d J(-d.x() / n, -d.y() / n, -1.0);
-        JtJ += J * J.transpose();
-        Jtr += J * res;
-      }
-      const Eigen::Vector3d delta = JtJ.ldlt().solve(-Jtr);
-      c += delta.head<2>();
-      r += delta(2);
-      if (delta.norm() < 1e-6) break;
-    }
-    std::vector<double> res;
-    res.reserve(pts.size());
-    for (const auto& p : pts) res.push_back(std::abs((p - c).norm() - r));
-    std::vector<double> sorted = res;
-    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-    const double gate = std::max(0.5, 3.0 * 1.4826 * sorted[sorted.size() / 2]);
-    std::vector<Eigen::Vector2d> kept;
-    kept.reserve(pts.size());
-    for (std::size_t i = 0; i < pts.size(); ++i)
-      if (res[i] <= gate) kept.push_back(pts[i]);
-    if (kept.size() == pts.size()) break;
-    pts.swap(kept);
-  }
-  return std::isfinite(c.x()) && std::isfinite(c.y()) && std::isfinite(r) && r > 0;
-}
-
-// Smooths an accumulator and returns the position of its maximum (with a parabolic sub-pixel
-// step in each axis).
-Eigen::Vector2d accumulator_peak(cv::Mat& acc, double sigma) {
-  cv::GaussianBlur(acc, acc, cv::Size(), sigma);
-  cv::Point loc;
-  cv::minMaxLoc(acc, nullptr, nullptr, nullptr, &loc);
-  double dx = 0, dy = 0;
-  if (loc.x > 0 && loc.x < acc.cols - 1) {
-    const float l = acc.at<float>(loc.y, loc.x - 1), m = acc.at<float>(loc.y, loc.x),
-                r = acc.at<float>(loc.y, loc.x + 1);
-    const double den = l - 2 * m + r;
-    if (den < 0) dx = 0.5 * (l - r) / den;
-  }
-  if (loc.y > 0 && loc.y < acc.rows - 1) {
-    const float u = acc.at<float>(loc.y - 1, loc.x), m = acc.at<float>(loc.y, loc.x),
-                d = acc.at<float>(loc.y + 1, loc.x);
-    const double den = u - 2 * m + d;
-    if (den < 0) dy = 0.5 * (u - d) / den;
-  }
-  return {loc.x + dx, loc.y + dy};
-}
-
-// Fraction of the in-image circumference at each integer radius covered by edge pixels with
-// a radial gradient of the given sign (+1: brighter outward, -1: darker outward).
-std::vector<double> radial_edge_coverage(const cv::Mat& gx,
-                                         const cv::Mat& gy,
-                                         const Eigen::Vector2d& c,
-                                         int r_max,
-                                         double threshold,
-                                         int sign) {
-  std::vector<double> hits(r_max + 2, 0.0), total(r_max + 2, 0.0);
-  const double t2 = threshold * threshold;
-  const double cos20 = std::cos(deg2rad(20.0));
-  for (int v = 1; v < gx.rows - 1; ++v) {
-    const short* px = gx.ptr<short>(v);
-    const short* py = gy.ptr<short>(v);
-    for (int u = 1; u < gx.cols - 1; ++u) {
-      const double dx = u - c.x(), dy = v - c.y();
-      const double rr = std::sqrt(dx * dx + dy * dy);
-      const int ri = static_cast<int>(rr + 0.5);
-      if (ri > r_max || ri < 1) continue;
-      total[ri] += 1.0;
-      const double g2 = double(px[u]) * px[u] + double(py[u]) * py[u];
-      if (g2 < t2) continue;
-      const double radial = (px[u] * dx + py[u] * dy) / rr;  // gradient along r-hat
-      if (sign * radial >= cos20 * std::sqrt(g2)) hits[ri] += 1.0;
-    }
-  }
-  std::vector<double> cov(r_max + 2, 0.0);
-  for (int r = 1; r <= r_max; ++r) {
-    // Circumference pixels at radius r number about 2 pi r; the ring of pixels rounding to
-    // r has that many, and an edge is about one pixel thick.
-    if (total[r] > 0.25 * kTwoPi * r) cov[r] = hits[r] / total[r];
-  }
-  // Smooth over +-1 pixel: an edge between two pixel rings splits its votes.
-  std::vector<double> sm(cov.size(), 0.0);
-  for (std::size_t r = 1; r + 1 < cov.size(); ++r) sm[r] = cov[r - 1] + cov[r] + cov[r + 1];
-  return sm;
+// The usable mask of a reduced image: a small pixel is usable when all the pixels it averages
+// are, and its Sobel window is then shrunk by one small pixel. Empty stays empty.
+cv::Mat shrink_mask(const cv::Mat& usable, cv::Size small) {
+  if (usable.empty() || usable.size() == small) return usable;
+  cv::Mat s;
+  cv::resize(usable, s, small, 0, 0, cv::INTER_AREA);
+  cv::compare(s, 255, s, cv::CMP_GE);
+  return erode_mask(s, 1);
 }
 
 }  // namespace
+
+void MirrorCenterDetector::set_mask(const cv::Mat& usable) {
+  CV_Assert(usable.empty() || usable.type() == CV_8UC1);
+  usable_ = usable.empty() || mask_all_usable(usable) ? cv::Mat() : erode_mask(usable, 1);
+}
 
 bool MirrorCenterDetector::refine(const cv::Mat& gray,
                                   Eigen::Vector2d& center,
@@ -181,9 +71,10 @@ bool MirrorCenterDetector::refine(const cv::Mat& gray,
       bool ok = true;
       for (int i = 0; i < n && ok; ++i) {
         const Eigen::Vector2d p = center + (rim_radius - W + i * step) * d;
-        ok = sample(gray, p.x(), p.y(), prof[i]);
+        ok = rim::sample(gray, p.x(), p.y(), prof[i]) &&
+             (usable_.empty() || rim::usable_at(usable_, p));
       }
-      if (!ok) continue;
+      if (!ok) continue;  // outside the image or masked
       for (int s = 0; s < 2; ++s) {
         const double sgn = s == 0 ? -1.0 : 1.0;
         int best = -1;
@@ -209,102 +100,105 @@ bool MirrorCenterDetector::refine(const cv::Mat& gray,
     if (static_cast<int>(pts[s].size()) < options_.rim_rays / 4) return false;
     Eigen::Vector2d c = center;
     double r = rim_radius;
-    if (!fit_circle(pts[s], c, r)) return false;
+    if (!rim::fit_circle(pts[s], c, r)) return false;
     center = c;
     rim_radius = r;
   }
   return true;
 }
 
-std::optional<MirrorCircle> MirrorCenterDetector::estimate(const cv::Mat& gray,
-                                                           const CameraGeometry& geometry,
-                                                           std::string* why) const {
-  CV_Assert(gray.type() == CV_8UC1);
-  // Work on a copy no larger than 640 pixels across for the coarse search.
-  const double scale = std::min(1.0, 640.0 / std::max(gray.cols, gray.rows));
+namespace {
+
+std::optional<rim::RimFit> find_rim(const cv::Mat& gray,
+                                    const CameraGeometry& geometry,
+                                    const MirrorCenterOptions& options_,
+                                    const cv::Mat& usable,
+                                    std::string* why) {
+  // Candidate circles (centre, radius) on a copy no larger than 320 pixels across.
+  const double scale = std::min(1.0, 320.0 / std::max(gray.cols, gray.rows));
   cv::Mat small;
   if (scale < 1.0)
     cv::resize(gray, small, cv::Size(), scale, scale, cv::INTER_AREA);
   else
     small = gray;
-  cv::Mat gx, gy;
-  cv::Sobel(small, gx, CV_16S, 1, 0, 3);
-  cv::Sobel(small, gy, CV_16S, 0, 1, 3);
-  const double thr = options_.edge_threshold;
-
-  Eigen::Vector2d c;
-  if (geometry.center) {
-    c = *geometry.center * scale;
-  } else {
-    // Gradient lines of every circular edge around the mirror axis (rim, self-reflection,
-    // concentric floor/ceiling structure) pass through the centre: vote along them.
-    cv::Mat acc = cv::Mat::zeros(small.size(), CV_32F);
-    const int reach = std::max(small.cols, small.rows);
-    const double t2 = thr * thr;
-    for (int v = 1; v < small.rows - 1; v += 1) {
-      const short* px = gx.ptr<short>(v);
-      const short* py = gy.ptr<short>(v);
-      for (int u = 1; u < small.cols - 1; u += 1) {
-        const double g2 = double(px[u]) * px[u] + double(py[u]) * py[u];
-        if (g2 < t2) continue;
-        const double g = std::sqrt(g2);
-        const double ex = px[u] / g, ey = py[u] / g;
-        for (int sgn = -1; sgn <= 1; sgn += 2) {
-          for (int t = 8; t < reach; t += 1) {
-            const int x = static_cast<int>(u + sgn * t * ex + 0.5);
-            const int y = static_cast<int>(v + sgn * t * ey + 0.5);
-            if (x < 0 || y < 0 || x >= acc.cols || y >= acc.rows) break;
-            acc.at<float>(y, x) += 1.0f;
-          }
-        }
-      }
-    }
-    c = accumulator_peak(acc, 2.0);
-  }
-
-  // Rim: radii with a good coverage of darker-outward radial edges, best first; the first
-  // that fits to sub-pixel precision is the rim (a mirror holder can add rings that lie
-  // mostly outside the image).
-  const int rmax_search = static_cast<int>(std::hypot(small.cols, small.rows) / 2);
-  const auto outer = radial_edge_coverage(gx, gy, c, rmax_search, thr, -1);
-  std::vector<std::pair<double, int>> rims;  // (coverage, radius in the small image)
-  int r_lo = static_cast<int>(0.15 * std::min(small.cols, small.rows)), r_hi = rmax_search;
+  const cv::Mat small_usable = shrink_mask(usable, small.size());
+  const int diag = static_cast<int>(std::hypot(small.cols, small.rows) / 2);
+  // The rim is larger than the self-reflection: at least 30% of the image's smaller side.
+  int r_lo = static_cast<int>(0.3 * std::min(small.cols, small.rows)), r_hi = diag;
   if (geometry.r_max) {
     // Rim just outside the given r_max: look in the next 15%.
     r_lo = static_cast<int>(*geometry.r_max * scale);
-    r_hi = std::min(rmax_search, static_cast<int>(*geometry.r_max * scale * 1.15 + 3));
+    r_hi = std::min(diag, static_cast<int>(*geometry.r_max * scale * 1.15 + 3));
   }
-  for (int r = std::max(r_lo, 2); r < r_hi; ++r) {
-    if (outer[r] >= 0.3 && outer[r] >= outer[r - 1] && outer[r] > outer[r + 1])
-      rims.emplace_back(outer[r], r);
+  std::vector<rim::CircleCandidate> cands;
+  if (geometry.center) {
+    cv::Mat gx, gy;
+    cv::Sobel(small, gx, CV_16S, 1, 0, 3);
+    cv::Sobel(small, gy, CV_16S, 0, 1, 3);
+    const Eigen::Vector2d c = *geometry.center * scale;
+    const auto cov =
+        rim::radial_edge_coverage(gx, gy, c, diag, options_.edge_threshold, 0, small_usable);
+    for (int r = std::max(r_lo, 2); r < std::min(r_hi, diag); ++r)
+      if (cov[r] >= 0.3 && cov[r] >= cov[r - 1] && cov[r] > cov[r + 1])
+        cands.push_back({c, double(r), cov[r]});
+    std::sort(
+        cands.begin(), cands.end(), [](const auto& x, const auto& y) { return x.score > y.score; });
+    if (cands.size() > 8) cands.resize(8);
+  } else {
+    cands = rim::hough_circles(small, r_lo, r_hi, options_.edge_threshold, 10, 6.0, small_usable);
   }
-  std::sort(rims.rbegin(), rims.rend());
-  Eigen::Vector2d center = c / scale;
+  // Each candidate is refined on rays at full resolution; the rim is the candidate found
+  // within 1 px on the most rays, on at least 30% of its visible circumference, with enough
+  // arc to fix a centre (a mirror holder's ring cut by the frame loses to the rim inside it).
+  std::optional<rim::RimFit> best;
+  const int min_points = options_.rim_rays / 4;
+  for (const auto& cand : cands) {
+    rim::RimFit fit;
+    Eigen::Vector2d c = cand.center / scale;
+    double r = cand.radius / scale;
+    double window = std::max(options_.rim_window, 2.0 / scale + 2.0);
+    bool ok = true;
+    for (int pass = 0; pass < 3 && ok; ++pass) {
+      ok = rim::fit_rim_on_rays(gray, c, r, window, options_.rim_rays, fit, usable);
+      c = fit.center;
+      r = fit.radius;
+      window = options_.rim_window;
+    }
+    if (!ok || fit.inliers < min_points || fit.quadrants < 3 || fit.rms > 2.0) continue;
+    if (geometry.center && (fit.center - *geometry.center).norm() > options_.search_radius)
+      continue;
+    if (fit.coverage() >= 0.3 && (!best || fit.close > best->close)) best = fit;
+  }
+  if (!best) {
+    set_why(why,
+            "no mirror rim found (no circle of edges, darker or brighter outward, on enough of "
+            "its visible arc around a centre inside the image); give center, r_min and r_max "
+            "in cam0/sensor.yaml, or run `omnivert camera` on several frames to estimate them");
+    return std::nullopt;
+  }
+  return best;
+}
+
+}  // namespace
+
+std::optional<MirrorCircle> MirrorCenterDetector::estimate(const cv::Mat& gray,
+                                                           const CameraGeometry& geometry,
+                                                           std::string* why) const {
+  CV_Assert(gray.type() == CV_8UC1);
+  std::string reason;
+  const auto fit = find_rim(gray, geometry, options_, usable_, &reason);
+  Eigen::Vector2d center;
   double rim_radius = 0;
-  bool refined = false;
-  for (std::size_t i = 0; i < rims.size() && i < 6 && !refined; ++i) {
-    center = c / scale;
-    rim_radius = rims[i].second / scale;
-    refined = refine(gray, center, rim_radius);
+  if (fit) {
+    center = fit->center;
+    rim_radius = fit->radius;
+  } else if (geometry.center && geometry.r_max) {
+    center = *geometry.center;  // no rim: the centre stays where sensor.yaml puts it
+  } else {
+    set_why(why, reason);
+    return std::nullopt;
   }
-  if (!refined) {
-    if (!geometry.r_max) {
-      set_why(why,
-              rims.empty() ? "no mirror rim found (no circle of darker-outward edges around the "
-                             "centre); give center, r_min and r_max in sensor.yaml"
-                           : "the mirror rim was found but could not be fitted to sub-pixel "
-                             "precision; give center, r_min and r_max in sensor.yaml");
-      return std::nullopt;
-    }
-    if (!geometry.center) {
-      set_why(why, "the mirror rim could not be fitted; give center in sensor.yaml");
-      return std::nullopt;
-    }
-    center = *geometry.center;
-    rim_radius = 0;  // no rim: the centre stays where sensor.yaml puts it
-  }
-  if (geometry.center && !refined) center = *geometry.center;
-  const double rim = rim_radius * scale;
+  if (geometry.center) center = *geometry.center;
 
   MirrorCircle circle;
   circle.center = center;
@@ -314,20 +208,42 @@ std::optional<MirrorCircle> MirrorCenterDetector::estimate(const cv::Mat& gray,
   if (geometry.r_min) {
     circle.r_min = *geometry.r_min;
   } else {
-    // The camera's own reflection: a dark disc, so brighter-outward circular edges.
-    const auto inner = radial_edge_coverage(gx, gy, center * scale, rmax_search, thr, +1);
-    double best = 0;
-    int disc = 0;
-    for (int r = static_cast<int>(0.05 * rim); r <= static_cast<int>(0.5 * rim); ++r)
-      if (inner[r] > best) best = inner[r], disc = r;
-    circle.r_min =
-        best >= 0.3 ? (disc / scale) * (1.0 + options_.inner_margin_fraction) : 0.25 * circle.r_max;
+    circle.r_min = self_reflection_radius(gray, center, circle.r_max);
   }
   if (!(circle.r_min < circle.r_max)) {
     set_why(why, "estimated r_min is not below r_max; give r_min and r_max in sensor.yaml");
     return std::nullopt;
   }
   return circle;
+}
+
+double MirrorCenterDetector::self_reflection_radius(const cv::Mat& gray,
+                                                    const Eigen::Vector2d& center,
+                                                    double r_max) const {
+  const double scale = std::min(1.0, 640.0 / std::max(gray.cols, gray.rows));
+  cv::Mat small;
+  if (scale < 1.0)
+    cv::resize(gray, small, cv::Size(), scale, scale, cv::INTER_AREA);
+  else
+    small = gray;
+  cv::Mat gx, gy;
+  cv::Sobel(small, gx, CV_16S, 1, 0, 3);
+  cv::Sobel(small, gy, CV_16S, 0, 1, 3);
+  // The camera's own reflection: a dark disc, so brighter-outward circular edges.
+  const int rmax_search = static_cast<int>(std::hypot(small.cols, small.rows) / 2);
+  const auto inner = rim::radial_edge_coverage(gx,
+                                               gy,
+                                               center * scale,
+                                               rmax_search,
+                                               options_.edge_threshold,
+                                               +1,
+                                               shrink_mask(usable_, small.size()));
+  const double rim = r_max * scale;
+  double best = 0;
+  int disc = 0;
+  for (int r = static_cast<int>(0.05 * rim); r <= static_cast<int>(0.5 * rim); ++r)
+    if (r < static_cast<int>(inner.size()) && inner[r] > best) best = inner[r], disc = r;
+  return best >= 0.3 ? (disc / scale) * (1.0 + options_.inner_margin_fraction) : 0.25 * r_max;
 }
 
 std::optional<MirrorCircle> MirrorCenterDetector::detect(const cv::Mat& gray,
@@ -358,6 +274,7 @@ std::optional<MirrorCircle> MirrorCenterDetector::detect(const cv::Mat& gray,
     const short* px = gx.ptr<short>(v);
     const short* py = gy.ptr<short>(v);
     const double y = roi.y + v;
+    const uchar* ok = usable_.empty() ? nullptr : usable_.ptr<uchar>(roi.y + v) + roi.x;
     for (int u = 1; u < roi.width - 1; ++u) {
       const double x = roi.x + u;
       const double dx = x - prior.center.x(), dy = y - prior.center.y();
@@ -365,6 +282,7 @@ std::optional<MirrorCircle> MirrorCenterDetector::detect(const cv::Mat& gray,
       if (d2 < band_lo * band_lo || d2 > band_hi * band_hi) continue;
       const double g2 = double(px[u]) * px[u] + double(py[u]) * py[u];
       if (g2 < t2) continue;
+      if (ok && !ok[u]) continue;  // masked pixels cast no vote
       const double g = std::sqrt(g2);
       for (int sgn = -1; sgn <= 1; sgn += 2) {
         const double cx = x + sgn * R * px[u] / g - prior.center.x();
@@ -375,7 +293,7 @@ std::optional<MirrorCircle> MirrorCenterDetector::detect(const cv::Mat& gray,
       }
     }
   }
-  const Eigen::Vector2d peak = accumulator_peak(acc, 1.0);
+  const Eigen::Vector2d peak = rim::accumulator_peak(acc, 1.0);
   Eigen::Vector2d center = prior.center + peak - Eigen::Vector2d(A, A);
   double rim = R;
   if (!refine(gray, center, rim)) {

@@ -58,7 +58,9 @@ TrackDatasetResult tracks_of(const dataset::Dataset& data,
   if (given) return std::move(*given);
   TrackDatasetOptions to;
   to.pipeline = o.features;
+  to.mask = o.mask;
   to.tracker = o.tracker;
+  to.tilt = o.tilt;
   return track_dataset(data, to, [&](std::size_t done, std::size_t total) {
     if (o.progress) o.progress("track", done, total);
   });
@@ -82,7 +84,7 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
   lo.require_wheel = true;
   lo.allow_missing_images = true;
   const auto data = dataset::Dataset::load(dataset_dir, lo);
-  const calib::Options opt = calib::options_from_dataset(data, o.calibration);
+  const calib::CalibrationOptions opt = calib::options_from_dataset(data, o.calibration);
   if (!opt.IsValid(&why)) throw InputError("invalid calibration options: " + why);
 
   // Read before the output folder is cleared: the tracks file may be out_dir/tracks.csv.
@@ -93,10 +95,12 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
 
   CalibrateDatasetResult r;
   r.out_dir = out_dir;
-  r.noise_check_requested = o.run.noise_check;
+  r.noise_check_requested = o.calibration.noise_check.enabled;
   const auto t0 = Clock::now();
   const TrackDatasetResult tracked = tracks_of(data, o, std::move(given));
   r.warnings = tracked.warnings;
+  r.tilt = tracked.tilt;
+  r.tilt_corrected = tracked.tilt_corrected;
   write_tracks_csv(out / "tracks.csv", tracked.rows);
   write_tracks_png(out / "tracks.png", tracked.rows);
   const auto t1 = Clock::now();
@@ -112,7 +116,7 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
   r.warnings.insert(r.warnings.end(), o.notes.begin(), o.notes.end());
   for (const auto& w : r.warnings) spdlog::warn("{}", w);
   if (o.progress) o.progress("calibrate", 0, 0);
-  r.calibration = calib::calibrate(r.input.run, opt, o.run);
+  r.calibration = calib::calibrate(r.input.run, opt);
   const auto t2 = Clock::now();
   const calib::CalibrationResult& result = r.calibration;
   if (!result.extrinsics.vec().allFinite() || !result.covariance.allFinite())
@@ -144,7 +148,7 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
   ri.tracks_total = tracked.stats.new_tracks;
   ri.run = &r.input;
   ri.options = opt;
-  ri.options.bearing_sigma = result.bearing_sigma;
+  ri.options.noise.bearing_sigma = result.model.bearing_sigma;
   ri.truth = r.truth;
   ri.force = o.force;
   ri.exit_code = r.wrote_extrinsics ? 0 : 3;
@@ -218,8 +222,9 @@ std::string CalibrateDatasetResult::BriefReport() const {
               p(0) * 1e3,
               p(1) * 1e3,
               rad2deg(e.yaw()));
-  const std::string noise = calib::bearing_noise_text(c.bearing_sigma, c.track_bias_sigma);
-  if (c.noise_checked)
+  const std::string noise =
+      calib::bearing_noise_text(c.model.bearing_sigma, c.model.track_bias_sigma);
+  if (c.noise_check.checked)
     s += "bearing sigma " + noise + "; " + calib::noise_check_line(c) + "\n";
   else
     s += "bearing sigma " + noise + " (no noise check" +

@@ -231,10 +231,10 @@ DatasetRun calibration_run_from_tracks(const dataset::Dataset& data,
   return out;
 }
 
-Options options_from_dataset(const dataset::Dataset& data, Options base) {
+CalibrationOptions options_from_dataset(const dataset::Dataset& data, CalibrationOptions base) {
   if (data.has_wheel()) {
-    base.wheel_base = data.wheel_sensor().wheel_base;
-    if (data.wheel_sensor().odometry_k) base.odometry_K = *data.wheel_sensor().odometry_k;
+    base.robot.wheel_base = data.wheel_sensor().wheel_base;
+    if (data.wheel_sensor().odometry_k) base.robot.odometry_K = *data.wheel_sensor().odometry_k;
   }
   return base;
 }

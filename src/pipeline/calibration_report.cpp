@@ -131,37 +131,37 @@ nlohmann::json joins_json(const std::vector<std::pair<int, int>>& joins) {
 }
 
 std::string noise_check_line(const CalibrationResult& r) {
-  if (!r.noise_checked) return {};
-  const int g = r.noise.clusters;
+  if (!r.noise_check.checked) return {};
+  const int g = r.noise_check.check.clusters;
   char verdict[320] = "as the model allows: sigmas kept";
-  if (r.noise_verdict == NoiseVerdict::kMoreNoise)
+  if (r.noise_check.verdict == NoiseVerdict::kMoreNoise)
     std::snprintf(
         verdict,
         sizeof verdict,
         "more than the model allows (%s): sigmas scaled by %.2f",
-        noise_check_chance(noise_check_limit(g, r.noise_check_level), "more", r.noise_check_level)
+        noise_check_chance(noise_check_limit(g, r.noise_check.level), "more", r.noise_check.level)
             .c_str(),
-        std::sqrt(r.noise_ratio));
-  else if (r.noise_verdict == NoiseVerdict::kLessNoise && r.noise_applied)
+        std::sqrt(r.noise_check.ratio));
+  else if (r.noise_check.verdict == NoiseVerdict::kLessNoise && r.noise_check.applied)
     std::snprintf(verdict,
                   sizeof verdict,
                   "less than the model assumes (%s): sigmas scaled by %.2f; %s would weight the "
                   "bearings so from the start",
-                  noise_check_chance(noise_check_lower_limit(g, r.noise_check_lower_level),
+                  noise_check_chance(noise_check_lower_limit(g, r.noise_check.lower_level),
                                      "less",
-                                     r.noise_check_lower_level)
+                                     r.noise_check.lower_level)
                       .c_str(),
-                  std::sqrt(r.noise_ratio),
+                  std::sqrt(r.noise_check.ratio),
                   noise_check_flags(r).c_str());
-  else if (r.noise_verdict == NoiseVerdict::kLessNoise)
+  else if (r.noise_check.verdict == NoiseVerdict::kLessNoise)
     std::snprintf(verdict,
                   sizeof verdict,
                   "less than the model assumes (%s): sigmas kept, on the safe side, as %zu pieces "
                   "of lines were joined (pieces left apart hide noise from this check); %s would "
                   "weight the bearings as the data say",
-                  noise_check_chance(noise_check_lower_limit(g, r.noise_check_lower_level),
+                  noise_check_chance(noise_check_lower_limit(g, r.noise_check.lower_level),
                                      "less",
-                                     r.noise_check_lower_level)
+                                     r.noise_check.lower_level)
                       .c_str(),
                   r.refined && r.refinement.covariance_ok ? r.refinement.merges.size()
                                                           : r.filter.joins.size(),
@@ -172,10 +172,10 @@ std::string noise_check_line(const CalibrationResult& r) {
       sizeof(buf),
       "noise check over %d tracks: the errors along the tracks act as %s of "
       "%s (variance x%.2f; %s)",
-      r.noise.clusters,
+      r.noise_check.check.clusters,
       bearing_noise_text(effective_bearing_sigma(r), effective_track_bias_sigma(r)).c_str(),
-      r.track_bias_sigma > 0.0 ? "noise" : "independent noise",
-      r.noise.scale,
+      r.model.track_bias_sigma > 0.0 ? "noise" : "independent noise",
+      r.noise_check.check.scale,
       verdict);
   return buf;
 }
@@ -218,18 +218,18 @@ json inputs_json(const CalibrationResult& r, const ReportInputs& in) {
     inputs["frames_dropped_for_wheel_gaps"] = in.run->frames_dropped_for_gaps;
     inputs["frames_with_too_few_lines"] = in.run->starved_frames;
   }
-  inputs["wheel_base_m"] = num(in.options.wheel_base);
-  inputs["odometry_K_m"] = num(in.options.odometry_K);
-  inputs["odometry_inflation"] = num(in.options.odometry_inflation);
-  inputs["bearing_sigma_deg"] = num(rad2deg(r.bearing_sigma));
-  inputs["track_bias_sigma_deg"] = num(rad2deg(r.track_bias_sigma));
+  inputs["wheel_base_m"] = num(in.options.robot.wheel_base);
+  inputs["odometry_K_m"] = num(in.options.robot.odometry_K);
+  inputs["odometry_inflation"] = num(in.options.filter.odometry_inflation);
+  inputs["bearing_sigma_deg"] = num(rad2deg(r.model.bearing_sigma));
+  inputs["track_bias_sigma_deg"] = num(rad2deg(r.model.track_bias_sigma));
 
-  inputs["prior"] = {{"phi", num(in.options.prior.phi)},
-                     {"rho", num(in.options.prior.rho)},
-                     {"psi", num(in.options.prior.psi)},
-                     {"sigma_phi", num(in.options.prior_sigma(0))},
-                     {"sigma_rho", num(in.options.prior_sigma(1))},
-                     {"sigma_psi", num(in.options.prior_sigma(2))}};
+  inputs["prior"] = {{"phi", num(in.options.prior.mean.phi)},
+                     {"rho", num(in.options.prior.mean.rho)},
+                     {"psi", num(in.options.prior.mean.psi)},
+                     {"sigma_phi", num(in.options.prior.sigma(0))},
+                     {"sigma_rho", num(in.options.prior.sigma(1))},
+                     {"sigma_psi", num(in.options.prior.sigma(2))}};
   return inputs;
 }
 
@@ -258,7 +258,8 @@ json filter_json(const FilterResult& f) {
   j["window_solved"] = f.window_frames > 0 && f.window_failure.empty();
   if (!f.window_failure.empty()) j["window_failure"] = f.window_failure;
   j["splits"] = splits_json(f.splits);
-  // Bearings left out where lines cross (Options::crossing_guard), window and EKF.
+  // Bearings left out where lines cross (CalibrationOptions::association.crossing_guard), window
+  // and EKF.
   j["bearings_guarded"] = f.guarded.size();
   // Refused by the chi-square gate (outliers), window and EKF.
   j["bearings_rejected"] = f.rejected.size();
@@ -286,38 +287,41 @@ json refinement_json(const CalibrationResult& r) {
 }
 
 json noise_check_json(const CalibrationResult& r) {
-  const BatchNoiseCheck& n = r.noise;
+  const BatchNoiseCheck& n = r.noise_check.check;
   json nc;
-  nc["checked"] = r.noise_checked;
-  nc["applied"] = r.noise_applied;  // the reported covariance is the checked one
-  nc["verdict"] = verdict_name(r.noise_verdict);
-  // The levels of the verdict's sides (CalibrateOptions::noise_check_level, _lower_level).
-  nc["level_more_noise"] = r.noise_check_level;
-  nc["level_less_noise"] = r.noise_check_lower_level;
+  nc["checked"] = r.noise_check.checked;
+  nc["applied"] = r.noise_check.applied;  // the reported covariance is the checked one
+  nc["verdict"] = verdict_name(r.noise_check.verdict);
+  // The levels of the verdict's sides (CalibrationOptions::noise_check.level, lower_level).
+  nc["level_more_noise"] = r.noise_check.level;
+  nc["level_less_noise"] = r.noise_check.lower_level;
   nc["scale"] = num(n.ok ? n.scale : NAN);
   nc["tracks"] = n.clusters;
   nc["effective_bearing_sigma_deg"] = num(rad2deg(effective_bearing_sigma(r)));
   nc["effective_track_bias_sigma_deg"] = num(rad2deg(effective_track_bias_sigma(r)));
-  nc["variance_ratio"] = num(r.noise_checked ? r.noise_ratio : NAN);  // 1 when not applied
+  nc["variance_ratio"] =
+      num(r.noise_check.checked ? r.noise_check.ratio : NAN);  // 1 when not applied
   nc["of"] = r.refined && r.refinement.covariance_ok ? "refinement" : "filter";
-  nc["filter_scale"] = num(r.filter_noise.ok ? r.filter_noise.scale : NAN);
-  nc["filter_variance_ratio"] = num(r.filter_noise.ok ? r.filter_noise_ratio : NAN);
-  nc["filter_applied"] = r.filter_noise_applied;
-  nc["filter_verdict"] = verdict_name(r.filter_noise_verdict);
+  nc["filter_scale"] = num(r.noise_check.filter_check.ok ? r.noise_check.filter_check.scale : NAN);
+  nc["filter_variance_ratio"] =
+      num(r.noise_check.filter_check.ok ? r.noise_check.filter_ratio : NAN);
+  nc["filter_applied"] = r.noise_check.filter_applied;
+  nc["filter_verdict"] = verdict_name(r.noise_check.filter_verdict);
   auto mat = [&](const Eigen::Matrix3d& m, bool ok) {
     json a = json::array();
     for (int i = 0; i < 9; ++i) a.push_back(num(ok && m.allFinite() ? m(i / 3, i % 3) : NAN));
     return a;
   };
-  nc["filter_model_covariance"] = mat(r.filter_model_covariance, true);
-  nc["refinement_model_covariance"] = mat(r.refinement_model_covariance, r.refined);
+  nc["filter_model_covariance"] = mat(r.noise_check.filter_model_covariance, true);
+  nc["refinement_model_covariance"] = mat(r.noise_check.refinement_model_covariance, r.refined);
   nc["batch_model_covariance"] = mat(n.model_covariance, n.ok);
   nc["batch_checked_covariance"] = mat(n.covariance, n.ok);
   // The Cramer-Rao bounds at the noise the check found: each bound times the square root of
   // the checked over the model variance of that parameter.
   auto checked = [&](double crlb, int i) {
-    return num(r.noise_checked ? crlb * std::sqrt(n.covariance(i, i) / n.model_covariance(i, i))
-                               : NAN);
+    return num(r.noise_check.checked
+                   ? crlb * std::sqrt(n.covariance(i, i) / n.model_covariance(i, i))
+                   : NAN);
   };
   {
     const WheelCheck& w = wheel_check_of(r);
@@ -390,7 +394,7 @@ void html_estimates(std::ostringstream& h, const CalibrationResult& r, const Rep
     h << "</td><td>" << f("%.2f", p(0) * 1e3) << "</td><td>" << f("%.2f", p(1) * 1e3) << "</td><td>"
       << f("%.3f", rad2deg(e.yaw())) << "</td></tr>\n";
   };
-  row("prior (hand measurement)", in.options.prior, nullptr);
+  row("prior (hand measurement)", in.options.prior.mean, nullptr);
   row("filter (Sec. 8.2)", r.filter.extrinsics, &r.filter.covariance);
   if (r.refined && r.refinement.covariance_ok)
     row("batch refinement (--refine)", r.refinement.extrinsics, &r.refinement.covariance);
@@ -442,10 +446,10 @@ void html_inputs(std::ostringstream& h, const CalibrationResult& r, const Report
     kv("frames dropped for wheel gaps", std::to_string(in.run->frames_dropped_for_gaps));
   }
   kv("wheel base e / Chong-Kleeman K (x inflation)",
-     f("%.4f m", in.options.wheel_base) + " / " + f("%.3g m", in.options.odometry_K) + " (x" +
-         f("%g", in.options.odometry_inflation) + ")");
-  kv("bearing sigma", bearing_noise_text(r.bearing_sigma, r.track_bias_sigma));
-  kv("noise check", r.noise_checked ? noise_check_line(r) : std::string("not made"));
+     f("%.4f m", in.options.robot.wheel_base) + " / " + f("%.3g m", in.options.robot.odometry_K) +
+         " (x" + f("%g", in.options.filter.odometry_inflation) + ")");
+  kv("bearing sigma", bearing_noise_text(r.model.bearing_sigma, r.model.track_bias_sigma));
+  kv("noise check", r.noise_check.checked ? noise_check_line(r) : std::string("not made"));
   {
     const std::string w = wheel_check_line(r);
     kv("wheel check", w.empty() ? std::string("not made") : w);

@@ -23,8 +23,20 @@ TrackDatasetResult track_dataset(const dataset::Dataset& data,
     }
   }
   Tracker tracker(to);
-  FeaturePipeline pipe(data.camera(), options.pipeline);
+  CameraGeometry camera = data.camera();
+  if (!options.mask.empty()) camera.mask = options.mask;
   TrackDatasetResult out;
+  FeaturePipelineOptions po = options.pipeline;
+  if (options.tilt.enabled && po.tilt.isZero()) {
+    out.tilt = measure_tilt(data, po, options.tilt);
+    if (out.tilt.valid && out.tilt.tilt_deg() > options.tilt.correct_deg) {
+      po.tilt = out.tilt.vector;
+      out.tilt_corrected = true;
+    }
+    const std::string w = tilt_warning(out.tilt, options.tilt, out.tilt_corrected);
+    if (!w.empty()) out.warnings.push_back(w);
+  }
+  FeaturePipeline pipe(camera, po);
   std::vector<TrackAssignment> assignments;
   FrameFeatures f;
   const auto& travel = data.travel_at_images();

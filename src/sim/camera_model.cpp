@@ -44,6 +44,8 @@ CameraGeometry CatadioptricCamera::geometry() const {
   g.r_min = r_min;
   g.r_max = r_max;
   g.bearing_sign = bearing_sign;
+  g.xi = xi;
+  g.gamma = gamma;
   return g;
 }
 
@@ -53,6 +55,8 @@ std::string CatadioptricCamera::validate() const {
   if (!(gamma > 0.0)) return "gamma must be positive";
   if (!(r_min > 0.0 && r_min < r_max)) return "need 0 < r_min < r_max";
   if (bearing_sign != 1 && bearing_sign != -1) return "bearing_sign must be 1 or -1";
+  if (!(tilt_deg >= 0.0 && tilt_deg <= 10.0)) return "tilt_deg must lie in [0, 10]";
+  if (!std::isfinite(tilt_direction_deg)) return "tilt_direction_deg must be a number";
   const double rim = r_max + 6.0;
   if (cx - rim < 0 || cy - rim < 0 || cx + rim > width || cy + rim > height) {
     return "the mirror rim (r_max + 6 px around the centre) must lie inside the image";

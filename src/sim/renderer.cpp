@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "omnivert/core/angles.hpp"
+#include "sim/tilt_warp.hpp"
 
 namespace omnivert::sim {
 
@@ -125,6 +126,9 @@ Renderer::Renderer(const CatadioptricCamera& camera, const World& world)
       px_weight_.push_back(static_cast<float>(weight));
     }
   }
+  if (camera_.tilt_deg != 0.0) {
+    tilt_ = std::make_shared<const TiltWarp>(camera_, world_, px_index_, px_weight_);
+  }
 }
 
 cv::Mat1f Renderer::render(const CameraPose& pose) const {
@@ -155,6 +159,10 @@ void Renderer::setup_walls(const CameraPose& pose, FrameState& f) const {
 }
 
 void Renderer::render(const CameraPose& pose, cv::Mat1f& image) const {
+  if (tilt_) {
+    tilt_->render(pose, background_, image);
+    return;
+  }
   FrameState f;
   setup_walls(pose, f);
   const std::size_t nw = world_.walls.size();

@@ -158,7 +158,10 @@ void write_wheel_sensor(const fs::path& path, const WheelConfig& wc) {
 }
 
 // cam0/sensor.yaml.
-void write_camera_sensor(const fs::path& path, const CatadioptricCamera& c, double frame_rate) {
+void write_camera_sensor(const fs::path& path,
+                         const CatadioptricCamera& c,
+                         double frame_rate,
+                         bool with_mask) {
   std::string y = "# omnivert simulator: catadioptric camera, unified sphere model with the\n";
   y += "# mirror axis vertical: r = gamma cos(el) / (xi - sin(el)) (docs/simulator.md)\n";
   y += "model: unified\n";
@@ -171,7 +174,13 @@ void write_camera_sensor(const fs::path& path, const CatadioptricCamera& c, doub
        "   # dark beyond: the mirror's outer boundary\n";
   y += "xi: " + fmt("%.9g", c.xi) + "\n";
   y += "gamma: " + fmt("%.9g", c.gamma) + "\n";
+  if (c.tilt_deg != 0.0) {
+    y += "tilt_deg: " + fmt("%.9g", c.tilt_deg) + "   # true tilt of the mirror axis\n";
+    y += "tilt_direction_deg: " + fmt("%.9g", c.tilt_direction_deg) +
+         "   # camera bearing the axis leans towards (docs/theory/tilt.md)\n";
+  }
   y += "rate_hz: " + fmt("%.9g", frame_rate) + "\n";
+  if (with_mask) y += "mask: mask.png   # the struts and the robot's reflection: 0\n";
   write_text(path, y);
 }
 
@@ -228,6 +237,28 @@ void write_simulation_settings(const fs::path& path,
   y += "exposure: " + fmt("%.9g", s.exposure) + "\n";
   y += "blur_sigma: " + fmt("%.9g", s.blur_sigma) + "\n";
   y += "min_line_px: " + fmt("%.9g", cfg.min_line_px) + "\n";
+  const RobotOverlay& o = cfg.overlay;
+  if (!o.strut_angles_deg.empty()) {
+    y += "struts_deg: [";
+    for (std::size_t i = 0; i < o.strut_angles_deg.size(); ++i)
+      y += (i ? ", " : "") + fmt("%.9g", o.strut_angles_deg[i]);
+    y += "]\n";
+    y += "strut_width_px: " + fmt("%.9g", o.strut_width_px) + "\n";
+    y += "strut_inner_px: " + fmt("%.9g", o.strut_inner_px) + "\n";
+    y += "strut_grey: " + fmt("%.9g", o.strut_grey) + "\n";
+  }
+  if (o.reflection_width_deg > 0) {
+    y += "reflection: [" + fmt("%.9g", o.reflection_angle_deg) + ", " +
+         fmt("%.9g", o.reflection_width_deg) + "]\n";
+    y += "reflection_radii_px: [" + fmt("%.9g", o.reflection_r_inner_px) + ", " +
+         fmt("%.9g", o.reflection_r_outer_px) + "]\n";
+    y += "reflection_grey: " + fmt("%.9g", o.reflection_grey) + "\n";
+  }
+  if (o.write_mask) y += "mask_margin_px: " + fmt("%.9g", o.mask_margin_px) + "\n";
+  if (cfg.camera.tilt_deg != 0.0) {
+    y += "tilt_deg: " + fmt("%.9g", cfg.camera.tilt_deg) + "\n";
+    y += "tilt_direction_deg: " + fmt("%.9g", cfg.camera.tilt_direction_deg) + "\n";
+  }
   write_text(path, y);
 }
 
@@ -255,6 +286,10 @@ void write_frames(const fs::path& dir,
   cv::Mat1b img;
   const std::vector<int> png_params = {cv::IMWRITE_PNG_COMPRESSION, 3};
   long total_lines = 0;
+  // Struts and reflection: static in the image, painted before the image sensor.
+  const bool overlay = !cfg.overlay.empty();
+  const OverlayPicture picture =
+      overlay ? overlay_picture(cfg.overlay, cfg.camera) : OverlayPicture{};
   Pose2 prev = pose_at(motion, times.time(0));
   for (int k = 0; k < n_frames; ++k) {
     const double t = times.time(k);
@@ -264,6 +299,7 @@ void write_frames(const fs::path& dir,
     prev = robot;
     const CameraPose cam = camera_pose(robot, cfg.extrinsics, cfg.camera_height);
     renderer.render(cam, clean);
+    if (overlay) paint_overlay(picture, clean);
     apply_image_sensor(clean, cfg.image, image_rng, img);
     const std::string name = std::to_string(ts) + ".png";
     if (!cv::imwrite((dir / "cam0" / "data" / name).string(), img, png_params)) {
@@ -336,7 +372,15 @@ void write_dataset(const World& world,
   write_wheel_data(dir / "wheel0" / "data.csv", wheels, cfg.wheel, cfg.start_ns);
   summary.wheel_samples = static_cast<int>(wheels.t.size());
   write_wheel_sensor(dir / "wheel0" / "sensor.yaml", cfg.wheel);
-  write_camera_sensor(dir / "cam0" / "sensor.yaml", cfg.camera, cfg.frame_rate);
+  write_camera_sensor(
+      dir / "cam0" / "sensor.yaml", cfg.camera, cfg.frame_rate, cfg.overlay.write_mask);
+  if (cfg.overlay.write_mask) {
+    const cv::Mat mask =
+        overlay_mask(overlay_picture(cfg.overlay, cfg.camera), cfg.overlay.mask_margin_px);
+    if (!cv::imwrite((dir / "cam0" / "mask.png").string(), mask)) {
+      throw std::runtime_error("cannot write " + (dir / "cam0" / "mask.png").string());
+    }
+  }
   write_extrinsics(dir / "ground_truth" / "extrinsics.yaml", cfg.extrinsics, cfg.camera_height);
   save_world(world, (dir / "ground_truth" / "world.yaml").string());
 
@@ -365,6 +409,7 @@ SimSummary simulate(const World& world,
     throw InputError("trajectory '" + trajectory.name + "': " + p);
   }
   if (!(cfg.frame_rate > 0) || !(cfg.wheel.rate_hz > 0)) throw InputError("rates must be positive");
+  if (std::string why; !cfg.overlay.IsValid(&why)) throw InputError("overlay: " + why);
   if (cfg.wheel.odometry_k < 0) throw InputError("odometry_k must not be negative");
   if (!(cfg.wheel.wheel_base > 0) || !(cfg.wheel.true_wheel_base() > 0)) {
     throw InputError("the wheel base must be positive");

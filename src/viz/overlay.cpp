@@ -97,4 +97,62 @@ cv::Mat draw_overlay(const cv::Mat& image,
   return bgr;
 }
 
+cv::Mat draw_camera_overlay(const cv::Mat& image, const CameraEstimate& e) {
+  cv::Mat gray, bgr;
+  FeaturePipeline::to_gray8(image, gray);
+  cv::cvtColor(gray, bgr, cv::COLOR_GRAY2BGR);
+  const auto& c = e.circle;
+  if (!e.mask.empty() && e.mask.size() == bgr.size()) {
+    cv::Mat annulus = cv::Mat::zeros(bgr.size(), CV_8U);
+    const cv::Point ci(static_cast<int>(std::lround(c.center.x())),
+                       static_cast<int>(std::lround(c.center.y())));
+    cv::circle(annulus, ci, static_cast<int>(c.r_max), 255, cv::FILLED);
+    cv::circle(annulus, ci, static_cast<int>(c.r_min), 0, cv::FILLED);
+    cv::Mat tinted;
+    cv::addWeighted(bgr, 0.5, cv::Mat(bgr.size(), CV_8UC3, cv::Scalar(0, 0, 255)), 0.5, 0, tinted);
+    tinted.copyTo(bgr, annulus & (e.mask == 0));
+  }
+  const int thick =
+      static_cast<int>(std::lround(std::max(1.0, std::max(bgr.cols, bgr.rows) / 800.0)));
+  const int shift = 4;
+  auto P = [](const Eigen::Vector2d& p) {
+    return cv::Point(static_cast<int>(std::lround(p.x() * 16)),
+                     static_cast<int>(std::lround(p.y() * 16)));
+  };
+  auto ring = [&](double r, const cv::Scalar& col) {
+    if (r > 0)
+      cv::circle(bgr, P(c.center), static_cast<int>(r * 16), col, thick, cv::LINE_AA, shift);
+  };
+  ring(c.r_min, {255, 160, 0});
+  ring(c.r_max, {255, 160, 0});
+  ring(c.rim_radius, {0, 220, 255});
+  for (const auto& f : e.frames) {
+    if (!f.found) continue;
+    const Eigen::Vector2d p = c.center + 10.0 * (f.circle.center - c.center);
+    cv::circle(bgr,
+               P(p),
+               3 * 16 * thick,
+               f.inlier ? cv::Scalar(0, 200, 0) : cv::Scalar(255, 0, 255),
+               cv::FILLED,
+               cv::LINE_AA,
+               shift);
+  }
+  const double m = 10.0 * thick;
+  cv::line(bgr,
+           P(c.center - Eigen::Vector2d(m, 0)),
+           P(c.center + Eigen::Vector2d(m, 0)),
+           {0, 0, 255},
+           thick,
+           cv::LINE_AA,
+           shift);
+  cv::line(bgr,
+           P(c.center - Eigen::Vector2d(0, m)),
+           P(c.center + Eigen::Vector2d(0, m)),
+           {0, 0, 255},
+           thick,
+           cv::LINE_AA,
+           shift);
+  return bgr;
+}
+
 }  // namespace omnivert

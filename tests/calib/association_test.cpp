@@ -1,9 +1,9 @@
 // Which bearings belong together in the batch refinement (association.hpp): a track that
 // slipped onto a neighbouring line (the office's door leaf 6 cm inside its frame,
 // docs/theory/association.md#slipped-tracks) is split in two, which removes the bias it puts on the
-// extrinsics, and clean tracks are left whole (BatchOptions::split_chi2); bearings where lines
-// cross are left out (Options::crossing_guard); pieces of one line are joined, and only with their
-// own line.
+// extrinsics, and clean tracks are left whole (CalibrationOptions::association.split_chi2);
+// bearings where lines cross are left out (CalibrationOptions::association.crossing_guard); pieces
+// of one line are joined, and only with their own line.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -29,6 +29,7 @@ namespace {
 
 using test_support::nees;
 using test_support::options_for;
+using test_support::refined;
 using test_support::slip;
 using test_support::truth_point;
 
@@ -45,11 +46,11 @@ TEST(TrackSplitting, SlippedTracksAreSplitAndTheirBiasRemoved) {
   // The splitting alone: the crossing guard leaves out other bearings of this run and moves
   // its NEES by chance (the clean run's: 5.3 without the guard, 6.8 with it). Over seeds
   // 7-46 it changes nothing on average (docs/theory/association.md#lines-that-cross).
-  Options o = options_for(so);
-  o.crossing_guard = 0.0;
-  BatchOptions off;
-  off.split_chi2 = 0.0;
-  const RefinementResult whole = refine_batch(run.run, o, truth_point(run), off);
+  CalibrationOptions o = options_for(so);
+  o.association.crossing_guard = 0.0;
+  CalibrationOptions off = o;
+  off.association.split_chi2 = 0.0;
+  const RefinementResult whole = refine_batch(run.run, off, truth_point(run));
   const RefinementResult split = refine_batch(run.run, o, truth_point(run));
   ASSERT_TRUE(whole.covariance_ok);
   ASSERT_TRUE(split.covariance_ok);
@@ -92,9 +93,9 @@ TEST(TrackSplitting, CleanTracksAreLeftWhole) {
     const RefinementResult r = refine_batch(run.run, options_for(so), truth_point(run));
     splits += r.num_splits;
     if (r.num_splits == 0) {
-      BatchOptions off;
-      off.split_chi2 = 0.0;
-      const RefinementResult w = refine_batch(run.run, options_for(so), truth_point(run), off);
+      CalibrationOptions off = options_for(so);
+      off.association.split_chi2 = 0.0;
+      const RefinementResult w = refine_batch(run.run, off, truth_point(run));
       EXPECT_DOUBLE_EQ(w.extrinsics.phi, r.extrinsics.phi);
       EXPECT_DOUBLE_EQ(w.extrinsics.rho, r.extrinsics.rho);
     }
@@ -150,13 +151,13 @@ SyntheticRunOptions crossing_options(int s) {
 }
 
 SyntheticRun with_crossings(const SyntheticRun& clean) {
-  return merge_crossings(clean, deg2rad(0.4), Options{}.crossing_guard, 0.2);
+  return merge_crossings(clean, deg2rad(0.4), AssociationOptions{}.crossing_guard, 0.2);
 }
 
-// The crossing guard (Options::crossing_guard) leaves out exactly the bearings where another
-// feature is within the guard, and with it merged detections no longer move the estimate:
-// the run with merged detections gives the clean run's estimate; without the guard it does
-// not.
+// The crossing guard (CalibrationOptions::association.crossing_guard) leaves out exactly the
+// bearings where another feature is within the guard, and with it merged detections no longer move
+// the estimate: the run with merged detections gives the clean run's estimate; without the guard it
+// does not.
 TEST(CrossingGuard, MergedDetectionsAreLeftOutAndDoNotMoveTheEstimate) {
   const int runs = 10;
   double moved_on = 0.0, moved_off = 0.0;  // mean squared Mahalanobis shift from the clean run
@@ -168,10 +169,10 @@ TEST(CrossingGuard, MergedDetectionsAreLeftOutAndDoNotMoveTheEstimate) {
     const SyntheticRunOptions so = crossing_options(s);
     const SyntheticRun clean = make_synthetic_run(so);
     const SyntheticRun run = with_crossings(clean);
-    Options o = options_for(so);
+    CalibrationOptions o = options_for(so);
     const RefinementResult on = refine_batch(run.run, o, truth_point(run));
     const RefinementResult on_clean = refine_batch(clean.run, o, truth_point(clean));
-    o.crossing_guard = 0.0;
+    o.association.crossing_guard = 0.0;
     const RefinementResult off = refine_batch(run.run, o, truth_point(run));
     const RefinementResult off_clean = refine_batch(clean.run, o, truth_point(clean));
     ASSERT_TRUE(on.covariance_ok && off.covariance_ok && on_clean.covariance_ok &&
@@ -191,12 +192,12 @@ TEST(CrossingGuard, MergedDetectionsAreLeftOutAndDoNotMoveTheEstimate) {
         auto [it, fresh] = span.emplace(ob.track_id, std::make_pair(int(k), int(k)));
         it->second.second = static_cast<int>(k);
       }
-    const double guard = Options{}.crossing_guard, tol = deg2rad(0.2);
+    const double guard = AssociationOptions{}.crossing_guard, tol = deg2rad(0.2);
     const std::set<std::pair<int, int>> left_out(on.guarded.begin(), on.guarded.end());
     int wrong = 0;
     for (std::size_t k = 0; k < run.run.frames.size(); ++k)
       for (const BearingObservation& ob : run.run.frames[k].observations) {
-        const int kk = static_cast<int>(k), m = o.max_missed_frames;
+        const int kk = static_cast<int>(k), m = o.association.max_missed_frames;
         const double mine = bearing_from_geometry(
             run.true_poses[k], run.features[run.track_feature.at(ob.track_id)], run.truth);
         double nearest = kPi;
@@ -238,9 +239,9 @@ TEST(CrossingGuard, TheFilterLeavesOutMergedDetections) {
     const SyntheticRunOptions so = crossing_options(s);
     const SyntheticRun clean = make_synthetic_run(so);
     const SyntheticRun run = with_crossings(clean);
-    Options o = options_for(so);
+    CalibrationOptions o = options_for(so);
     const FilterResult on = run_filter(run.run, o), on_clean = run_filter(clean.run, o);
-    o.crossing_guard = 0.0;
+    o.association.crossing_guard = 0.0;
     const FilterResult off = run_filter(run.run, o), off_clean = run_filter(clean.run, o);
     ASSERT_TRUE(on.window_failure.empty() && off.window_failure.empty());
     moved_on += shift(on, on_clean) / runs;
@@ -285,12 +286,12 @@ TEST(CrossingGuard, BeforeATrackStartsBesideAnother) {
     if (k >= 20) obs.push_back({2, a + deg2rad(0.3) + rate * (k - 20)});
     if (k >= 25) obs.push_back({3, a + deg2rad(10.0)});
   }
-  Options o;
-  ASSERT_NEAR(o.crossing_guard, deg2rad(0.75), 1e-12);
+  CalibrationOptions o;
+  ASSERT_NEAR(o.association.crossing_guard, deg2rad(0.75), 1e-12);
   std::map<std::pair<int, int>, int> expected;  // (track, frame) -> where the other starts
   for (int k = 10; k <= 19; ++k) expected[{1, k}] = 20;
   EXPECT_EQ(guard_before_starts(run, o), expected);
-  o.crossing_guard = 0.0;  // the guard off: nothing
+  o.association.crossing_guard = 0.0;  // the guard off: nothing
   EXPECT_TRUE(guard_before_starts(run, o).empty());
 }
 
@@ -308,7 +309,7 @@ TEST(CrossingGuard, PiecesOfOneLineDoNotGuardEachOther) {
     const SyntheticRun run = make_synthetic_run(so);
     int bearings = 0;
     for (const FrameInput& f : run.run.frames) bearings += static_cast<int>(f.observations.size());
-    const CalibrationResult r = calibrate(run.run, options_for(so), {.refine = true});
+    const CalibrationResult r = calibrate(run.run, refined(options_for(so)));
     ASSERT_TRUE(r.observability.all_determined())
         << "seed " << s << ": " << r.observability.message;
     // Measured (seeds 1-8): at most 0.017 rad and 5.2 mm off, against bounds of 4-13 mrad
@@ -332,16 +333,16 @@ TEST(PiecesOfOneLine, AreJoinedOnlyWithTheirOwnLine) {
     so.bearing_sigma = deg2rad(0.03);
     so.break_probability = 0.1;
     const SyntheticRun run = make_synthetic_run(so);
-    const Options o = options_for(so);
-    CalibrateOptions on{.refine = true}, off{.refine = true};
-    off.batch.merge_pieces = false;
-    const RefinementResult r = calibrate(run.run, o, on).refinement;
-    const RefinementResult apart = calibrate(run.run, o, off).refinement;
+    const CalibrationOptions on = refined(options_for(so));
+    CalibrationOptions off = on;
+    off.association.join_pieces = false;
+    const RefinementResult r = calibrate(run.run, on).refinement;
+    const RefinementResult apart = calibrate(run.run, off).refinement;
     // The same run with each line under one id.
     CalibrationRun whole_run = run.run;
     for (FrameInput& f : whole_run.frames)
       for (BearingObservation& b : f.observations) b.track_id = run.track_feature.at(b.track_id);
-    const RefinementResult whole = calibrate(whole_run, o, off).refinement;
+    const RefinementResult whole = calibrate(whole_run, off).refinement;
     ASSERT_TRUE(r.covariance_ok && apart.covariance_ok && whole.covariance_ok) << "seed " << s;
     int wrong = 0;
     for (const auto& [a, c] : r.merges) wrong += run.track_feature.at(a) != run.track_feature.at(c);

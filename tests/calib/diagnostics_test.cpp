@@ -24,6 +24,7 @@ namespace omnivert::calib {
 namespace {
 
 using test_support::options_for;
+using test_support::refined;
 using test_support::truth_point;
 
 // result_warnings: a filter that refused many bearings, and a refinement outside the filter's
@@ -71,18 +72,19 @@ NoiseCheckStats noise_check_monte_carlo(double true_sigma_deg,
                                         double correlation,
                                         int runs,
                                         double gate_probability = 0.999,
-                                        const BatchOptions& batch = {}) {
+                                        double split_chi2 = AssociationOptions{}.split_chi2) {
   SyntheticRunOptions so;
   so.bearing_sigma = deg2rad(true_sigma_deg);
   so.bearing_correlation = correlation;
-  Options o = options_for(so);
-  o.bearing_sigma = deg2rad(0.05);  // what the model assumes
-  o.gate_probability = gate_probability;
+  CalibrationOptions o = options_for(so);
+  o.noise.bearing_sigma = deg2rad(0.05);  // what the model assumes
+  o.association.gate_probability = gate_probability;
+  o.association.split_chi2 = split_chi2;
   NoiseCheckStats s;
   for (int k = 0; k < runs; ++k) {
     so.seed = 300 + k;
     const SyntheticRun run = make_synthetic_run(so);
-    const RefinementResult r = refine_batch(run.run, o, truth_point(run), batch);
+    const RefinementResult r = refine_batch(run.run, o, truth_point(run));
     if (!r.noise.ok) continue;
     ++s.runs;
     s.scale += r.noise.scale;
@@ -109,8 +111,8 @@ TEST(WheelCheck, FindsAWrongWheelBaseAndNothingWhereTheModelIsRight) {
     so.bearing_sigma = deg2rad(0.03);
     so.seed = seed;
     const SyntheticRun run = make_synthetic_run(so);
-    Options o = options_for(so);
-    o.bearing_sigma = so.bearing_sigma;
+    CalibrationOptions o = options_for(so);
+    o.noise.bearing_sigma = so.bearing_sigma;
     const RefinementResult r = refine_batch(run.run, o, truth_point(run));
     ASSERT_TRUE(r.noise.wheels.ok) << seed;
     chi2 += r.noise.wheels.chi2;
@@ -118,8 +120,8 @@ TEST(WheelCheck, FindsAWrongWheelBaseAndNothingWhereTheModelIsRight) {
     flagged += wheel_check_rejects_model(r.noise.wheels);
     ++runs;
     if (seed > 5) continue;
-    Options wrong = o;
-    wrong.wheel_base = so.wheel_base / 1.02;
+    CalibrationOptions wrong = o;
+    wrong.robot.wheel_base = so.wheel_base / 1.02;
     const RefinementResult w = refine_batch(run.run, wrong, truth_point(run));
     ASSERT_TRUE(w.noise.wheels.ok);
     EXPECT_TRUE(wheel_check_rejects_model(w.noise.wheels))
@@ -187,7 +189,7 @@ TEST(NoiseCheck, AgreesWithTheModelWhenTheModelIsRight) {
     EXPECT_NEAR(r.noise.model_covariance(i, i), r.covariance(i, i), 1e-3 * r.covariance(i, i));
 }
 
-// With a constant bearing error per line in the data and in the model (Options::
+// With a constant bearing error per line in the data and in the model (CalibrationOptions::
 // track_bias_sigma), the check counts each line's bias prior as a row of that line's cluster:
 // the scale stays near 1 (without that row the bias was free and the scale read 656 on a run
 // from pixels), and the dense and sparse leverages agree.
@@ -195,11 +197,11 @@ TEST(NoiseCheck, AgreesWithTheModelWithPerLineBias) {
   SyntheticRunOptions so;
   so.bearing_sigma = deg2rad(0.03);
   so.track_bias_sigma = deg2rad(0.03);
-  Options o = options_for(so);
-  o.bearing_sigma = so.bearing_sigma;
-  o.track_bias_sigma = so.track_bias_sigma;
-  BatchOptions sparse;
-  sparse.noise_check_dense_limit = 0;
+  CalibrationOptions o = options_for(so);
+  o.noise.bearing_sigma = so.bearing_sigma;
+  o.noise.track_bias_sigma = so.track_bias_sigma;
+  CalibrationOptions sparse = o;
+  sparse.noise_check.dense_limit = 0;
   double scale = 0.0;
   const int runs = 20;
   for (int k = 0; k < runs; ++k) {
@@ -209,7 +211,7 @@ TEST(NoiseCheck, AgreesWithTheModelWithPerLineBias) {
     ASSERT_TRUE(r.noise.ok) << so.seed;
     scale += r.noise.scale;
     if (k < 3) {
-      const RefinementResult s = refine_batch(run.run, o, truth_point(run), sparse);
+      const RefinementResult s = refine_batch(run.run, sparse, truth_point(run));
       ASSERT_TRUE(s.noise.ok);
       EXPECT_NEAR(r.noise.scale, s.noise.scale, 1e-6 * r.noise.scale);
     }
@@ -252,10 +254,10 @@ TEST(NoiseCheck, DenseAndSparseLeverageAgree) {
   so.bearing_correlation = 0.5;
   so.seed = 9;
   const SyntheticRun run = make_synthetic_run(so);
-  BatchOptions sparse;
-  sparse.noise_check_dense_limit = 0;
+  CalibrationOptions sparse = options_for(so);
+  sparse.noise_check.dense_limit = 0;
   const RefinementResult d = refine_batch(run.run, options_for(so), truth_point(run));
-  const RefinementResult s = refine_batch(run.run, options_for(so), truth_point(run), sparse);
+  const RefinementResult s = refine_batch(run.run, sparse, truth_point(run));
   ASSERT_TRUE(d.noise.ok);
   ASSERT_TRUE(s.noise.ok);
   EXPECT_EQ(d.noise.clusters, s.noise.clusters);
@@ -270,10 +272,8 @@ TEST(NoiseCheck, DenseAndSparseLeverageAgree) {
 // default gate (3.3 sigmas) a tenth of these bearings would be cut off and the rest would
 // look less noisy than they are (scale 2.0), and splitting would cut clean tracks (10 per run).
 TEST(NoiseCheck, FindsBearingsNoisierThanAssumed) {
-  BatchOptions no_splits;
-  no_splits.split_chi2 = 0.0;
   const NoiseCheckStats s =
-      noise_check_monte_carlo(0.10, 0.0, 20, /*gate_probability=*/1.0, no_splits);
+      noise_check_monte_carlo(0.10, 0.0, 20, /*gate_probability=*/1.0, /*split_chi2=*/0.0);
   ASSERT_EQ(s.runs, 20);
   EXPECT_GT(s.scale, 3.0);
   EXPECT_LT(s.scale, 5.3);
@@ -308,13 +308,13 @@ TEST(NoiseCheck, FindsErrorsCorrelatedAlongTracks) {
 // whole (no pieces joined), shrinks the bearings' share of the covariances. The camera's yaw
 // phi + psi, which the bearings determine, then has about the right sigma (mean z^2 near 1
 // instead of 0.21 under the model's). With the same bearings cut into pieces every ~10
-// frames (CalibrateOptions::noise_check_lower_max_joins), the verdict is reported and the
+// frames (CalibrationOptions::noise_check.lower_max_joins), the verdict is reported and the
 // covariances kept.
 TEST(NoiseCheck, FindsBearingsLessNoisyThanAssumed) {
   SyntheticRunOptions so;
   so.bearing_sigma = deg2rad(0.0125);
-  Options o = options_for(so);
-  o.bearing_sigma = deg2rad(0.05);  // what the model assumes
+  CalibrationOptions o = options_for(so);
+  o.noise.bearing_sigma = deg2rad(0.05);  // what the model assumes
   const int runs = 12;
   int less = 0, filter_less = 0, kept_broken = 0, less_broken = 0;
   double scale = 0, yaw = 0, yaw_model = 0;
@@ -326,14 +326,14 @@ TEST(NoiseCheck, FindsBearingsLessNoisyThanAssumed) {
     so.seed = 400 + static_cast<std::uint64_t>(k);
     so.break_probability = 0.0;
     const SyntheticRun run = make_synthetic_run(so);
-    const CalibrationResult r = calibrate(run.run, o, {.refine = true});
-    ASSERT_TRUE(r.noise_checked && r.refinement.covariance_ok) << "seed " << so.seed;
-    scale += r.noise.scale;
-    if (r.noise_verdict == NoiseVerdict::kLessNoise) {
+    const CalibrationResult r = calibrate(run.run, refined(o));
+    ASSERT_TRUE(r.noise_check.checked && r.refinement.covariance_ok) << "seed " << so.seed;
+    scale += r.noise_check.check.scale;
+    if (r.noise_check.verdict == NoiseVerdict::kLessNoise) {
       ++less;
-      EXPECT_LT(r.noise.scale,
-                noise_check_lower_limit(r.noise.clusters, r.noise_check_lower_level));
-      EXPECT_TRUE(r.noise_applied);
+      EXPECT_LT(r.noise_check.check.scale,
+                noise_check_lower_limit(r.noise_check.check.clusters, r.noise_check.lower_level));
+      EXPECT_TRUE(r.noise_check.applied);
       EXPECT_NE(noise_check_line(r).find("less than the model assumes"), std::string::npos);
       EXPECT_NE(noise_check_line(r).find("sigmas scaled by"), std::string::npos);
       EXPECT_NE(noise_check_line(r).find("--bearing-sigma"), std::string::npos);
@@ -341,28 +341,32 @@ TEST(NoiseCheck, FindsBearingsLessNoisyThanAssumed) {
       // definite.
       EXPECT_LT(r.refinement.covariance(0, 0) + r.refinement.covariance(2, 2) +
                     2.0 * r.refinement.covariance(0, 2),
-                r.refinement_model_covariance(0, 0) + r.refinement_model_covariance(2, 2) +
-                    2.0 * r.refinement_model_covariance(0, 2));
+                r.noise_check.refinement_model_covariance(0, 0) +
+                    r.noise_check.refinement_model_covariance(2, 2) +
+                    2.0 * r.noise_check.refinement_model_covariance(0, 2));
       EXPECT_EQ(Eigen::LLT<Eigen::Matrix3d>(r.refinement.covariance).info(), Eigen::Success);
     } else {
-      EXPECT_EQ(r.refinement.covariance, r.refinement_model_covariance);
+      EXPECT_EQ(r.refinement.covariance, r.noise_check.refinement_model_covariance);
     }
-    if (r.filter_noise_verdict == NoiseVerdict::kLessNoise) {
+    if (r.noise_check.filter_verdict == NoiseVerdict::kLessNoise) {
       ++filter_less;
-      EXPECT_TRUE(r.filter_noise_applied);
+      EXPECT_TRUE(r.noise_check.filter_applied);
       EXPECT_EQ(Eigen::LLT<Eigen::Matrix3d>(r.filter.covariance).info(), Eigen::Success);
     }
     yaw += yaw_z2(r.refinement.extrinsics, r.refinement.covariance, run.truth);
-    yaw_model += yaw_z2(r.refinement.extrinsics, r.refinement_model_covariance, run.truth);
+    yaw_model +=
+        yaw_z2(r.refinement.extrinsics, r.noise_check.refinement_model_covariance, run.truth);
     // The same bearings in pieces: kept.
     so.break_probability = 0.1;
     const SyntheticRun broken = make_synthetic_run(so);
-    const CalibrationResult b = calibrate(broken.run, o, {.refine = true});
-    ASSERT_TRUE(b.noise_checked && b.refinement.covariance_ok) << "seed " << so.seed;
-    if (b.noise_verdict == NoiseVerdict::kLessNoise) {
+    const CalibrationResult b = calibrate(broken.run, refined(o));
+    ASSERT_TRUE(b.noise_check.checked && b.refinement.covariance_ok) << "seed " << so.seed;
+    if (b.noise_check.verdict == NoiseVerdict::kLessNoise) {
       ++less_broken;
-      EXPECT_GT(static_cast<double>(b.refinement.merges.size()), 0.5 * b.noise.clusters);
-      kept_broken += !b.noise_applied && b.refinement.covariance == b.refinement_model_covariance;
+      EXPECT_GT(static_cast<double>(b.refinement.merges.size()),
+                0.5 * b.noise_check.check.clusters);
+      kept_broken += !b.noise_check.applied &&
+                     b.refinement.covariance == b.noise_check.refinement_model_covariance;
       EXPECT_NE(noise_check_line(b).find("pieces of lines were joined"), std::string::npos);
     }
   }

@@ -27,8 +27,11 @@
 namespace omnivert::calib {
 namespace {
 
-Options options_for(const SyntheticRunOptions& so) { return test_support::filter_case_options(so); }
+CalibrationOptions options_for(const SyntheticRunOptions& so) {
+  return test_support::filter_case_options(so);
+}
 using test_support::error;
+using test_support::refined;
 
 double nees(const Extrinsics& est, const Eigen::Matrix3d& cov, const Extrinsics& truth) {
   const Eigen::Vector3d e = error(est, truth);
@@ -68,8 +71,8 @@ TEST(CalibrationFilter, NoiseFreeRunConvergesToTruth) {
   so.odometry_K = 0.0;
   so.seed = 3;
   const SyntheticRun run = make_synthetic_run(so);
-  Options o = options_for(so);
-  o.odometry_K = 1e-9;
+  CalibrationOptions o = options_for(so);
+  o.robot.odometry_K = 1e-9;
   const FilterResult r = run_filter(run.run, o);
   const Eigen::Vector3d e = error(r.extrinsics, run.truth);
   EXPECT_LT(std::abs(rad2deg(e(0))), 0.05);
@@ -92,15 +95,15 @@ TEST(CalibrationFilter, MonteCarloNeesIsConsistent) {
   for (int r = 0; r < N; ++r) {
     so.seed = 100 + r;
     const SyntheticRun run = make_synthetic_run(so);
-    const Options o = options_for(so);
+    const CalibrationOptions o = options_for(so);
     const FilterResult fr = run_filter(run.run, o);
     filt += nees(fr.extrinsics, fr.covariance, run.truth);
     const RefinementResult rr = refine_batch(run.run, o, batch_point_from_filter(run.run, o, fr));
     ASSERT_TRUE(rr.covariance_ok);
     ref += nees(rr.extrinsics, rr.covariance, run.truth);
     if (r < 5) {
-      Options on = o;
-      on.feature_init = FeatureInit::kNaive;
+      CalibrationOptions on = o;
+      on.filter.feature_init = FeatureInit::kNaive;
       const FilterResult nr = run_filter(run.run, on);
       naive += nees(nr.extrinsics, nr.covariance, run.truth);
     }
@@ -113,30 +116,30 @@ TEST(CalibrationFilter, MonteCarloNeesIsConsistent) {
   EXPECT_GT(naive / 5, 50.0);  // NOTES Sec. 5: the naive initialisation is inconsistent
 }
 
-// A constant bearing error per line (Options::track_bias_sigma): a new track's block ends
-// with its bias b at 0, with the prior variance, and the block's azimuth, computed from the
-// first bearing, correlated with it by -sigma_b^2; the prediction is eq. (30) + b; the block's
+// A constant bearing error per line (CalibrationOptions::noise.track_bias_sigma): a new track's
+// block ends with its bias b at 0, with the prior variance, and the block's azimuth, computed from
+// the first bearing, correlated with it by -sigma_b^2; the prediction is eq. (30) + b; the block's
 // change to a robot-frame point keeps b.
 TEST(TrackBias, EntersWithItsPriorAndIsPredictedAndKept) {
-  Options o;
-  o.bearing_sigma = deg2rad(0.02);
-  o.track_bias_sigma = deg2rad(0.05);
-  FilterState state(o.prior, o.prior_sigma, ExtrinsicsParam::kCameraPose);
+  CalibrationOptions o;
+  o.noise.bearing_sigma = deg2rad(0.02);
+  o.noise.track_bias_sigma = deg2rad(0.05);
+  FilterState state(o.prior.mean, o.prior.sigma, ExtrinsicsParam::kCameraPose);
   const FeatureInitializer init(o);
   const int slot = init.initialize(7, 0.4, 0, &state);
   const FeatureSlot& s = state.slots()[slot];
   ASSERT_TRUE(s.bias);
   ASSERT_EQ(s.size, 5);
   const int ib = s.bias_index();
-  const double vb = o.track_bias_sigma * o.track_bias_sigma;
+  const double vb = o.noise.track_bias_sigma * o.noise.track_bias_sigma;
   EXPECT_EQ(state.x()(ib), 0.0);
   EXPECT_NEAR(state.P()(ib, ib), vb, 1e-15);
   EXPECT_NEAR(state.P()(s.index + 2, ib), -vb, 1e-15);  // alpha = beta + eta - b
   // Prediction: a bearing equal to the bias-free prediction plus b has no innovation.
   const Updater up(o);
-  Options no_bias = o;
-  no_bias.track_bias_sigma = 0.0;
-  FilterState plain(o.prior, o.prior_sigma, ExtrinsicsParam::kCameraPose);
+  CalibrationOptions no_bias = o;
+  no_bias.noise.track_bias_sigma = 0.0;
+  FilterState plain(o.prior.mean, o.prior.sigma, ExtrinsicsParam::kCameraPose);
   FeatureInitializer(no_bias).initialize(7, 0.4, 0, &plain);
   ASSERT_EQ(plain.slots()[0].size, 4);
   state.mutable_x()(ib) = deg2rad(0.03);
@@ -171,15 +174,15 @@ TEST(TrackBias, MonteCarloNeesIsConsistentWithBiasedBearings) {
   for (int r = 0; r < N; ++r) {
     so.seed = 100 + r;
     const SyntheticRun run = make_synthetic_run(so);
-    Options o = options_for(so);
-    o.bearing_sigma = so.bearing_sigma;
-    o.track_bias_sigma = so.track_bias_sigma;
-    const CalibrationResult cr = calibrate(run.run, o, {.refine = true});
+    CalibrationOptions o = options_for(so);
+    o.noise.bearing_sigma = so.bearing_sigma;
+    o.noise.track_bias_sigma = so.track_bias_sigma;
+    const CalibrationResult cr = calibrate(run.run, refined(o));
     ASSERT_TRUE(cr.refined && cr.refinement.covariance_ok) << so.seed;
     filt += nees(cr.filter.extrinsics, cr.filter.covariance, run.truth);
     ref += nees(cr.refinement.extrinsics, cr.refinement.covariance, run.truth);
-    o.track_bias_sigma = 0.0;
-    const CalibrationResult cw = calibrate(run.run, o, {.refine = true});
+    o.noise.track_bias_sigma = 0.0;
+    const CalibrationResult cw = calibrate(run.run, refined(o));
     ASSERT_TRUE(cw.refined && cw.refinement.covariance_ok) << so.seed;
     white += nees(cw.refinement.extrinsics, cw.refinement.covariance, run.truth);
   }
@@ -204,12 +207,12 @@ TEST(CalibrationFilter, StraightRunGainsNoSpuriousInformation) {
   so.trajectory = Trajectory::kStraight;
   so.seed = 5;
   const SyntheticRun run = make_synthetic_run(so);
-  Options o = options_for(so);
-  o.bootstrap_rotation = 0.0;  // the EKF alone from the first frame
+  CalibrationOptions o = options_for(so);
+  o.filter.bootstrap_rotation = 0.0;  // the EKF alone from the first frame
   const FilterResult anchored = run_filter(run.run, o);
   EXPECT_GT(std::sqrt(anchored.covariance(1, 1)), 0.09);
   EXPECT_GT(std::sqrt(anchored.covariance(0, 0)), 0.4);  // 0.8 / sqrt(2): phi + psi is seen
-  o.feature_init = FeatureInit::kInverseDistance;
+  o.filter.feature_init = FeatureInit::kInverseDistance;
   const FilterResult paper = run_filter(run.run, o);
   EXPECT_LT(std::sqrt(paper.covariance(1, 1)), 0.05);
 }
@@ -222,7 +225,7 @@ TEST(CalibrationFilter, OutlierBearingIsGated) {
   run.run.frames[30].observations[4].beta += deg2rad(25.0);
   run.run.frames[100].observations[2].beta += deg2rad(25.0);
   run.run.frames[105].observations[6].beta -= deg2rad(10.0);
-  const Options o = options_for(so);
+  const CalibrationOptions o = options_for(so);
   CalibrationFilter f(o);
   for (const FrameInput& fr : run.run.frames) f.process(fr);
   f.finish();
@@ -251,8 +254,8 @@ TEST(CalibrationFilter, TracksEnterAndLeave) {
   so.break_probability = 0.03;  // tracks are cut and restart under new ids
   const SyntheticRun run = make_synthetic_run(so);
   ASSERT_GT(run.track_feature.size(), 30u);
-  Options o = options_for(so);
-  o.max_missed_frames = 0;  // a track not seen in this frame has ended
+  CalibrationOptions o = options_for(so);
+  o.association.max_missed_frames = 0;  // a track not seen in this frame has ended
   CalibrationFilter f(o);
   int max_features = 0;
   for (const FrameInput& fr : run.run.frames) {
@@ -276,15 +279,15 @@ TEST(CalibrationFilter, BearingSigmaScaleWeighsLikeALargerSigma) {
   so.bearing_sigma = deg2rad(0.05);
   so.seed = 5;
   const SyntheticRun run = make_synthetic_run(so);
-  Options o = options_for(so);
-  o.bearing_sigma = deg2rad(0.05);
+  CalibrationOptions o = options_for(so);
+  o.noise.bearing_sigma = deg2rad(0.05);
   CalibrationRun scaled = run.run, some = run.run;
   for (FrameInput& f : scaled.frames)
     for (BearingObservation& b : f.observations) b.sigma_scale = 2.0;
   for (std::size_t k = 0; k < some.frames.size(); k += 3)
     for (BearingObservation& b : some.frames[k].observations) b.sigma_scale = 4.0;
-  Options wide = o;
-  wide.bearing_sigma = 2.0 * o.bearing_sigma;
+  CalibrationOptions wide = o;
+  wide.noise.bearing_sigma = 2.0 * o.noise.bearing_sigma;
   const FilterResult a = run_filter(scaled, o), b = run_filter(run.run, wide);
   EXPECT_LT((a.extrinsics.vec() - b.extrinsics.vec()).norm(), 1e-9);
   EXPECT_LT((a.covariance - b.covariance).norm(), 1e-9 * b.covariance.norm());
@@ -298,8 +301,8 @@ TEST(CalibrationFilter, BearingSigmaScaleWeighsLikeALargerSigma) {
   const FilterResult c = run_filter(some, o), d = run_filter(run.run, o);
   EXPECT_GT((c.extrinsics.vec() - d.extrinsics.vec()).norm(), 1e-7);
   const BatchPoint at = batch_point_from_filter(run.run, o, d);
-  const ObservabilityReport os = analyse_observability(some, o, at, BatchOptions{});
-  const ObservabilityReport od = analyse_observability(run.run, o, at, BatchOptions{});
+  const ObservabilityReport os = analyse_observability(some, o, at);
+  const ObservabilityReport od = analyse_observability(run.run, o, at);
   EXPECT_GT(os.phi.crlb, 1.01 * od.phi.crlb);
   EXPECT_GT(os.rho.crlb, 1.01 * od.rho.crlb);
 }
@@ -312,7 +315,7 @@ TEST(CalibrationFilter, RefusedBearingsAreListedAndLeftOutOfTheBound) {
   so.bearing_sigma = deg2rad(0.03);
   so.seed = 2;
   SyntheticRun run = make_synthetic_run(so);
-  const Options o = options_for(so);
+  const CalibrationOptions o = options_for(so);
   std::set<std::pair<int, int>> planted;
   for (std::size_t k = 5; k < run.run.frames.size(); k += 11) {
     auto& obs = run.run.frames[k].observations;
@@ -320,7 +323,7 @@ TEST(CalibrationFilter, RefusedBearingsAreListedAndLeftOutOfTheBound) {
     obs[1].beta += deg2rad(3.0);
     planted.emplace(obs[1].track_id, static_cast<int>(k));
   }
-  const CalibrationResult r = calibrate(run.run, o, {});
+  const CalibrationResult r = calibrate(run.run, o);
   ASSERT_GT(r.filter.window_frames, 0);
   const std::set<std::pair<int, int>> refused(r.filter.rejected.begin(), r.filter.rejected.end());
   int in_window = 0, after = 0;
@@ -358,41 +361,42 @@ TEST(CalibrationFilter, RefusedBearingsAreListedAndLeftOutOfTheBound) {
 // and its information without bound (a short track, 16 bearings). Tracks broken every ~10
 // frames at 0.1 degree, seed 2: the window's solution had a feature 3e-9 m from the camera,
 // information 1e21 on rho, and the filter reported sigmas of 2e-6 rad and 1.4e-6 m (NEES
-// 2.7e7) for an estimate 0.01 rad off. Such features are left out (Options::min_feature_range).
-// (That window had the pieces of each line apart: joined (Options::join_pieces), the same run
-// gives sigma rho 0.74 mm, with no feature near the camera.)
+// 2.7e7) for an estimate 0.01 rad off. Such features are left out
+// (CalibrationOptions::association.min_feature_range). (That window had the pieces of each line
+// apart: joined (CalibrationOptions::association.join_pieces), the same run gives sigma rho 0.74
+// mm, with no feature near the camera.)
 TEST(CalibrationFilter, AFeatureCollapsedOntoTheCameraIsLeftOut) {
   SyntheticRunOptions so;
   so.seed = 2;
   so.bearing_sigma = deg2rad(0.1);
   so.break_probability = 0.1;
   const SyntheticRun run = make_synthetic_run(so);
-  Options o = options_for(so);
-  o.bearing_sigma = so.bearing_sigma;
-  o.join_pieces = false;
+  CalibrationOptions o = options_for(so);
+  o.noise.bearing_sigma = so.bearing_sigma;
+  o.association.join_pieces = false;
   const FilterResult r = run_filter(run.run, o);
   ASSERT_GT(r.window_frames, 0);
   ASSERT_TRUE(r.window_failure.empty()) << r.window_failure;
   EXPECT_GT(std::sqrt(r.covariance(0, 0)), 1e-3);
   EXPECT_GT(std::sqrt(r.covariance(1, 1)), 1e-3);  // measured 5.8 mm
   EXPECT_LT(nees(r.extrinsics, r.covariance, run.truth), 16.3);
-  o.join_pieces = true;
+  o.association.join_pieces = true;
   const FilterResult joined = run_filter(run.run, o);
   EXPECT_GT(std::sqrt(joined.covariance(1, 1)), 3e-4);  // measured 0.74 mm
   EXPECT_LT(nees(joined.extrinsics, joined.covariance, run.truth), 16.3);
 }
 
 // A tracker that loses a line and finds it again under a new id after the start-up window:
-// the new track continues the feature (Options::join_pieces), and the filter computes what it
-// computes when the track keeps its id, to the last digit (the same bearings update the same
-// feature in the same frames).
+// the new track continues the feature (CalibrationOptions::association.join_pieces), and the filter
+// computes what it computes when the track keeps its id, to the last digit (the same bearings
+// update the same feature in the same frames).
 TEST(CalibrationFilter, ATrackFoundAgainUnderANewIdContinuesItsFeature) {
   SyntheticRunOptions so;
   so.seed = 3;
   so.bearing_sigma = deg2rad(0.03);
   const SyntheticRun run = make_synthetic_run(so);
-  Options o = options_for(so);
-  o.bearing_sigma = so.bearing_sigma;
+  CalibrationOptions o = options_for(so);
+  o.noise.bearing_sigma = so.bearing_sigma;
   const FilterResult whole = run_filter(run.run, o);
   ASSERT_GT(whole.window_frames, 0);
   ASSERT_TRUE(whole.window_failure.empty()) << whole.window_failure;
@@ -424,7 +428,7 @@ TEST(CalibrationFilter, ATrackFoundAgainUnderANewIdContinuesItsFeature) {
     EXPECT_EQ(joined.tracks.at(c).D_theta, whole.tracks.at(a).D_theta);
   }
   // Off: each new id is a feature of its own, from the depth prior.
-  o.join_pieces = false;
+  o.association.join_pieces = false;
   const FilterResult apart = run_filter(renamed, o);
   EXPECT_TRUE(apart.joins.empty());
   EXPECT_NE(apart.extrinsics.rho, whole.extrinsics.rho);
@@ -440,11 +444,11 @@ TEST(CalibrationFilter, AJoinedTrackThatComesBackAfterItsFeatureLeftIsOneFeature
   so.bearing_sigma = deg2rad(0.03);
   so.trajectory = Trajectory::kZigzag;
   const SyntheticRun run = make_synthetic_run(so);
-  Options o = options_for(so);
-  o.bearing_sigma = so.bearing_sigma;
-  o.bootstrap_rotation = 0.0;  // no window: the EKF joins from frame 0 on
+  CalibrationOptions o = options_for(so);
+  o.noise.bearing_sigma = so.bearing_sigma;
+  o.filter.bootstrap_rotation = 0.0;  // no window: the EKF joins from frame 0 on
   const int n = static_cast<int>(run.run.frames.size());
-  const int from = 60, gap_from = 70, gap_to = gap_from + o.max_missed_frames + 10;
+  const int from = 60, gap_from = 70, gap_to = gap_from + o.association.max_missed_frames + 10;
   ASSERT_LT(gap_to + 10, n);
   CalibrationRun renamed = run.run;
   for (int k = from; k < n; ++k)
@@ -458,7 +462,7 @@ TEST(CalibrationFilter, AJoinedTrackThatComesBackAfterItsFeatureLeftIsOneFeature
   for (int k = 0; k < n; ++k) {
     filter.process(renamed.frames[static_cast<std::size_t>(k)]);
     std::set<int> live;
-    for (int j = std::max(0, k - o.max_missed_frames); j <= k; ++j)
+    for (int j = std::max(0, k - o.association.max_missed_frames); j <= k; ++j)
       for (const BearingObservation& b : renamed.frames[static_cast<std::size_t>(j)].observations)
         live.insert(b.track_id);
     ASSERT_LE(filter.state().num_features(), static_cast<int>(live.size())) << "frame " << k;
@@ -481,10 +485,10 @@ TEST(CalibrationFilter, PiecesOfOneLineAreOneFeature) {
     so.bearing_sigma = deg2rad(0.03);
     so.break_probability = 0.1;
     const SyntheticRun run = make_synthetic_run(so);
-    Options o = options_for(so);
-    o.bearing_sigma = so.bearing_sigma;
+    CalibrationOptions o = options_for(so);
+    o.noise.bearing_sigma = so.bearing_sigma;
     const FilterResult r = run_filter(run.run, o);
-    o.join_pieces = false;
+    o.association.join_pieces = false;
     const FilterResult apart = run_filter(run.run, o);
     for (const auto& [a, c] : r.joins) {
       ++joins;
@@ -506,14 +510,14 @@ TEST(CalibrationFilter, PiecesOfOneLineAreOneFeature) {
 }
 
 TEST(CalibrationFilter, BadInputIsAnInputError) {
-  Options o;
-  o.bearing_sigma = -1.0;
+  CalibrationOptions o;
+  o.noise.bearing_sigma = -1.0;
   std::string why;
   EXPECT_FALSE(o.IsValid(&why));
   EXPECT_NE(why.find("bearing_sigma"), std::string::npos);
   EXPECT_THROW(CalibrationFilter{o}, InputError);
 
-  CalibrationFilter f(Options{});
+  CalibrationFilter f(CalibrationOptions{});
   FrameInput bad;
   bad.d_right = std::nan("");
   EXPECT_THROW(f.process(bad), InputError);

@@ -16,6 +16,7 @@ namespace omnivert::calib {
 namespace {
 
 using test_support::options_for;
+using test_support::refined;
 using test_support::truth_point;
 
 TEST(Observability, StraightRunDeterminesOnlyTheYaw) {
@@ -104,8 +105,8 @@ TEST(Observability, BoundIsTheMarginalOfTheFullInverseOfTheSolvedProblem) {
       auto& obs = run.run.frames[k].observations;
       if (!obs.empty()) obs[0].beta += deg2rad(3.0);
     }
-    const Options opt = options_for(so);
-    const CalibrationResult r = calibrate(run.run, opt, {.refine = true});
+    const CalibrationOptions opt = options_for(so);
+    const CalibrationResult r = calibrate(run.run, refined(opt));
     ASSERT_TRUE(r.refinement.noise.ok);
     ASSERT_TRUE(r.observability.all_determined())
         << "seed " << seed << ": " << r.observability.message;
@@ -145,7 +146,7 @@ TEST(Calibrate, PaperRunEndToEndWritesExtrinsics) {
   SyntheticRunOptions so;
   so.seed = 21;
   const SyntheticRun run = make_synthetic_run(so);
-  const CalibrationResult r = calibrate(run.run, options_for(so), {.refine = true});
+  const CalibrationResult r = calibrate(run.run, refined(options_for(so)));
   EXPECT_TRUE(r.observable()) << r.observability.message;
   ASSERT_TRUE(r.refinement.covariance_ok);
   for (int i = 0; i < 3; ++i) {
@@ -212,11 +213,10 @@ TEST(Calibrate, StraightRunIsNotDeterminedAtAnyBearingNoise) {
   EXPECT_LT(o.heading_range, ObservabilityOptions{}.min_rotation_sigmas * o.heading_noise);
   EXPECT_NE(o.message.find("within the wheels' noise"), std::string::npos) << o.message;
   // The bounds alone would have called rho determined.
-  ObservabilityOptions bounds_only;
-  bounds_only.min_rotation_sigmas = 0.0;
+  CalibrationOptions bounds_only = options_for(so);
+  bounds_only.observability.min_rotation_sigmas = 0.0;
   const BatchPoint at = batch_point_from_filter(run.run, options_for(so), r.filter);
-  const ObservabilityReport b =
-      analyse_observability(run.run, options_for(so), at, {}, bounds_only);
+  const ObservabilityReport b = analyse_observability(run.run, bounds_only, at);
   RecordProperty("rho_crlb_mm", std::to_string(1e3 * b.rho.crlb));
   EXPECT_TRUE(b.rho.determined) << "rho's bound " << b.rho.crlb;
   // A run that turns is not affected (paper trajectory: 180 degrees).

@@ -3,14 +3,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <set>
+#include <string>
 #include <vector>
 
 #include <Eigen/Dense>
 
 #include "calib/synthetic_run.hpp"
 #include "omnivert/calib/batch_point.hpp"
+#include "omnivert/calib/calibrate.hpp"
 #include "omnivert/calib/refinement.hpp"
 #include "omnivert/core/angles.hpp"
 #include "synthetic_support.hpp"
@@ -20,6 +23,7 @@ namespace {
 
 using test_support::nees;
 using test_support::options_for;
+using test_support::refined;
 using test_support::truth_point;
 
 TEST(Refinement, MirroredExtrinsicsAreReportedWithPositiveRho) {
@@ -39,6 +43,42 @@ TEST(Refinement, MirroredExtrinsicsAreReportedWithPositiveRho) {
   const RefinementResult direct = refine_batch(run.run, options_for(so), truth_point(run));
   EXPECT_NEAR(r.extrinsics.rho, direct.extrinsics.rho, 1e-6);
   EXPECT_NEAR(std::sqrt(r.covariance(1, 1)), std::sqrt(direct.covariance(1, 1)), 1e-6);
+}
+
+// The result's reports: the brief one gives phi, rho, psi with their sigmas as documented
+// (degrees with 3 decimals, millimetres with 2) and the verdict; the full one every stage.
+TEST(CalibrationResult, ReportsGiveTheEstimateItsSigmasAndTheVerdict) {
+  SyntheticRunOptions so;
+  so.bearing_sigma = deg2rad(0.05);
+  so.seed = 3;
+  const SyntheticRun run = make_synthetic_run(so);
+  const CalibrationResult r = calibrate(run.run, refined(options_for(so)));
+  ASSERT_TRUE(r.refined && r.refinement.covariance_ok && r.observable());
+  char line[256];
+  std::snprintf(
+      line,
+      sizeof line,
+      "refined estimate: phi %.3f +- %.3f deg, rho %.2f +- %.2f mm, psi %.3f +- %.3f deg\n",
+      rad2deg(r.extrinsics.phi),
+      rad2deg(std::sqrt(r.covariance(0, 0))),
+      1e3 * r.extrinsics.rho,
+      1e3 * std::sqrt(r.covariance(1, 1)),
+      rad2deg(r.extrinsics.psi),
+      rad2deg(std::sqrt(r.covariance(2, 2))));
+  const std::string brief = r.BriefReport();
+  EXPECT_EQ(brief.rfind(line, 0), 0u) << brief;
+  EXPECT_NE(brief.find(r.observability.message), std::string::npos) << brief;
+  EXPECT_NE(brief.find("camera in the robot frame: x "), std::string::npos) << brief;
+  const std::string full = r.FullReport();
+  EXPECT_EQ(full.rfind(brief, 0), 0u);  // begins with the brief report
+  for (const char* item : {"\nfilter: phi ",
+                           "\nrefinement: phi ",
+                           "\nCramer-Rao bound: phi ",
+                           "\nbearing noise model: 0.050 deg\n",
+                           "\nnoise check: over ",
+                           "\nrefinement: converged",
+                           "\ntime: filter "})
+    EXPECT_NE(full.find(item), std::string::npos) << item << " in\n" << full;
 }
 
 }  // namespace

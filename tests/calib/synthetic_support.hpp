@@ -22,11 +22,17 @@ inline BatchPoint truth_point(const SyntheticRun& run) {
 }
 
 // Models matching the run: its wheel base, K and bearing noise.
-inline Options options_for(const SyntheticRunOptions& so) {
-  Options o;
-  o.wheel_base = so.wheel_base;
-  o.odometry_K = so.odometry_K;
-  o.bearing_sigma = so.bearing_sigma;
+inline CalibrationOptions options_for(const SyntheticRunOptions& so) {
+  CalibrationOptions o;
+  o.robot.wheel_base = so.wheel_base;
+  o.robot.odometry_K = so.odometry_K;
+  o.noise.bearing_sigma = so.bearing_sigma;
+  return o;
+}
+
+// The options with the batch refinement on.
+inline CalibrationOptions refined(CalibrationOptions o) {
+  o.refinement.enabled = true;
   return o;
 }
 
@@ -61,11 +67,11 @@ inline SyntheticRun slip(SyntheticRun run, int track, int from, double behind) {
 
 // The filter tests' models: the run's wheel base and K, the paper's bearing sigma 0.3 degree
 // (whatever the run's noise).
-inline Options filter_case_options(const SyntheticRunOptions& so) {
-  Options o;
-  o.wheel_base = so.wheel_base;
-  o.odometry_K = so.odometry_K;
-  o.bearing_sigma = deg2rad(0.3);
+inline CalibrationOptions filter_case_options(const SyntheticRunOptions& so) {
+  CalibrationOptions o;
+  o.robot.wheel_base = so.wheel_base;
+  o.robot.odometry_K = so.odometry_K;
+  o.noise.bearing_sigma = deg2rad(0.3);
   return o;
 }
 

@@ -64,11 +64,11 @@ TEST(TrackSplitting, SplitTracksRebuildsTheRefinementsParts) {
 
 // A tracker that loses lines and finds them again under new ids (a new id with probability
 // 0.1 per frame: pieces of ~10 frames). The refinement joins the pieces of each line
-// (BatchOptions::merge_pieces) and so reaches nearly the precision of the whole tracks.
-// Seeds 69 and 90: with the Wald test alone, 2 and 4 joins were of two lines (a three-bearing
-// piece has no depth and passed it at 0.00), and the refinement ended with NEES 46 and 1547.
-// Chains of joins are followed to the line's first piece; of two joins of one piece the last
-// counts; a join of a piece to itself and one that closes a loop are left out, so every chain
+// (CalibrationOptions::association.join_pieces) and so reaches nearly the precision of the whole
+// tracks. Seeds 69 and 90: with the Wald test alone, 2 and 4 joins were of two lines (a
+// three-bearing piece has no depth and passed it at 0.00), and the refinement ended with NEES 46
+// and 1547. Chains of joins are followed to the line's first piece; of two joins of one piece the
+// last counts; a join of a piece to itself and one that closes a loop are left out, so every chain
 // ends (the window reports joins by the tracker's ids, and a corridor zigzag run hung on
 // (T, T)).
 TEST(PiecesOfOneLine, JoinChainsEndAtTheFirstPiece) {

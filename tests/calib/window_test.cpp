@@ -52,11 +52,11 @@ TEST(TrackSplitting, TheFiltersWindowSplitsSlippedTracks) {
       slip_frame[track] = n / 3 + 7 * i;
       run = slip(run, track, slip_frame[track], 0.10);
     }
-  Options o = options_for(so);
-  o.crossing_guard = 0.0;        // the splitting alone (as above)
-  o.bootstrap_rotation = 100.0;  // never reached: the window ends with the run
+  CalibrationOptions o = options_for(so);
+  o.association.crossing_guard = 0.0;   // the splitting alone (as above)
+  o.filter.bootstrap_rotation = 100.0;  // never reached: the window ends with the run
   const FilterResult split = run_filter(run.run, o);
-  o.split_chi2 = 0.0;
+  o.association.split_chi2 = 0.0;
   const FilterResult whole = run_filter(run.run, o);
   const double nees_whole = test_support::nees(whole.extrinsics, whole.covariance, run.truth);
   const double nees_split = test_support::nees(split.extrinsics, split.covariance, run.truth);
@@ -118,7 +118,9 @@ TEST(WindowStarts, CameraYawFromTheBearingsFlow) {
 namespace window_filter_cases {
 namespace {
 
-Options options_for(const SyntheticRunOptions& so) { return test_support::filter_case_options(so); }
+CalibrationOptions options_for(const SyntheticRunOptions& so) {
+  return test_support::filter_case_options(so);
+}
 using test_support::error;
 
 // A track whose every bearing is an outlier in the bootstrap window (two rays that diverge:
@@ -139,8 +141,8 @@ TEST(CalibrationFilter, BootstrapWindowDropsATrackWithOnlyOutliers) {
     window.frames[10 + 5 * j].observations.push_back({900 + j, deg2rad(95.0) - yaw});
     window.frames[11 + 5 * j].observations.push_back({900 + j, deg2rad(85.0) - yaw});
   }
-  const Options o = options_for(so);
-  FilterState state(o.prior, o.prior_sigma, ExtrinsicsParam::kCameraPose);
+  const CalibrationOptions o = options_for(so);
+  FilterState state(o.prior.mean, o.prior.sigma, ExtrinsicsParam::kCameraPose);
   std::string why;
   BootstrapDetails details;
   ASSERT_TRUE(bootstrap_filter_state(window, o, &state, &why, &details)) << why;
@@ -163,9 +165,10 @@ TEST(CalibrationFilter, BootstrapWindowEndsATrackAfterALongGap) {
   so.seed = 3;
   so.bearing_sigma = deg2rad(0.05);
   const SyntheticRun run = make_synthetic_run(so);
-  Options o = options_for(so);
-  o.bearing_sigma = so.bearing_sigma;
-  const int gap_frame = o.max_missed_frames + 21;  // 11 frames after the track's last + margin
+  CalibrationOptions o = options_for(so);
+  o.noise.bearing_sigma = so.bearing_sigma;
+  const int gap_frame =
+      o.association.max_missed_frames + 21;  // 11 frames after the track's last + margin
   // A track seen in frames 0-10 and at gap_frame.
   int id = -1;
   for (const BearingObservation& b : run.run.frames[0].observations)
@@ -185,7 +188,7 @@ TEST(CalibrationFilter, BootstrapWindowEndsATrackAfterALongGap) {
     if (c.track_id == id)
       lone.frames[gap_frame].observations.push_back({id, c.beta + deg2rad(0.3)});
   std::string why;
-  FilterState a(o.prior, o.prior_sigma, ExtrinsicsParam::kCameraPose), b = a;
+  FilterState a(o.prior.mean, o.prior.sigma, ExtrinsicsParam::kCameraPose), b = a;
   ASSERT_TRUE(bootstrap_filter_state(clean, o, &a, &why)) << why;
   ASSERT_TRUE(bootstrap_filter_state(lone, o, &b, &why)) << why;
   EXPECT_LT((a.extrinsics().vec() - b.extrinsics().vec()).norm(), 1e-9);
@@ -204,8 +207,8 @@ TEST(CalibrationFilter, AnUnsolvableWindowIsReported) {
   int id = 100000;
   for (int k = 0; k < 100; ++k)
     for (BearingObservation& o : run.run.frames[k].observations) o.track_id = id++;
-  Options o = options_for(so);
-  o.max_missed_frames = 0;  // tracks not seen leave at once (the state stays small)
+  CalibrationOptions o = options_for(so);
+  o.association.max_missed_frames = 0;  // tracks not seen leave at once (the state stays small)
   const FilterResult fr = run_filter(run.run, o);
   EXPECT_GT(fr.window_frames, 0);
   EXPECT_NE(fr.window_failure.find("no track with two bearings"), std::string::npos)

@@ -146,11 +146,48 @@ TEST_F(DatasetTest, ImageOfTheWrongSize) {
       p("cam0/data/a.png") + ": image is 32x24 pixels but cam0/sensor.yaml gives resolution 64x48");
 }
 
-TEST_F(DatasetTest, ImageOfTheWrongDepth) {
-  image("cam0/data/a.png", 64, 48, CV_16UC1);
+TEST_F(DatasetTest, SixteenBitImagesAreScaledToEightBits) {
+  cv::Mat1w m(48, 64, static_cast<uint16_t>(100 * 257));
+  m(10, 20) = 65535;
+  ASSERT_TRUE(cv::imwrite(p("cam0/data/a.png"), m));
+  const Dataset d = Dataset::load(root.string());
+  const cv::Mat1b g = d.image(0);
+  EXPECT_EQ(g(0, 0), 100);
+  EXPECT_EQ(g(10, 20), 255);
+}
+
+TEST_F(DatasetTest, TwelveBitImagesUseTheSensorsBitDepth) {
+  write("cam0/sensor.yaml", "resolution: [64, 48]\nbit_depth: 12\n");
+  cv::Mat1w m(48, 64, static_cast<uint16_t>(4095));
+  m(0, 0) = 0;
+  ASSERT_TRUE(cv::imwrite(p("cam0/data/a.png"), m));
+  const cv::Mat1b g = Dataset::load(root.string()).image(0);
+  EXPECT_EQ(g(0, 0), 0);
+  EXPECT_EQ(g(1, 1), 255);
+}
+
+TEST_F(DatasetTest, BayerPatternOnAColourImageIsRefused) {
+  write("cam0/sensor.yaml", "resolution: [64, 48]\nbayer: RGGB\n");
+  image("cam0/data/a.png", 64, 48, CV_8UC3);
   EXPECT_EQ(error(),
             p("cam0/data/a.png") +
-                ": image is 16 bits deep; expected 8-bit grey (convert it, e.g. to 8-bit PNG)");
+                ": the camera's images are Bayer mosaics (bayer: RGGB) but this image has 3 "
+                "channels; set bayer: none in sensor.yaml for colour images");
+}
+
+TEST_F(DatasetTest, UnknownBayerPatternNamesTheLine) {
+  write("cam0/sensor.yaml", "resolution: [64, 48]\nbayer: RGBG\n");
+  EXPECT_EQ(error(),
+            p("cam0/sensor.yaml") +
+                ":2: field 'bayer' is 'RGBG'; expected RGGB, BGGR, GRBG, GBRG or none");
+}
+
+TEST_F(DatasetTest, BitDepthOutOfRangeNamesTheLine) {
+  write("cam0/sensor.yaml", "resolution: [64, 48]\nbit_depth: 8\n");
+  EXPECT_EQ(error(),
+            p("cam0/sensor.yaml") +
+                ":2: field 'bit_depth' must be a whole number of bits from 9 to 16 (the "
+                "significant bits of a 16-bit image)");
 }
 
 TEST_F(DatasetTest, BadImageLaterInTheSequenceIsFoundWhenRead) {

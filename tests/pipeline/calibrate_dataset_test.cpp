@@ -81,22 +81,22 @@ TEST_F(CalibrateDataset, NoiseCheckChoosesTheReportedCovarianceAndCanBeTurnedOff
                               ? nc["batch_checked_covariance"][0].get<double>()
                               : nc["refinement_model_covariance"][0].get<double>();
   EXPECT_EQ(json["result"]["covariance"][0].get<double>(), expected);
-  EXPECT_TRUE(r.calibration.noise_checked);
+  EXPECT_TRUE(r.calibration.noise_check.checked);
   EXPECT_THAT(r.BriefReport(), ContainsRegex("noise check over [0-9]+ tracks"));
 
   auto off = cli_defaults_refined();
-  off.run.noise_check = false;
+  off.calibration.noise_check.enabled = false;
   const auto r_off = calibrate_dataset(paper().string(), out.string(), off);
   expect_complete_outputs_without_nan(out);
   json = read_json(out / "summary.json");
   EXPECT_FALSE(json["noise_check"]["checked"].get<bool>());
   EXPECT_EQ(json["noise_check"]["refinement_model_covariance"][0].get<double>(),
             json["result"]["covariance"][0].get<double>());
-  EXPECT_FALSE(r_off.calibration.noise_checked);
+  EXPECT_FALSE(r_off.calibration.noise_check.checked);
   EXPECT_THAT(r_off.BriefReport(), HasSubstr("no noise check"));
 
   auto level = cli_defaults();
-  level.run.noise_check_lower_level = 0.3;
+  level.calibration.noise_check.lower_level = 0.3;
   calibrate_dataset(paper().string(), out.string(), level);
   expect_complete_outputs_without_nan(out);
   json = read_json(out / "summary.json");
@@ -109,8 +109,8 @@ TEST_F(CalibrateDataset, NoiseCheckChoosesTheReportedCovarianceAndCanBeTurnedOff
 TEST_F(CalibrateDataset, TrackBiasSigmaIsUsedAndNamedInEveryOutput) {
   const fs::path out = scratch("track-bias");
   auto o = cli_defaults_refined();
-  o.calibration.bearing_sigma = deg2rad(0.018);
-  o.calibration.track_bias_sigma = deg2rad(0.016);
+  o.calibration.noise.bearing_sigma = deg2rad(0.018);
+  o.calibration.noise.track_bias_sigma = deg2rad(0.016);
   const auto r = calibrate_dataset(paper().string(), out.string(), o);
   expect_complete_outputs_without_nan(out);
   const auto json = read_json(out / "summary.json");
@@ -120,9 +120,9 @@ TEST_F(CalibrateDataset, TrackBiasSigmaIsUsedAndNamedInEveryOutput) {
   EXPECT_THAT(r.BriefReport(), HasSubstr("bearing sigma 0.018 deg + 0.016 deg per track"));
   EXPECT_THAT(read_text(out / "report.html"), HasSubstr("0.016 deg per track"));
 
-  o.calibration.track_bias_sigma = deg2rad(-0.01);
+  o.calibration.noise.track_bias_sigma = deg2rad(-0.01);
   EXPECT_THAT(input_error_of([&] { calibrate_dataset(paper().string(), out.string(), o); }),
-              HasSubstr("invalid calibration options: track_bias_sigma must be >= 0"));
+              HasSubstr("invalid calibration options: noise.track_bias_sigma must be >= 0"));
 }
 
 // Without turns the camera's position is not observable (Sec. 8.1): the camera yaw is
@@ -171,8 +171,8 @@ TEST_F(CalibrateDataset, StraightRunWithForceWritesExtrinsicsMarkedNotObservable
 TEST_F(CalibrateDataset, PriorCommandAndNotesOfTheOptionsReachTheOutputs) {
   const fs::path out = scratch("prior");
   auto o = cli_defaults();
-  o.calibration.prior = {-0.3, 0.25, 0.3};
-  o.calibration.prior_sigma = {0.2, 0.05, 0.2};
+  o.calibration.prior.mean = {-0.3, 0.25, 0.3};
+  o.calibration.prior.sigma = {0.2, 0.05, 0.2};
   o.command = "omnivert calibrate paper --out prior";
   o.notes = {"a note of the caller"};
   const auto r = calibrate_dataset(paper().string(), out.string(), o);

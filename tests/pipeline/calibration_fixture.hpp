@@ -30,7 +30,7 @@ inline pipeline::CalibrateDatasetOptions cli_defaults() { return {}; }
 
 inline pipeline::CalibrateDatasetOptions cli_defaults_refined() {
   pipeline::CalibrateDatasetOptions o = cli_defaults();
-  o.run.refine = true;
+  o.calibration.refinement.enabled = true;
   return o;
 }
 

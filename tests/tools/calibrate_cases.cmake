@@ -1,8 +1,8 @@
 # Rendered runs where calibration once failed, each calibrated from pixels (no --refine) and
 # checked against its ground truth (summary.json). CASE names the run.
 #
-# The filter's batch window solved from several starts (calib::Options::bootstrap_starts,
-# docs/theory/window.md#starts), CASE prior and flow:
+# The filter's batch window solved from several starts (calib::CalibrationOptions::
+# filter.bootstrap_starts, docs/theory/window.md#starts), CASE prior and flow:
 # - prior: the office, zigzag, seed 11 run, whose window solved from the prior alone ends in a
 #   local minimum (measured before the fix: camera yaw 2.0 degrees off, NEES 9175);
 # - flow: the corridor, zigzag, seed 57 run with the camera mounted at -107.5 degrees of yaw
@@ -11,9 +11,9 @@
 #   phi (NEES 1e10) before the starts at the bearings' flow yaw (calib::camera_yaw_from_flow).
 # Each must end near the truth.
 #
-# The filter's crossing guard (calib::Options::crossing_guard), CASE start and window: office,
-# paper trajectory, each with the camera mount scripts/eval-calibration's VARY_EXTRINSICS
-# draws for its seed.
+# The filter's crossing guard (calib::CalibrationOptions::association.crossing_guard), CASE
+# start and window: office, paper trajectory, each with the camera mount
+# scripts/eval-calibration's VARY_EXTRINSICS draws for its seed.
 # - CASE=start, seed 32: a line's track starts at frame 80 0.5 degree from a line tracked over
 #   the whole run, and the two part to 1.1 degree. Judged by the predictions alone, the new
 #   feature (depth unknown) was guarded from its start, never updated, and kept guarding the

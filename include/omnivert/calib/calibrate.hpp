@@ -3,9 +3,10 @@
 //   filter (Sec. 8.2) -> observability and Cramer-Rao bounds (Sec. 8.1) -> optional batch
 //   maximum-likelihood refinement (Ceres) -> outputs.
 //
-//   omnivert::calib::CalibrationRun run;          // one FrameInput per image
-//   omnivert::calib::Options options;             // wheel base, K, bearing sigma, prior...
-//   auto result = omnivert::calib::calibrate(run, options, {.refine = true});
+//   omnivert::calib::CalibrationRun run;              // one FrameInput per image
+//   omnivert::calib::CalibrationOptions options;      // options.hpp: robot, noise, prior...
+//   options.refinement.enabled = true;
+//   auto result = omnivert::calib::calibrate(run, options);
 //   if (!result.observability.all_determined() && !force) -> print message, exit code 3
 //   omnivert::calib::write_extrinsics_yaml(dir + "/extrinsics.yaml", result);
 //   omnivert::calib::write_states_csv(dir + "/states.csv", result.filter.history);
@@ -16,88 +17,79 @@
 #include "omnivert/calib/calibration_filter.hpp"
 #include "omnivert/calib/diagnostics.hpp"
 #include "omnivert/calib/observability.hpp"
+#include "omnivert/calib/options.hpp"
 #include "omnivert/calib/refinement.hpp"
 #include "omnivert/calib/track_ids.hpp"
-#include "omnivert/calib/types.hpp"
 
 namespace omnivert::calib {
 
-struct CalibrateOptions {
-  bool refine = false;
-  // The data's check of the bearing noise (BatchNoiseCheck, at a batch solution): where it
-  // shows more noise than the model allows (noise_check_verdict), the reported covariance
-  // becomes the checked one. The refinement's: model + (scale - 1) x its bearing part. The
-  // filter's: scaled by the overall variance ratio tr(model^-1 checked) / 3 of a check on its
-  // own tracks (split only where its window split them), a batch solved for the check alone.
-  // Where it shows less noise than the model assumes, the bearings' share of the covariance
-  // is shrunk the same way (the refinement's: the checked covariance; the filter's: plus the
-  // checked minus the model covariance of its own check), but only when the tracker kept its
-  // lines: at most noise_check_lower_max_joins pieces joined per track checked. A tracker that
-  // loses lines leaves pieces of one line that the joins miss, independent tracks to the
-  // check, which then reads less noise than there is: runs with tracks broken every ~10
-  // frames join 2.6-7.4 pieces per track (our tracker's runs from pixels at most 0.6), and
-  // shrunk they would be overconfident (docs/theory/noise-check.md#verdicts). Otherwise the
-  // verdict is reported and the covariances kept (noise_check_line names the sigma the data
-  // want).
-  // false: no check, the model's covariances.
-  bool noise_check = true;
-  // The levels of noise_check_verdict's two sides. "More noise" at 1%: enlarging sigmas that
-  // were right costs accuracy nowhere and is rare. "Less noise" at 20%: when the model is
-  // right, 1 run in 5 is shrunk, a mean NEES 0.10-0.15 higher (synthetic, 0.03 degree, 200
-  // runs: still inside the 95% interval [2.67, 3.35]); where the model's
-  // sigma is too large, most runs are (from pixels, corridor, paper trajectory, 188 of 200
-  // runs; at 1% 74 of 200; docs/theory/noise-check.md#verdicts).
-  double noise_check_level = 0.01;
-  double noise_check_lower_level = 0.2;
-  // Pieces joined per track checked above which "less noise" is reported, not applied (< 0:
-  // never applied).
-  double noise_check_lower_max_joins = 0.5;
-  BatchOptions batch;
-  ObservabilityOptions observability;
+// What the data's check of the bearing noise found and did (CalibrationOptions::noise_check).
+struct NoiseCheckReport {
+  // The check of the reported estimate (the refinement's when refined, else the filter's),
+  // valid when `checked`; its verdict; `applied`: the reported covariance is the checked one
+  // (more noise than the model allows, or less where the tracker kept its lines); `ratio`:
+  // the overall variance ratio tr(model^-1 checked) / 3 then (1 when not applied).
+  bool checked = false;
+  bool applied = false;
+  NoiseVerdict verdict = NoiseVerdict::kAgrees;
+  BatchNoiseCheck check;
+  double ratio = 1.0;
+  // The check of the filter on its own tracks (split only where its window split them), its
+  // verdict, and the filter's variance ratio (1 when not applied).
+  BatchNoiseCheck filter_check;
+  NoiseVerdict filter_verdict = NoiseVerdict::kAgrees;
+  bool filter_applied = false;
+  double filter_ratio = 1.0;
+  // CalibrationOptions::noise_check.level and lower_level, as used.
+  double level = 0.01;
+  double lower_level = 0.2;
+  // The model's covariances before any check.
+  Eigen::Matrix3d filter_model_covariance = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d refinement_model_covariance = Eigen::Matrix3d::Zero();
+};
+
+// Each stage's wall time [s].
+struct CalibrationTiming {
+  double filter = 0.0, refinement = 0.0, observability = 0.0, noise_check = 0.0;
 };
 
 struct CalibrationResult {
-  FilterResult filter;
-  bool refined = false;
-  RefinementResult refinement;  // valid when refined
-  ObservabilityReport observability;
   // The answer: the refinement's when refined and its covariance exists, else the filter's.
   Extrinsics extrinsics;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  double bearing_sigma = 0.0;     // the bearing sigma used by the models [rad]
-  double track_bias_sigma = 0.0;  // Options::track_bias_sigma used by the models [rad]
   // Refinement only: its covariance came from the Fisher information of the observability
   // analysis (the inverse of the same information) because ceres::Covariance failed.
   bool covariance_from_information = false;
-  // CalibrateOptions::noise_check. noise: the check of the reported estimate (the
-  // refinement's when refined, else the filter's), valid when noise_checked; noise_verdict:
-  // what it found; noise_applied: it showed more noise than the model allows and the
-  // reported covariance is the checked one (CalibrateOptions::noise_check); noise_ratio: the
-  // overall variance ratio tr(model^-1 checked) / 3 then (1 when not applied). filter_noise: the
-  // check of the filter on its own tracks (split only where its window split them), its
-  // verdict, and the filter's variance ratio (1 when not applied). The model's covariances
-  // before any check are kept.
-  bool noise_checked = false;
-  bool noise_applied = false;
-  NoiseVerdict noise_verdict = NoiseVerdict::kAgrees;
-  BatchNoiseCheck noise;
-  double noise_ratio = 1.0;
-  BatchNoiseCheck filter_noise;
-  NoiseVerdict filter_noise_verdict = NoiseVerdict::kAgrees;
-  bool filter_noise_applied = false;
-  double filter_noise_ratio = 1.0;
-  // CalibrateOptions::noise_check_level and noise_check_lower_level, as used.
-  double noise_check_level = 0.01;
-  double noise_check_lower_level = 0.2;
-  Eigen::Matrix3d filter_model_covariance = Eigen::Matrix3d::Zero();
-  Eigen::Matrix3d refinement_model_covariance = Eigen::Matrix3d::Zero();
+  // The verdict of Sec. 8.1 and the Cramer-Rao bounds of this run.
+  ObservabilityReport observability;
+  // The estimators: the filter (with its window's association), the refinement (valid when
+  // refined, with its splits, joins and rejections).
+  FilterResult filter;
+  bool refined = false;
+  RefinementResult refinement;
+  BearingNoise model;  // the bearing noise the models used (CalibrationOptions::noise)
+  NoiseCheckReport noise_check;
+  CalibrationTiming seconds;
+
   bool observable() const { return observability.all_determined(); }
+  // A few lines: phi, rho, psi with their sigmas (degrees, millimetres), the camera's position
+  // and yaw, and the verdict of Sec. 8.1, e.g.
+  //   refined estimate: phi 12.345 +- 0.067 deg, rho 201.23 +- 0.45 mm, psi -3.210 +- 0.070 deg
+  //   camera in the robot frame: x 196.5 mm, y 43.0 mm, yaw 9.135 deg
+  //   phi, rho and psi are determined by this trajectory (...).
+  std::string BriefReport() const;
+  // Everything, one item a line: the brief report's lines, then the filter's and the
+  // refinement's estimates with their model covariances, the bounds, the bearing noise model
+  // and the noise check, the wheel check, the association (window, splits, joins, guarded and
+  // rejected bearings), the refinement's solver figures, each stage's time and the warnings
+  // (result_warnings).
+  std::string FullReport() const;
 };
 
 // The independent bearing noise [rad] that would do the harm the noise check found:
 // bearing_sigma x sqrt(noise.scale) (the sigma its messages advise); NaN when not checked.
 double effective_bearing_sigma(const CalibrationResult& result);
-// The same for the per-track part (Options::track_bias_sigma): track_bias_sigma x
+// The same for the per-track part (CalibrationOptions::noise.track_bias_sigma): track_bias_sigma x
 // sqrt(noise.scale); 0 when the model has none, NaN when not checked.
 double effective_track_bias_sigma(const CalibrationResult& result);
 // The bearing noise model in words, e.g. "0.025 deg" or "0.018 deg + 0.016 deg per track",
@@ -111,9 +103,7 @@ std::string noise_check_flags(const CalibrationResult& result);
 std::string noise_check_chance(double limit, const char* side, double level);
 
 // Throws InputError on invalid options or input (non-finite values, repeated track ids).
-CalibrationResult calibrate(const CalibrationRun& run,
-                            const Options& options,
-                            const CalibrateOptions& calibrate_options = {});
+CalibrationResult calibrate(const CalibrationRun& run, const CalibrationOptions& options = {});
 
 // What a user should be told about a result (empty when nothing): the filter's gate refused
 // more than 20% of the bearings after its start-up window (it has probably diverged, or the

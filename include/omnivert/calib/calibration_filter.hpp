@@ -3,7 +3,7 @@
 // features): feed it one FrameInput per image; it propagates with the wheel travels
 // (eq. 29, 31), updates with the bearings of the tracks it knows (eq. 30), adds the tracks
 // that start (FeatureInitializer) and marginalises the tracks that ended (not seen for
-// options.max_missed_frames frames).
+// options.association.max_missed_frames frames).
 //
 //   CalibrationFilter filter(options);
 //   for (const FrameInput& f : frames) filter.process(f);
@@ -17,8 +17,8 @@
 
 #include "omnivert/calib/feature_initializer.hpp"
 #include "omnivert/calib/filter_state.hpp"
+#include "omnivert/calib/options.hpp"
 #include "omnivert/calib/propagator.hpp"
-#include "omnivert/calib/types.hpp"
 #include "omnivert/calib/updater.hpp"
 
 namespace omnivert::calib {
@@ -32,7 +32,8 @@ struct FrameEstimate {
   int num_updates = 0;   // bearings used
   int num_rejected = 0;  // bearings refused by the chi-square gate
   int num_new = 0;       // tracks that entered
-  int num_guarded = 0;   // bearings left out where lines cross (Options::crossing_guard)
+  int num_guarded =
+      0;  // bearings left out where lines cross (CalibrationOptions::association.crossing_guard)
 };
 
 // The last estimate of a track while it was in the state: (D, theta) relative to the robot
@@ -48,7 +49,7 @@ struct TrackEstimate {
 class CalibrationFilter {
  public:
   // Throws omnivert::InputError when !options.IsValid().
-  explicit CalibrationFilter(const Options& options);
+  explicit CalibrationFilter(const CalibrationOptions& options);
 
   // One image frame. Throws InputError on non-finite wheel travel or bearings, or a track id
   // repeated within the frame.
@@ -73,19 +74,20 @@ class CalibrationFilter {
   // solved, why (the filter then ran over it from the prior, undelayed).
   int window_frames() const { return window_frames_; }
   const std::string& window_failure() const { return window_failure_; }
-  // Bearings left out where lines cross (Options::crossing_guard), in the window and after:
-  // (tracker's track id, frame).
+  // Bearings left out where lines cross (CalibrationOptions::association.crossing_guard), in the
+  // window and after: (tracker's track id, frame).
   const std::vector<std::pair<int, int>>& guarded() const { return guarded_; }
   // Bearings refused by the chi-square gate, in the window and after (tracker's track id,
   // frame). The bound of Sec. 8.1 for the filter's estimate is computed without these and
   // the guarded ones (calibrate()).
   const std::vector<std::pair<int, int>>& rejected() const { return rejected_; }
-  // New tracks taken for the continuation of a feature in the state (Options::join_pieces):
-  // (the feature's track id, the new track's id). The new track's bearings update that
-  // feature, and tracks() lists it with the feature's estimate.
+  // New tracks taken for the continuation of a feature in the state
+  // (CalibrationOptions::association.join_pieces): (the feature's track id, the new track's id).
+  // The new track's bearings update that feature, and tracks() lists it with the feature's
+  // estimate.
   const std::vector<std::pair<int, int>>& joins() const { return joins_; }
   int frames_processed() const { return frame_; }
-  const Options& options() const { return options_; }
+  const CalibrationOptions& options() const { return options_; }
 
  private:
   void admit(const FrameInput& frame);
@@ -116,12 +118,13 @@ class CalibrationFilter {
   // The slot of a track (a joined track's feature while that is in the state), -1 when not
   // in the state.
   int slot_of(int track_id) const;
-  // Joins the new tracks in `fresh` that continue a feature of the state (Options::join_pieces)
-  // and appends their bearings to z / z_ids; returns the new tracks left.
+  // Joins the new tracks in `fresh` that continue a feature of the state
+  // (CalibrationOptions::association.join_pieces) and appends their bearings to z / z_ids; returns
+  // the new tracks left.
   std::vector<const BearingObservation*> join_pieces(std::vector<const BearingObservation*> fresh,
                                                      std::vector<BearingMeasurement>* z,
                                                      std::vector<int>* z_ids);
-  Options options_;
+  CalibrationOptions options_;
   FilterState state_;
   Propagator propagator_;
   Updater updater_;
@@ -144,10 +147,10 @@ class CalibrationFilter {
   std::map<int, int> ahead_count_;            // frame -> bearings left out ahead
 };
 
-// The crossing guard ahead of a track's start (Options::crossing_guard): a track often starts
-// where its line parts from another, the extractor having seen the two as one before (the
-// other line's bearings pulled or pushed meanwhile), and the filter, which knows a line once
-// its track has started, cannot guard those frames as the batch problems do (reject_crossings
+// The crossing guard ahead of a track's start (CalibrationOptions::association.crossing_guard): a
+// track often starts where its line parts from another, the extractor having seen the two as one
+// before (the other line's bearings pulled or pushed meanwhile), and the filter, which knows a line
+// once its track has started, cannot guard those frames as the batch problems do (reject_crossings
 // widens each track's span by max_missed_frames). For each track b and each track a seen in
 // b's first frame k0 (and before it), the separation b - a is carried back from k0 at its
 // rate over b's first 3 frames both saw; a's bearings over the max_missed_frames frames
@@ -156,7 +159,7 @@ class CalibrationFilter {
 // (A line beside another before its track starts pushes that one's bearings off, and the
 // filter ends off by several of its sigmas: CrossingGuard.BeforeATrackStartsBesideAnother.)
 std::map<std::pair<int, int>, int> guard_before_starts(const CalibrationRun& run,
-                                                       const Options& options);
+                                                       const CalibrationOptions& options);
 
 // Runs the filter over a whole run.
 struct FilterResult {
@@ -171,6 +174,6 @@ struct FilterResult {
   std::vector<std::pair<int, int>> rejected;  // CalibrationFilter::rejected
   std::vector<std::pair<int, int>> joins;     // CalibrationFilter::joins
 };
-FilterResult run_filter(const CalibrationRun& run, const Options& options);
+FilterResult run_filter(const CalibrationRun& run, const CalibrationOptions& options);
 
 }  // namespace omnivert::calib

@@ -10,7 +10,7 @@ namespace omnivert::calib {
 
 // How large the extrinsics' error is, measured by the data (batch.cpp, noise_check). The
 // model covariance of (phi, rho, psi) assumes independent bearings of sigma
-// options.bearing_sigma; `bearing_part` is the share of it due to the bearings. The
+// options.noise.bearing_sigma; `bearing_part` is the share of it due to the bearings. The
 // cluster-robust (jackknife) estimate of that share, with each track's bearings as one
 // cluster, is `bearing_clustered`; scale = tr(bearing_part^-1 bearing_clustered) / 3 is 1 on
 // average when the assumed noise is right and above 1 when the bearings are noisier or
@@ -55,7 +55,7 @@ struct BatchNoiseCheck {
 bool noise_check_rejects_model(const BatchNoiseCheck& check, double level = 0.01);
 // Whether a check shows less noise than the model assumes: its scale below the `level`
 // quantile of chi-square(G) / G. calibrate() shrinks the bearings' share of the covariance
-// by it only where the tracker kept its lines (CalibrateOptions::noise_check): pieces of one
+// by it only where the tracker kept its lines (CalibrationOptions::noise_check): pieces of one
 // line left apart look like independent tracks to the check, which then reads less noise
 // than there is (docs/theory/noise-check.md). false when the check failed, has fewer
 // than 2 tracks, or level is not in (0, 0.5).

@@ -9,20 +9,20 @@
 //     two sigma; stored as (q = 1/D, theta) of the robot origin.
 
 #include "omnivert/calib/filter_state.hpp"
-#include "omnivert/calib/types.hpp"
+#include "omnivert/calib/options.hpp"
 
 namespace omnivert::calib {
 
 class FeatureInitializer {
  public:
-  explicit FeatureInitializer(const Options& options) : options_(options) {}
-  // Adds track `track_id`, first seen at bearing beta (sigma: Options::bearing_sigma x
-  // sigma_scale) in frame `frame`. Returns its slot.
+  explicit FeatureInitializer(const CalibrationOptions& options) : options_(options) {}
+  // Adds track `track_id`, first seen at bearing beta (sigma:
+  // CalibrationOptions::noise.bearing_sigma x sigma_scale) in frame `frame`. Returns its slot.
   int initialize(
       int track_id, double beta, int frame, FilterState* state, double sigma_scale = 1.0) const;
 
  private:
-  Options options_;
+  CalibrationOptions options_;
 };
 
 }  // namespace omnivert::calib

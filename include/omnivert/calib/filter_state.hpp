@@ -31,8 +31,8 @@ struct FeatureSlot {
   int first_frame = 0;
   int last_seen_frame = 0;
   int num_updates = 0;
-  // Options::track_bias_sigma > 0: the block ends with one more entry, the track's constant
-  // bearing error b (each bearing is eq. (30) + b); size is then feature_param_size + 1.
+  // CalibrationOptions::noise.track_bias_sigma > 0: the block ends with one more entry, the track's
+  // constant bearing error b (each bearing is eq. (30) + b); size is then feature_param_size + 1.
   bool bias = false;
   // Index in x of b (bias only).
   int bias_index() const { return index + size - 1; }

@@ -13,7 +13,7 @@
 #include <utility>
 #include <vector>
 
-#include "omnivert/calib/types.hpp"
+#include "omnivert/calib/options.hpp"
 
 namespace omnivert::calib {
 
@@ -164,9 +164,9 @@ Vec2 point_to_distance_form(const Vec2& p, Mat2* J_out_p = nullptr);
 Vec3 camera_pose_from_extrinsics(const Extrinsics& ex, Mat3* J_cam_ex = nullptr);
 Extrinsics extrinsics_from_camera_pose(const Vec3& cam, Mat3* J_ex_cam = nullptr);
 
-// The crossing guard's test (Options::crossing_guard): of directions (angle [rad], key), the
-// keys with another direction within `guard` of theirs on the circle; a pair for which
-// same_line(key_a, key_b) is true does not count (two parts of one split track).
+// The crossing guard's test (CalibrationOptions::association.crossing_guard): of directions (angle
+// [rad], key), the keys with another direction within `guard` of theirs on the circle; a pair for
+// which same_line(key_a, key_b) is true does not count (two parts of one split track).
 std::set<int> crowded_directions(std::vector<std::pair<double, int>> directions,
                                  double guard,
                                  const std::function<bool(int, int)>& same_line = {});

@@ -7,7 +7,7 @@
 #include <Eigen/Core>
 
 #include "omnivert/calib/batch_point.hpp"
-#include "omnivert/calib/types.hpp"
+#include "omnivert/calib/options.hpp"
 
 namespace omnivert::calib {
 
@@ -15,19 +15,6 @@ namespace omnivert::calib {
 struct ParameterVerdict {
   bool determined = false;
   double crlb = 0.0;  // Cramer-Rao standard deviation (infinity when not determined)
-};
-
-struct ObservabilityOptions {
-  double max_sigma_angle = 0.035;           // [rad] (2 degrees) an angle with a larger bound is
-                                            // reported as not determined
-  double max_sigma_rho = 0.02;              // [m]
-  double relative_eigenvalue_floor = 1e-9;  // eigenvalues below floor * max count as zero
-  // phi, rho and psi individually need the robot to turn (Sec. 8.1). A run whose heading
-  // spans less than this many sigmas of its own odometry noise did not turn: the bounds at
-  // its estimated trajectory come from heading noise (a straight run at 0.025 degree of
-  // bearing noise: rho's bound 15.6 mm, under the 2 cm above), and they are not determined.
-  double min_rotation_sigmas = 5.0;
-  // (numerical null directions reach 2e-12)
 };
 
 // Sec. 8.1 for a recorded trajectory, from the Fisher information J^T Sigma^-1 J of the batch
@@ -49,9 +36,7 @@ struct ObservabilityReport {
 };
 
 ObservabilityReport analyse_observability(const CalibrationRun& run,
-                                          const Options& options,
-                                          const BatchPoint& at,
-                                          const BatchOptions& batch = {},
-                                          const ObservabilityOptions& obs = {});
+                                          const CalibrationOptions& options,
+                                          const BatchPoint& at);
 
 }  // namespace omnivert::calib

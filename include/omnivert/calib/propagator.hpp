@@ -9,13 +9,13 @@
 #include <Eigen/Core>
 
 #include "omnivert/calib/filter_state.hpp"
-#include "omnivert/calib/types.hpp"
+#include "omnivert/calib/options.hpp"
 
 namespace omnivert::calib {
 
 class Propagator {
  public:
-  explicit Propagator(const Options& options) : options_(options) {}
+  explicit Propagator(const CalibrationOptions& options) : options_(options) {}
   // One odometry step of wheel travels (d_right, d_left) [m].
   void propagate(double d_right, double d_left, FilterState* state) const;
   // One frame's motion (FrameInput: wheel travels and sideways displacement). With a
@@ -25,7 +25,7 @@ class Propagator {
   void propagate(const FrameInput& frame, FilterState* state) const;
 
  private:
-  Options options_;
+  CalibrationOptions options_;
 };
 
 // The two steps of eq. (14), (d_right, d_left) each, that compose to one step with the

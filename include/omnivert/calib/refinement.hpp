@@ -11,7 +11,7 @@
 
 #include "omnivert/calib/batch_point.hpp"
 #include "omnivert/calib/diagnostics.hpp"
-#include "omnivert/calib/types.hpp"
+#include "omnivert/calib/options.hpp"
 
 namespace omnivert::calib {
 
@@ -27,15 +27,15 @@ struct RefinementResult {
   int num_bearings = 0;  // bearings used
   int num_rejected = 0;  // bearings removed as outliers (|residual| > the filter's gate)
   int num_features = 0;  // tracks in the problem (after splitting)
-  int num_splits = 0;    // tracks split in two (BatchOptions::split_chi2)
+  int num_splits = 0;    // tracks split in two (CalibrationOptions::association.split_chi2)
   // (track id, first frame of the new part): the tracker's id, or with merges the id of the
   // line's first piece.
   std::vector<std::pair<int, int>> splits;
-  // Pieces of one line joined (BatchOptions::merge_pieces): (earlier track id, later track
-  // id), the later piece's bearings renamed to the line's first piece.
+  // Pieces of one line joined (CalibrationOptions::association.join_pieces): (earlier track id,
+  // later track id), the later piece's bearings renamed to the line's first piece.
   std::vector<std::pair<int, int>> merges;
-  // Bearings left out where lines cross (Options::crossing_guard): (track id of the solved
-  // run, i.e. of solved_run when tracks were split or merged, frame).
+  // Bearings left out where lines cross (CalibrationOptions::association.crossing_guard): (track id
+  // of the solved run, i.e. of solved_run when tracks were split or merged, frame).
   std::vector<std::pair<int, int>> guarded;
   // Bearings removed as outliers (the gate) or with a feature left with too few bearings:
   // (track id of the solved run, frame). With `guarded`, what the solution did not use; the
@@ -55,11 +55,11 @@ struct RefinementResult {
 
 // Batch maximum-likelihood refinement over the whole run (Ceres, Levenberg-Marquardt),
 // started from `start`, with the covariance of (phi, rho, psi) from ceres::Covariance.
-// Bearings whose residual exceeds the filter's chi-square gate (options.gate_probability)
-// at the solution are removed and the problem solved again (up to three rounds).
+// Bearings whose residual exceeds the filter's chi-square gate
+// (options.association.gate_probability) at the solution are removed and the problem solved again
+// (up to three rounds).
 RefinementResult refine_batch(const CalibrationRun& run,
-                              const Options& options,
-                              const BatchPoint& start,
-                              const BatchOptions& batch = {});
+                              const CalibrationOptions& options,
+                              const BatchPoint& start);
 
 }  // namespace omnivert::calib

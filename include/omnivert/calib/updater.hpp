@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "omnivert/calib/filter_state.hpp"
-#include "omnivert/calib/types.hpp"
+#include "omnivert/calib/options.hpp"
 
 namespace omnivert::calib {
 
@@ -26,7 +26,7 @@ double chi2_quantile(double p, int dof);
 struct BearingMeasurement {
   int slot = -1;             // feature slot in the state
   double beta = 0.0;         // measured bearing [rad]
-  double sigma_scale = 1.0;  // its sigma is Options::bearing_sigma x this
+  double sigma_scale = 1.0;  // its sigma is CalibrationOptions::noise.bearing_sigma x this
 };
 
 struct BearingUpdateResult {
@@ -36,7 +36,7 @@ struct BearingUpdateResult {
 
 class Updater {
  public:
-  explicit Updater(const Options& options);
+  explicit Updater(const CalibrationOptions& options);
   // Updates the state with all bearings of one frame at once (eq. 30: one stacked h, one
   // linearisation point for the frame, so that sequential scalar updates cannot gain
   // information along directions the frame does not observe). Innovations are wrapped; a
@@ -48,7 +48,7 @@ class Updater {
   // The gate's statistic of one bearing against the state's prediction, without updating:
   // the normalised innovation squared r^2 / (H P H^T + R) (R with the second-order term).
   double innovation_chi2(const FilterState& state, const BearingMeasurement& z) const;
-  // The chi-square gate (Options::gate_probability, 1 degree of freedom).
+  // The chi-square gate (CalibrationOptions::association.gate_probability, 1 degree of freedom).
   double gate() const { return gate_; }
 
  private:
@@ -61,7 +61,7 @@ class Updater {
   double measurement_variance(const FilterState& state, const BearingMeasurement& z) const;
   // Variance added by the curvature of h (second-order filter), see the source.
   double second_order_variance(const FilterState& state, const BearingMeasurement& z) const;
-  Options options_;
+  CalibrationOptions options_;
   double gate_;
 };
 

@@ -78,6 +78,17 @@ class DescriptorExtractor {
 
   const DescriptorOptions& options() const { return options_; }
 
+  // Image mask (image_mask.hpp: CV_8UC1, non-zero = usable) for the following calls, whose
+  // images must have its size; docs/extraction.md#image-masks. Masked pixels add nothing to
+  // the histograms: in the blur reading the image is blurred by normalised convolution
+  // (blur(I M) / blur(M): masked pixels are filled from the usable ones around them, so the
+  // mask's border makes no gradient) and each gradient sample votes with the usable fraction
+  // of its cell; in the weight reading a pixel whose Sobel window touches the mask does not
+  // vote. Normalisation is unchanged: a partly masked area is described by its usable pixels,
+  // scaled to unit length like any other; a wholly masked unit stays zero. An empty or
+  // all-usable mask: no mask (bit-identical descriptors).
+  void set_mask(const cv::Mat& usable);
+
   // Centres (image pixels) and radius of the circular areas of a line at image angle a.
   std::vector<cv::Point2d> area_centers(const MirrorCircle& circle, double image_angle) const;
   double area_radius(const MirrorCircle& circle) const;
@@ -91,6 +102,9 @@ class DescriptorExtractor {
   cv::Rect roi_;  // region of the frame the gradient images cover
   int step_ = 1;  // one gradient sample every step_ pixels (blur reading)
   cv::Mat full_, blurred_, gx_, gy_;
+  cv::Mat usable_;         // set_mask; empty: no mask
+  cv::Mat sample_usable_;  // per gradient sample: usable fraction in [0, 1] (CV_32F); or empty
+  cv::Mat mask_f_, weight_;
   cv::Mat log_lut_;  // grey level -> log(offset + I) (or I)
   double log_lut_offset_ = -1;
   bool log_lut_log_ = false;

@@ -13,6 +13,7 @@
 #include "omnivert/describe/frame_features.hpp"
 #include "omnivert/extract/line_extractor.hpp"
 #include "omnivert/extract/mirror_center.hpp"
+#include "omnivert/extract/tilt_estimator.hpp"
 
 namespace omnivert {
 
@@ -29,22 +30,37 @@ struct FeaturePipelineOptions {
   // calibrated camera 0.14 mm forward; docs/theory/extraction.md#a-given-centre). True: the given
   // centre only seeds the search, and the centre is fitted and tracked as without it.
   bool refine_given_center = false;
+  // Tilt vector t (cos d, sin d) [rad] of the mirror axis (core/tilt.hpp). Non-zero, with the
+  // camera's xi and gamma known: every frame is rectified to the upright camera before the
+  // lines are extracted and described, so that their bearings are the upright ones of
+  // eq. (16)-(17) (docs/theory/tilt.md). Zero: frames are used as they are.
+  Eigen::Vector2d tilt = Eigen::Vector2d::Zero();
 
   bool IsValid(std::string* why) const;
 };
 
 class FeaturePipeline {
  public:
+  // With geometry.mask set, reads that mask (read_mask: InputError naming the mask file) and
+  // hands it to every stage (set_mask).
   FeaturePipeline(CameraGeometry geometry, FeaturePipelineOptions options = {});
 
-  // Processes one image (8-bit or 16-bit, grey or colour; converted to 8-bit grey). Returns
+  // Image mask for every stage (image_mask.hpp: CV_8UC1, non-zero = usable; empty: none).
+  // The first frame is refused when less than kMinUsableAnnulus of the annulus is usable.
+  void set_mask(const cv::Mat& usable);
+  const cv::Mat& mask() const { return mask_; }
+  static constexpr double kMinUsableAnnulus = 0.2;
+
+  // Processes one image (8-bit or 16-bit, grey, colour or a Bayer mosaic: converted to 8-bit
+  // grey by to_grey8 with the camera's pixel_format). Returns
   // false with a reason in *why for an image that does not fit the camera (wrong size, the
   // annulus mostly outside the image) or whose mirror cannot be found on the first frame.
   // A later frame whose rim is not found keeps the previous centre (and says so in *why,
   // while still returning true).
   bool process(const cv::Mat& image, FrameFeatures& out, std::string* why = nullptr);
 
-  // Converts any supported image to 8-bit grey; false if the type is not supported.
+  // Converts a grey or colour image to 8-bit grey (to_grey8 with the default PixelFormat);
+  // false if the type is not supported.
   static bool to_gray8(const cv::Mat& image, cv::Mat& gray);
 
   const CameraGeometry& geometry() const { return geometry_; }
@@ -61,9 +77,16 @@ class FeaturePipeline {
   DescriptorExtractor descriptors_;
   std::optional<MirrorCircle> circle_;
   cv::Mat gray_;
+  cv::Mat mask_;
+  std::optional<TiltRectifier> rectifier_;
+  cv::Mat upright_;
 };
 
 // Fraction of the annulus r_min..r_max around `circle.center` that lies inside a w x h image.
 double annulus_fraction_inside(const MirrorCircle& circle, int width, int height);
+
+// Fraction of the annulus r_min..r_max around `circle.center`, inside the mask's image, that
+// the mask leaves usable (area-weighted samples, as above).
+double annulus_fraction_usable(const MirrorCircle& circle, const cv::Mat& usable);
 
 }  // namespace omnivert

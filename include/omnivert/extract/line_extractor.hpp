@@ -96,6 +96,14 @@ class LineExtractor {
 
   const LineExtractorOptions& options() const { return options_; }
 
+  // Image mask (image_mask.hpp: CV_8UC1, non-zero = usable) for the following calls of
+  // extract, whose images must have its size. Step 2 skips every pixel whose 3x3 Sobel window
+  // touches a masked pixel (the usable area eroded by one pixel), so masked pixels cast no
+  // votes and the mask's own border makes no edge. An empty or all-usable mask: no mask (the
+  // unmasked pass, bit-identical results).
+  void set_mask(const cv::Mat& usable);
+  bool has_mask() const { return !sobel_usable_.empty(); }
+
   // Edge pixels of the last call (after thinning), for drawing and tests: sub-pixel
   // position in the image.
   struct EdgePoint {
@@ -169,6 +177,8 @@ class LineExtractor {
   // Step 2: one pass over the annulus (rounded centre cxi, cyi): Sobel (eq. 1), magnitude
   // threshold, orientation test; fills cands_ and mag_.
   void edge_pass(const cv::Mat& gray, int cxi, int cyi);
+  template <bool kMasked>
+  void edge_pass_impl(const cv::Mat& gray, int cxi, int cyi);
   // Step 3: thinning along the gradient, sub-pixel position, soft sector votes into hist_;
   // fills edges_ ((fx, fy): the centre's offset from (cxi, cyi)) and clears mag_.
   void vote_sectors(int cxi, int cyi, float fx, float fy);
@@ -186,6 +196,8 @@ class LineExtractor {
   void refit_crowded_lines(const MirrorCircle& circle);
   // Histogram thresholding (Sec. 2, last step) of found_ into out, sorted by image angle.
   void threshold_lines(const MirrorCircle& circle, std::vector<VerticalLine>& out);
+  // Pixels whose Sobel window is wholly usable (set_mask); empty: no mask.
+  cv::Mat sobel_usable_;
   // Reused buffers (no allocation per frame once warmed up).
   cv::Mat mag_;  // float magnitude of candidates (0 elsewhere)
   std::vector<Candidate> cands_;

@@ -9,9 +9,17 @@
 // circle (least squares, outliers rejected) to rim points found with sub-pixel precision
 // along rays from the coarse centre.
 //
-// Without a known rim radius, `estimate` finds the centre from all circular edges (their
-// gradient lines meet at the centre) and then the rim radius from the radial edge profile;
-// this is meant for one static image, as in the paper, and its result seeds `detect`.
+// Without a known rim radius, `estimate` finds the rim as a circle Hough transform (every
+// edge pixel votes along its gradient line, for every radius from 30% of the image's
+// smaller side up, so a rim darker or brighter outward counts alike) on a copy at most 320
+// pixels across; each of the best ten circles is refined on rays at full resolution (the
+// strongest radial step of either sign near the circle, a robust circle fit) and the rim is
+// the circle found within one pixel on the most rays (at least 30% of its circumference
+// inside the image). Rays that leave the image are skipped, so a rim cut off by the frame is fitted
+// on its visible arcs; the fit must hold a quarter of the rays and three quadrants of the circle
+// (docs/extraction.md#mirror-centre-and-annulus). This is meant for one static image, as in the
+// paper, and its result seeds `detect`; `estimate_camera` (extract/camera_estimate.hpp) combines
+// many frames.
 
 #include <optional>
 #include <string>
@@ -46,7 +54,7 @@ class MirrorCenterDetector {
 
   // Finds centre, rim radius and annulus on an 8-bit grey image with nothing known but what
   // `geometry` gives (centre, r_min, r_max are used as given when present). Returns nullopt
-  // if no circle is found (a message in *why when not null).
+  // if no rim is found (a message in *why, when not null, saying what to give instead).
   std::optional<MirrorCircle> estimate(const cv::Mat& gray,
                                        const CameraGeometry& geometry,
                                        std::string* why = nullptr) const;
@@ -62,10 +70,24 @@ class MirrorCenterDetector {
   // circle fit). Returns false if fewer than a quarter of the rays found the rim.
   bool refine(const cv::Mat& gray, Eigen::Vector2d& center, double& rim_radius) const;
 
+  // Radius r_min of the valid annulus from the camera's self-reflection (a dark disc about
+  // `center`, searched between 5% and 50% of r_max) plus inner_margin_fraction; 0.25 r_max
+  // when no such disc is seen.
+  double self_reflection_radius(const cv::Mat& gray,
+                                const Eigen::Vector2d& center,
+                                double r_max) const;
+
   const MirrorCenterOptions& options() const { return options_; }
+
+  // Image mask (image_mask.hpp: CV_8UC1, non-zero = usable) for the following calls, whose
+  // images must have its size. Pixels whose Sobel window touches a masked pixel cast no
+  // centre votes and do not count in the rim's coverage, and rays whose rim window touches
+  // one give no rim point. An empty or all-usable mask: no mask (bit-identical results).
+  void set_mask(const cv::Mat& usable);
 
  private:
   MirrorCenterOptions options_;
+  cv::Mat usable_;  // the mask eroded by the Sobel radius; empty: no mask
 };
 
 }  // namespace omnivert

@@ -31,17 +31,20 @@ namespace omnivert::pipeline {
 
 struct CalibrateDatasetOptions {
   FeaturePipelineOptions features;  // extraction and descriptor (Sec. 2-3)
+  // Image mask file used instead of the `mask:` of cam0/sensor.yaml; empty: that one, if any.
+  std::string mask;
   // The tracker; its odometry gate takes the wheel base of wheel0/sensor.yaml.
   TrackerOptions tracker = recommended_dataset_tracker_options();
-  // Prior and models. The wheel base and Chong-Kleeman K come from wheel0/sensor.yaml
-  // (calib::options_from_dataset); everything else from here.
-  calib::Options calibration = calib::recommended_options();
-  calib::CalibrateOptions run;     // refinement, noise check, batch options
+  // The estimator's options: prior, models, filter, refinement, noise check. The wheel base and
+  // Chong-Kleeman K come from wheel0/sensor.yaml (calib::options_from_dataset); everything else
+  // from here.
+  calib::CalibrationOptions calibration = calib::recommended_options();
   calib::DatasetRunOptions input;  // wheel gaps, crowded lines
   std::string tracks_file;         // non-empty: calibrate from this earlier tracks.csv
   bool force = false;              // write extrinsics.yaml even when undetermined
   std::string command;             // the command line, recorded in the report
   std::vector<std::string> notes;  // extra warnings of the caller, reported with the rest
+  TiltCheckOptions tilt;           // the tilt of the mirror axis (pipeline/tilt_check.hpp)
   // Called while tracking (stage "track", frames done, frames in all) and once before the
   // calibration (stage "calibrate", 0, 0).
   std::function<void(const std::string& stage, std::size_t done, std::size_t total)> progress;
@@ -55,7 +58,9 @@ struct CalibrateDatasetResult {
   std::vector<std::string> warnings;       // tracking's, the input's and the estimate's
   bool wrote_extrinsics = false;           // determined, or forced
   std::string out_dir;
-  bool noise_check_requested = true;  // CalibrateOptions::noise_check of the run
+  bool noise_check_requested = true;  // CalibrationOptions::noise_check.enabled of the run
+  TiltEstimate tilt;                  // measured before tracking (not valid: not measured)
+  bool tilt_corrected = false;        // the frames were rectified with tilt.vector
 
   // The answer: the refinement's estimate when it ran and its covariance is usable, else the
   // filter's (the same as calibration.extrinsics / calibration.covariance).

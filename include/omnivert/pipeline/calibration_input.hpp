@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "omnivert/calib/types.hpp"
+#include "omnivert/calib/options.hpp"
 #include "omnivert/dataset/dataset.hpp"
 #include "omnivert/match/tracks_io.hpp"
 
@@ -54,8 +54,8 @@ DatasetRun calibration_run_from_tracks(const dataset::Dataset& data,
                                        const std::vector<TrackRow>& rows,
                                        const DatasetRunOptions& options = {});
 
-// Options filled from the dataset: wheel base from wheel0/sensor.yaml, Chong-Kleeman K from
-// its odometry_k when given (else the default of Options), the rest from `base`.
-Options options_from_dataset(const dataset::Dataset& data, Options base = {});
+// CalibrationOptions filled from the dataset: wheel base from wheel0/sensor.yaml, Chong-Kleeman K
+// from its odometry_k when given (else the default of CalibrationOptions), the rest from `base`.
+CalibrationOptions options_from_dataset(const dataset::Dataset& data, CalibrationOptions base = {});
 
 }  // namespace omnivert::calib

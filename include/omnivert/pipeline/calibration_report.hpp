@@ -38,7 +38,7 @@ struct ReportInputs {
   std::int64_t detections = 0;
   std::int64_t tracks_total = 0;  // tracks found by the tracker
   const DatasetRun* run = nullptr;
-  Options options;
+  CalibrationOptions options;
   std::optional<Extrinsics> truth;  // ground_truth/extrinsics.yaml
   bool force = false;
   int exit_code = 0;

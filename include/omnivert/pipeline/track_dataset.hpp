@@ -17,6 +17,7 @@
 #include "omnivert/describe/feature_pipeline.hpp"
 #include "omnivert/match/tracker.hpp"
 #include "omnivert/match/tracks_io.hpp"
+#include "omnivert/pipeline/tilt_check.hpp"
 
 namespace omnivert {
 
@@ -26,6 +27,12 @@ struct TrackDatasetOptions {
   // Use the wheel odometry for the tracker's bearing gate when the dataset has it (and the
   // gate is enabled in `tracker`; its wheel base is taken from wheel0/sensor.yaml).
   bool use_odometry = true;
+  // Image mask file (image_mask.hpp) used instead of the `mask:` of cam0/sensor.yaml; empty:
+  // that one, if any.
+  std::string mask;
+  // The tilt of the mirror axis: measured first (when pipeline.tilt is zero and the camera's
+  // xi and gamma are known), warned about and corrected above its thresholds.
+  TiltCheckOptions tilt;
 };
 
 struct TrackDatasetResult {
@@ -35,6 +42,8 @@ struct TrackDatasetResult {
   std::int64_t frames_skipped = 0;  // unreadable, or no mirror found
   std::vector<std::string> warnings;
   std::vector<FrameFeatures> features;  // per frame, when keep_features is set
+  TiltEstimate tilt;                    // the measured tilt (not valid: not measured)
+  bool tilt_corrected = false;          // frames rectified with tilt.vector
 };
 
 // `progress(done, total)` is called after each frame when set.

@@ -38,6 +38,11 @@ struct CatadioptricCamera {
   double r_min = 60.0;   // valid annulus [px]
   double r_max = 215.0;
   int bearing_sign = 1;  // +1: a = beta; -1: a = -beta (docs/theory/conventions.md)
+  // Tilt of the mirror axis from the vertical [deg], leaning towards the camera bearing
+  // tilt_direction_deg (core/tilt.hpp, docs/theory/tilt.md). The model above holds in the
+  // mirror's own frame; the renderer rotates the viewing directions. 0: upright.
+  double tilt_deg = 0.0;
+  double tilt_direction_deg = 0.0;
 
   // Radius [px] of the elevation el [rad]; el must lie in the valid domain.
   double radius_of_elevation(double el) const;

@@ -14,7 +14,12 @@
 // vertical edges it contains (analytic coverage in azimuth), so a vertical edge lands at its
 // exact sub-pixel bearing; horizontal texture edges, wall tops and bottoms are box-filtered
 // in height; floor and ceiling tiles are blended over the footprint.
+//
+// Tilt. With CatadioptricCamera::tilt_deg != 0 the image is that of an upright camera
+// warped to the tilted one (sim/tilt_warp.hpp, docs/simulator.md#tilt); visible_lines() keeps
+// the upright bearings, the ones eq. (16)-(17) predict, and render_reference() draws upright.
 
+#include <memory>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -23,6 +28,8 @@
 #include "omnivert/sim/world.hpp"
 
 namespace omnivert::sim {
+
+class TiltWarp;
 
 // The camera's pose in the world: centre (x, y) [m], height above the floor [m], and the
 // heading of the camera x-axis [rad] (theta_R + phi + psi, docs/theory/conventions.md).
@@ -89,6 +96,7 @@ class Renderer {
 
   CatadioptricCamera camera_;
   World world_;
+  std::shared_ptr<const TiltWarp> tilt_;  // set when the camera is tilted
   std::vector<VerticalEdge> edges_;
   std::vector<WallTexture> textures_;
   std::vector<double> wall_top_;

@@ -2,7 +2,7 @@
 // The simulator: drives a robot with a catadioptric camera through a world and writes a
 // dataset in the layout every omnivert tool reads (docs/simulator.md, dataset/dataset.hpp):
 //
-//   cam0/data.csv, cam0/data/<timestamp>.png, cam0/sensor.yaml
+//   cam0/data.csv, cam0/data/<timestamp>.png, cam0/sensor.yaml (cam0/mask.png when asked)
 //   wheel0/data.csv, wheel0/sensor.yaml
 //   ground_truth/extrinsics.yaml, poses.csv, lines.csv, edges.csv, world.yaml,
 //   ground_truth/simulation.yaml (every setting used, for reproduction)
@@ -16,6 +16,7 @@
 
 #include "omnivert/sim/camera_model.hpp"
 #include "omnivert/sim/renderer.hpp"
+#include "omnivert/sim/robot_overlay.hpp"
 #include "omnivert/sim/sensors.hpp"
 #include "omnivert/sim/trajectory.hpp"
 #include "omnivert/sim/world.hpp"
@@ -41,6 +42,7 @@ struct SimConfig {
   Extrinsics extrinsics;
   WheelConfig wheel;
   ImageSensor image;
+  RobotOverlay overlay;        // struts and the robot's reflection in the image; none by default
   double min_clearance = 0.2;  // the robot centre keeps this far from every wall [m]
   double min_line_px = 2.0;    // ground-truth lines shorter than this (radially) are left out
 };

@@ -7,6 +7,7 @@
 
 #include "omnivert/describe/descriptor.hpp"
 #include "omnivert/describe/frame_features.hpp"
+#include "omnivert/extract/camera_estimate.hpp"
 
 namespace omnivert {
 
@@ -16,5 +17,11 @@ cv::Mat draw_overlay(const cv::Mat& image,
                      const FrameFeatures& features,
                      const DescriptorExtractor& descriptor,
                      int highlight = -1);
+
+// Returns a BGR picture of a camera estimate on one of its frames: the rim (yellow), the
+// annulus r_min..r_max (blue), the centre (red cross), every frame's centre (green dots, at
+// 10x their offset from the joint centre, so a spread of 1 px shows as 10 px) and the pixels
+// the proposed mask excludes inside the annulus, tinted red.
+cv::Mat draw_camera_overlay(const cv::Mat& image, const CameraEstimate& estimate);
 
 }  // namespace omnivert

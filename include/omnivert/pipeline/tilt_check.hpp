@@ -1,0 +1,38 @@
+#pragma once
+// The tilt of the mirror axis measured on a dataset before tracking (docs/theory/tilt.md):
+// a few frames spread over the dataset go through the frame pipeline with a wider line
+// support (a tilted vertical is a curve, not a radial line), and the TiltEstimator fits the
+// tilt to the edge pixels of all their lines.
+
+#include <string>
+
+#include "omnivert/dataset/dataset.hpp"
+#include "omnivert/describe/feature_pipeline.hpp"
+#include "omnivert/extract/tilt_estimator.hpp"
+
+namespace omnivert {
+
+struct TiltCheckOptions {
+  bool enabled = true;  // measure when the camera's xi and gamma are known
+  int frames = 20;      // frames spread evenly over the dataset
+  // Above this the frames are rectified to the upright camera before tracking
+  // (FeaturePipelineOptions::tilt); above estimator.warn_deg a warning says so.
+  double correct_deg = 0.25;
+  // The line support of the measuring pass [px]: wide enough for a curved vertical
+  // (up to 3.4 px off its best radial line at 3 degrees, docs/theory/tilt.md).
+  double lateral_tolerance_px = 3.5;
+  TiltEstimatorOptions estimator;
+
+  bool IsValid(std::string* why) const;
+};
+
+// The tilt over `options.frames` frames of `data`, extracted with `pipeline` (its own tilt
+// is ignored). Not valid when the camera has no xi and gamma or too few lines were found.
+TiltEstimate measure_tilt(const dataset::Dataset& data,
+                          const FeaturePipelineOptions& pipeline,
+                          const TiltCheckOptions& options);
+
+// The warning for an estimate above options.estimator.warn_deg, else an empty string.
+std::string tilt_warning(const TiltEstimate& tilt, const TiltCheckOptions& options, bool corrected);
+
+}  // namespace omnivert
