@@ -117,6 +117,7 @@ void run_extract(const ExtractArgs& a) {
       jl["r_outer"] = l.r_outer;
       jl["polarity"] = l.polarity;
       jl["crowded"] = l.crowded;
+      jl["significance"] = l.significance;
       const auto row = f.descriptors.row(static_cast<Eigen::Index>(i));
       jl["descriptor"] = std::vector<float>(row.data(), row.data() + row.size());
       j["lines"].push_back(std::move(jl));
@@ -135,7 +136,7 @@ void run_extract(const ExtractArgs& a) {
     if (geometry.has_projection()) {
       std::printf("%s%s\n", tilt.describe().c_str(), corrected ? "; bearings upright" : "");
     }
-    std::printf("%4s %12s %16s %11s %9s %9s %8s %8s\n",
+    std::printf("%4s %12s %16s %11s %9s %9s %8s %8s %8s\n",
                 "line",
                 "bearing[deg]",
                 "image_angle[deg]",
@@ -143,10 +144,11 @@ void run_extract(const ExtractArgs& a) {
                 "r_inner",
                 "r_outer",
                 "fit[px]",
-                "crowded");
+                "crowded",
+                "signif");
     for (std::size_t i = 0; i < f.lines.size(); ++i) {
       const auto& l = f.lines[i];
-      std::printf("%4zu %12.3f %16.3f %11d %9.1f %9.1f %8.2f %8s\n",
+      std::printf("%4zu %12.3f %16.3f %11d %9.1f %9.1f %8.2f %8s %8.1f\n",
                   i,
                   rad2deg(l.bearing),
                   rad2deg(l.image_angle),
@@ -154,7 +156,8 @@ void run_extract(const ExtractArgs& a) {
                   l.r_inner,
                   l.r_outer,
                   l.fit_rms_px,
-                  l.crowded ? "yes" : "");
+                  l.crowded ? "yes" : "",
+                  l.significance);
     }
   }
   if (!a.overlay.empty()) {

@@ -4,6 +4,8 @@
 //   study sensitivity DATA   % correct NN vs clip, noise, bins/areas; rule PDFs (Figs. 13-18;
 //                            eval/sensitivity_study.hpp)
 //   study baselines DATA     precision/recall of ours, ZNCC and LBD on the same frames
+//   study real-images DIR    lines, rotation and lighting repeatability on real images
+//                            (tools/cmd_study_real.cpp, eval/real_image_study.hpp)
 
 #include <cmath>
 #include <cstdio>
@@ -368,6 +370,8 @@ void add_study_command(CLI::App& app) {
       "baselines", "Precision/recall of ours, ZNCC and LBD on the same frames");
   add_dataset_options(base, *b);
   base->callback([b] { run_baselines(*b); });
+
+  add_real_images_study(study);
 }
 
 }  // namespace omnivert::cli

@@ -57,6 +57,8 @@ void add_track_command(CLI::App& app);
 void add_evaluate_command(CLI::App& app);
 // omnivert study similarity|sensitivity|baselines: the descriptor study (tools/cmd_study.cpp).
 void add_study_command(CLI::App& app);
+// `study real-images`, a subcommand of `study` (tools/cmd_study_real.cpp).
+void add_real_images_study(CLI::App* study);
 // omnivert calibrate: the main job (tools/cmd_calibrate.cpp).
 void add_calibrate_command(CLI::App& app);
 

@@ -44,13 +44,16 @@ inline void add_tilt_options(CLI::App* cmd, TiltCheckOptions& o) {
 inline void add_pipeline_options(CLI::App* cmd, FeaturePipelineOptions& o) {
   const std::string g = kExtractionGroup;
   static const std::map<std::string, LineThreshold> kThreshold{
+      {"significance", LineThreshold::kSignificance},
       {"fraction", LineThreshold::kFractionOfAnnulus},
       {"adaptive", LineThreshold::kAdaptive},
       {"topk", LineThreshold::kTopK}};
   cmd->add_option("--line-threshold",
                   o.lines.threshold,
                   "Which lines to keep: fraction (>= --length-fraction of R_max - R_min, the "
-                  "paper's), adaptive (mean + 3 sigma of candidate lengths), topk")
+                  "paper's), significance (fewer than 1 false alarm expected among random edge "
+                  "pixels, a contrario), adaptive (mean + 3 sigma "
+                  "of candidate lengths), topk")
       ->transform(CLI::CheckedTransformer(kThreshold, CLI::ignore_case))
       ->group(g);
   cmd->add_option("--peak-window",
@@ -70,6 +73,12 @@ inline void add_pipeline_options(CLI::App* cmd, FeaturePipelineOptions& o) {
                   o.lines.length_fraction,
                   "Line length threshold as a fraction of the annulus")
       ->check(CLI::Range(0.01, 1.0))
+      ->capture_default_str()
+      ->group(g);
+  cmd->add_option("--min-significance",
+                  o.lines.min_significance,
+                  "Lines kept with --line-threshold significance: -log10 NFA at least this")
+      ->check(CLI::Range(-10.0, 1000.0))
       ->capture_default_str()
       ->group(g);
   cmd->add_option("--top-k", o.lines.top_k, "Lines kept per frame with --line-threshold topk")

@@ -30,6 +30,8 @@ bool LineExtractorOptions::IsValid(std::string* why) const {
   if (!(adaptive_k >= 0)) return fail("adaptive_k must not be negative");
   if (top_k < 1) return fail("top_k must be at least 1");
   if (!(min_fraction >= 0 && min_fraction <= 1)) return fail("min_fraction must be in [0, 1]");
+  if (!(min_significance >= -10 && min_significance <= 1000))
+    return fail("min_significance must be in [-10, 1000]");
   return true;
 }
 
@@ -72,6 +74,48 @@ double principal_angle(double sxx, double sxy, double syy, double near_a) {
   double b = 0.5 * std::atan2(2 * sxy, sxx - syy);
   if (std::cos(b - near_a) < 0) b += kPi;
   return b;
+}
+
+// log10 of the Chernoff bound of the binomial tail, P[B(n, p) >= k] <= exp(-n KL(k/n || p))
+// (exact when k = n); 0 when k/n <= p.
+double log10_binomial_tail(int k, int n, double p) {
+  const double r = static_cast<double>(k) / n;
+  if (r <= p) return 0.0;
+  double kl = r * std::log(r / p);
+  if (r < 1) kl += (1 - r) * std::log((1 - r) / (1 - p));
+  return -n * kl / std::log(10.0);
+}
+
+// Significance of a line (docs/theory/extraction.md#significance): -log10 of the smallest
+// NFA = 10^log10_tests * P[B(n, p) >= k] over the intervals of radii from the start of one
+// run of consecutive hit radii to the end of a later one (the best interval always has such
+// ends). `radii`: the support pixels' distances from the centre, sorted.
+double line_significance(const std::vector<float>& radii, double p, double log10_tests) {
+  // Runs of consecutive integer radii holding a support pixel: start, end, hits before.
+  struct Run {
+    int start, end, before;
+  };
+  std::vector<Run> runs;
+  int hits = 0, last = std::numeric_limits<int>::min();
+  for (float r : radii) {
+    const int q = static_cast<int>(std::floor(r));
+    if (q == last) continue;
+    if (q == last + 1)
+      runs.back().end = q;
+    else
+      runs.push_back({q, q, hits});
+    ++hits;
+    last = q;
+  }
+  double best = 0.0;
+  for (std::size_t a = 0; a < runs.size(); ++a) {
+    for (std::size_t b = a; b < runs.size(); ++b) {
+      const int n = runs[b].end - runs[a].start + 1;
+      const int k = (b + 1 < runs.size() ? runs[b + 1].before : hits) - runs[a].before;
+      best = std::min(best, log10_binomial_tail(k, n, p));
+    }
+  }
+  return -(log10_tests + best);
 }
 }  // namespace
 
@@ -321,7 +365,30 @@ void LineExtractor::suppress_non_maxima(const MirrorCircle& circle) {
   if (options_.threshold != LineThreshold::kFractionOfAnnulus) {
     floor_fraction = options_.min_fraction;
   }
-  const float peak_min = static_cast<float>(0.4 * floor_fraction * L);
+  float peak_min = static_cast<float>(0.4 * floor_fraction * L);
+  // Step 5's significance: a random line of polarity pol holds an edge pixel at a given radius
+  // with the chance that one falls in its support band (2 lateral_tolerance wide), from the
+  // frame's density of such pixels in the annulus; the tests are the sectors times the radial
+  // intervals of each polarity.
+  {
+    const double area = std::max(1.0, static_cast<double>(lut_.size()));
+    int count[2] = {0, 0};
+    for (const EdgePoint& e : edges_) ++count[e.polarity > 0];
+    for (int pol = 0; pol < 2; ++pol) {
+      const double density = count[pol] / area;
+      hit_probability_[pol] =
+          std::clamp(1.0 - std::exp(-density * 2.0 * options_.lateral_tolerance_px), 1e-4, 0.5);
+    }
+    const double Li = std::max(1.0, std::floor(L));
+    log10_tests_ = std::log10(2.0 * N * Li * (Li + 1) / 2);
+  }
+  if (options_.threshold == LineThreshold::kSignificance) {
+    // Fewer hits than this cannot be significant even in a row (votes split between two
+    // sectors: half of them).
+    const double p = std::max(hit_probability_[0], hit_probability_[1]);
+    const double k_min = (log10_tests_ + options_.min_significance) / -std::log10(p);
+    peak_min = static_cast<float>(std::max(2.0, 0.5 * k_min));
+  }
   const double cx = circle.center.x(), cy = circle.center.y();
   const double max_gap = std::max(1.0, options_.max_gap_px);
   std::vector<float>& score = score_;
@@ -349,6 +416,22 @@ void LineExtractor::suppress_non_maxima(const MirrorCircle& circle) {
   }
 }
 
+double LineExtractor::local_hit_probability(int k, int pol, double a, double cx, double cy) const {
+  // Clutter is not uniform: the density is that of the edge pixels of this polarity in the
+  // sectors within kLocalSpan of the peak, outside the line's own support band, over the
+  // annulus area of those sectors; the frame's density is the floor.
+  constexpr int kLocalSpan = 10;
+  const double tol = options_.lateral_tolerance_px;
+  int count = 0;
+  visit_pixels(k, pol, kLocalSpan, a, cx, cy, [&](double, double, double, double lat, double) {
+    if (std::abs(lat) > tol) ++count;
+  });
+  const double area =
+      std::max(1.0, static_cast<double>(lut_.size())) * (2 * kLocalSpan + 1) / options_.sectors;
+  const double p = 1.0 - std::exp(-count / area * 2.0 * tol);
+  return std::clamp(std::max(p, hit_probability_[pol]), 1e-4, 0.5);
+}
+
 bool LineExtractor::fit_peak(
     int k, int pol, double cx, double cy, double max_gap, LineCandidate* lc) {
   // Step 5: gather support around the peak and refine the angle (fit through the centre).
@@ -374,7 +457,10 @@ bool LineExtractor::fit_peak(
   lc->line.polarity = pol ? 1 : -1;
   lc->polarity = pol;
   lc->length = covered;
-  return true;
+  lc->line.significance =
+      line_significance(radii, local_hit_probability(k, pol, a, cx, cy), log10_tests_);
+  return options_.threshold != LineThreshold::kSignificance ||
+         lc->line.significance >= options_.min_significance;
 }
 
 void LineExtractor::refit_crowded_lines(const MirrorCircle& circle) {
@@ -427,8 +513,11 @@ void LineExtractor::threshold_lines(const MirrorCircle& circle, std::vector<Vert
   } else if (options_.threshold == LineThreshold::kTopK) {
     thr = options_.min_fraction * L;
   }
-  std::sort(found.begin(), found.end(), [](const LineCandidate& x, const LineCandidate& y) {
-    return x.length > y.length;
+  if (options_.threshold == LineThreshold::kSignificance) thr = 0;  // fit_peak kept them
+  // The most significant (or longest) first, so that of two peaks of one edge it is kept.
+  const bool by_significance = options_.threshold == LineThreshold::kSignificance;
+  std::sort(found.begin(), found.end(), [&](const LineCandidate& x, const LineCandidate& y) {
+    return by_significance ? x.line.significance > y.line.significance : x.length > y.length;
   });
   for (const LineCandidate& f : found) {
     if (f.length < thr) break;

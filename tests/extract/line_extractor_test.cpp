@@ -245,5 +245,82 @@ TEST(LineExtractor, EdgesTooCloseToRefitAreMarkedCrowded) {
   EXPECT_EQ(crowded_wide, 0);
 }
 
+// The significance criterion (docs/theory/extraction.md#significance): an image of pure noise
+// strong enough to make edge pixels everywhere is a random edge field, in which fewer than one
+// line is expected per image; the paper's 50 % rule keeps none either, but keeping the 20
+// longest candidates keeps 20 lines of noise.
+TEST(LineExtractor, SignificanceKeepsNoLineInNoise) {
+  MirrorCircle c;
+  c.center = {320.3, 240.6};
+  c.r_min = 40, c.r_max = 220;
+  int kept = 0, topk = 0;
+  for (int seed = 1; seed <= 10; ++seed) {
+    cv::Mat noise(480, 640, CV_8UC1);
+    cv::RNG rng(static_cast<std::uint64_t>(seed));
+    rng.fill(noise, cv::RNG::NORMAL, 128, 30);
+    std::vector<VerticalLine> lines;
+    LineExtractorOptions so;
+    so.threshold = LineThreshold::kSignificance;
+    LineExtractor sig(so);
+    sig.extract(noise, c, lines);
+    kept += static_cast<int>(lines.size());
+    LineExtractorOptions o;
+    o.threshold = LineThreshold::kTopK;
+    o.min_fraction = 0.02;
+    LineExtractor top(o);
+    top.extract(noise, c, lines);
+    topk += static_cast<int>(lines.size());
+  }
+  std::printf("noise, 10 images: %d significant lines, %d with topk\n", kept, topk);
+  EXPECT_LE(kept, 2);
+  EXPECT_EQ(topk, 200);
+}
+
+// Partial-height edges (a wall half hidden by furniture): the paper's rule drops those
+// shorter than half the annulus; the significance keeps every edge at least a fifth of the
+// annulus long, and invents none.
+TEST(LineExtractor, SignificanceKeepsPartialEdges) {
+  Score s_def, s_paper;
+  int partial = 0, partial_def = 0, partial_paper = 0;
+  for (int seed = 1; seed <= 10; ++seed) {
+    sim::RadialPatternOptions o;
+    o.seed = seed;
+    const auto p = sim::draw_radial_pattern(o);
+    const double L = p.circle.r_max - p.circle.r_min;
+    for (int paper = 0; paper < 2; ++paper) {
+      LineExtractorOptions lo;
+      lo.threshold = paper ? LineThreshold::kFractionOfAnnulus : LineThreshold::kSignificance;
+      LineExtractor ex(lo);
+      std::vector<VerticalLine> lines;
+      ex.extract(p.image, p.circle, lines);
+      FrameFeatures f;
+      f.circle = p.circle;
+      f.lines = lines;
+      score_frame(p, f, paper ? s_paper : s_def);
+      for (const auto& e : p.edges) {
+        if (e.full || e.r_to - e.r_from < 0.2 * L) continue;
+        partial += paper ? 0 : 1;
+        for (const auto& l : lines)
+          if (std::abs(angle_diff(l.image_angle, e.image_angle)) <= deg2rad(0.3)) {
+            ++(paper ? partial_paper : partial_def);
+            break;
+          }
+      }
+    }
+  }
+  std::printf(
+      "partial edges >= 20%% of the annulus: %d; found %d (significance), %d (50%% rule); "
+      "invented %d, %d\n",
+      partial,
+      partial_def,
+      partial_paper,
+      s_def.invented,
+      s_paper.invented);
+  EXPECT_EQ(partial_def, partial);
+  EXPECT_LT(partial_paper, partial);
+  EXPECT_EQ(s_def.invented, 0);
+  EXPECT_EQ(s_def.long_found, s_def.long_edges);
+}
+
 }  // namespace
 }  // namespace omnivert

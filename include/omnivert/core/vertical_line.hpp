@@ -18,6 +18,11 @@ struct VerticalLine {
   double r_outer = 0.0;
   // RMS lateral distance of the supporting edge pixels from the fitted radial line, in pixels.
   double fit_rms_px = 0.0;
+  // Significance of the line, -log10 NFA (docs/theory/extraction.md#significance): the number
+  // of radial lines of the image on which edge pixels of random positions would line up at
+  // least this well is 10^-significance. LineThreshold::kSignificance keeps lines when it is
+  // >= min_significance.
+  double significance = 0.0;
   // Edge polarity: +1 if the image is brighter on the side of increasing image angle.
   int polarity = 0;
   // Another edge line runs within LineExtractorOptions::isolation_px of this one over most of

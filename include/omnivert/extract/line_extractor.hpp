@@ -15,7 +15,8 @@
 //   line) are gathered and the line's angle is refined below the sector size by a weighted
 //   least-squares fit of a line through the mirror centre; its length is the radial extent
 //   covered by supporting pixels (gaps up to max_gap_px bridged), and it is kept by
-//   one of the criteria below (the paper's: >= 50% of R_max - R_min).
+//   one of the criteria below (the paper's, the default: >= 50% of R_max - R_min; or when
+//   it is significant: its number of false alarms, a contrario, is below 1).
 //
 // Speed: all per-pixel geometry (radial unit vector, sector coordinate, neighbour offsets)
 // comes from a lookup table built once per annulus (r_min, r_max) relative to the rounded
@@ -34,6 +35,11 @@
 namespace omnivert {
 
 enum class LineThreshold {
+  // A contrario (docs/theory/extraction.md#significance): NFA = n_tests * P[B(n, p) >= k] <=
+  // 10^-min_significance, k of the n radii between two support pixels holding one, p the
+  // chance that a radius of a random line holds an edge pixel of this polarity (the image's
+  // density of such pixels in the annulus times the support band's width 2 lateral_tolerance).
+  kSignificance,
   kFractionOfAnnulus,  // Sec. 2: edge_pixels >= length_fraction * (R_max - R_min)
   kAdaptive,           // preprint: edge_pixels >= mean + adaptive_k * stddev of candidates
   kTopK,               // the top_k longest candidates (still >= min_fraction)
@@ -70,10 +76,11 @@ struct LineExtractorOptions {
   int nms_radius = 1;
 
   LineThreshold threshold = LineThreshold::kFractionOfAnnulus;
-  double length_fraction = 0.5;  // kFractionOfAnnulus (the paper's 50%)
-  double adaptive_k = 3.0;       // kAdaptive
-  int top_k = 20;                // kTopK
-  double min_fraction = 0.2;     // floor for kAdaptive and kTopK
+  double min_significance = 0.0;  // kSignificance: -log10 of the largest NFA kept
+  double length_fraction = 0.5;   // kFractionOfAnnulus (the paper's 50%)
+  double adaptive_k = 3.0;        // kAdaptive
+  int top_k = 20;                 // kTopK
+  double min_fraction = 0.2;      // floor for kAdaptive and kTopK
 
   bool IsValid(std::string* why) const;
 };
@@ -162,6 +169,10 @@ class LineExtractor {
     int polarity;
     double length;
   };
+  // Chance that a radius of a random line holds an edge pixel of polarity 0 / 1 (step 5's
+  // significance), set from the edge density of the current frame.
+  double hit_probability_[2] = {0, 0};
+  double log10_tests_ = 0;
   // Steps of extract (Sec. 2), each on the buffers below.
   // Step 2: one pass over the annulus (rounded centre cxi, cyi): Sobel (eq. 1), magnitude
   // threshold, orientation test; fills cands_ and mag_.
@@ -178,6 +189,9 @@ class LineExtractor {
   void suppress_non_maxima(const MirrorCircle& circle);
   // Step 5: the support of the peak at sector k and its fitted line; false when too small.
   bool fit_peak(int k, int pol, double cx, double cy, double max_gap, LineCandidate* lc);
+  // Step 5's chance that a radius of a random line near sector k holds an edge pixel of
+  // polarity pol: from the density of such pixels around the line, at least the frame's.
+  double local_hit_probability(int k, int pol, double a, double cx, double cy) const;
   // Step 5 again for the lines of found_ that have a neighbour.
   void refit_crowded_lines(const MirrorCircle& circle);
   // Histogram thresholding (Sec. 2, last step) of found_ into out, sorted by image angle.
