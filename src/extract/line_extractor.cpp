@@ -95,7 +95,9 @@ double line_significance(const std::vector<float>& radii, double p, double log10
   struct Run {
     int start, end, before;
   };
-  std::vector<Run> runs;
+  // Reused across calls, as the extractor's own buffers are: no allocation per frame.
+  thread_local std::vector<Run> runs;
+  runs.clear();
   int hits = 0, last = std::numeric_limits<int>::min();
   for (float r : radii) {
     const int q = static_cast<int>(std::floor(r));
