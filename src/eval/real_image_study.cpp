@@ -61,24 +61,19 @@ RepeatCount repeat(const FrameFeatures& a,
                    double shift,
                    double tol) {
   RepeatCount c;
-  for (int i : which) {
-    ++c.looked_for;
-    int best = -1;
-    double best_err = tol;
-    for (int j = 0; j < static_cast<int>(b.lines.size()); ++j) {
-      if (a.lines[i].polarity != b.lines[j].polarity) continue;
-      const double e = std::abs(angle_diff(b.lines[j].image_angle, a.lines[i].image_angle + shift));
-      if (e <= best_err) best_err = e, best = j;
-    }
-    if (best < 0) continue;
+  c.looked_for = static_cast<int>(which.size());
+  // Found again: pair_lines' match at the shifted image angle (same polarity, within tol).
+  for (const LinePairing& p : pair_lines(a, b, shift, tol)) {
+    if (std::find(which.begin(), which.end(), p.original) == which.end()) continue;
     ++c.found;
+    // Right descriptor: the original line's nearest among all of the copy's lines is its match.
     int nn = -1;
     double nn_d = 0;
     for (int j = 0; j < static_cast<int>(b.lines.size()); ++j) {
-      const double d = (a.descriptors.row(i) - b.descriptors.row(j)).norm();
+      const double d = (a.descriptors.row(p.original) - b.descriptors.row(j)).norm();
       if (nn < 0 || d < nn_d) nn = j, nn_d = d;
     }
-    if (nn == best) ++c.nn_correct;
+    if (nn == p.transformed) ++c.nn_correct;
   }
   return c;
 }
