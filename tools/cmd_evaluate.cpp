@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <memory>
 
+#include <spdlog/spdlog.h>
+
 #include "commands.hpp"
 #include "omnivert/core/error.hpp"
 #include "omnivert/dataset/dataset.hpp"
@@ -28,6 +30,8 @@ void add_evaluate_command(CLI::App& app) {
     lo.require_wheel = false;
     lo.allow_missing_images = true;  // tracks of a dataset with a missing frame are evaluated
     const auto data = dataset::Dataset::load(a->dataset, lo);
+    for (const std::string& n : data.notes()) spdlog::debug("{}", n);
+    if (!data.ground_truth_error().empty()) throw InputError(data.ground_truth_error());
     const auto& gt = data.ground_truth();
     if (!gt || !gt->has_lines)
       throw InputError((fs::path(a->dataset) / "ground_truth/lines.csv").string(),

@@ -36,6 +36,7 @@ void run_track(const TrackArgs& a) {
   lo.require_wheel = false;
   lo.allow_missing_images = true;  // a missing frame is warned about and skipped (no lines)
   const auto data = dataset::Dataset::load(a.dataset, lo);
+  for (const std::string& n : data.notes()) spdlog::debug("{}", n);
   std::error_code ec;
   fs::create_directories(a.out, ec);
   if (ec) throw InputError(a.out, 0, "cannot create the output folder: " + ec.message());

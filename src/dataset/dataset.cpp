@@ -34,12 +34,15 @@ std::string trim(const std::string& s) {
   return s.substr(b, e - b + 1);
 }
 
-// Reads a CSV file whose first line is a '#' header with `columns` columns; returns the
-// header and the data rows (blank lines skipped). `what` names the columns for messages.
+// Reads a CSV file whose first line is a '#' header with at least `columns` columns; returns
+// the header and the data rows (blank lines skipped), each cut to `columns` fields: columns
+// beyond those are another tool's, ignored as EuRoC-style readers do, and counted in
+// `*extra_rows` (rows that had any). `what` names the columns for messages.
 std::vector<CsvRow> read_csv(const std::string& path,
                              std::size_t columns,
                              const std::string& what,
-                             std::string* header_out = nullptr) {
+                             std::string* header_out = nullptr,
+                             int* extra_rows = nullptr) {
   std::error_code ec;
   if (!fs::exists(path, ec)) throw InputError(path, 0, "file not found");
   std::ifstream in(path);
@@ -71,6 +74,10 @@ std::vector<CsvRow> read_csv(const std::string& path,
       if (comma == std::string::npos) break;
       start = comma + 1;
     }
+    if (row.fields.size() > columns) {
+      row.fields.resize(columns);
+      if (extra_rows) ++*extra_rows;
+    }
     if (row.fields.size() != columns) {
       throw InputError(path,
                        line,
@@ -82,6 +89,15 @@ std::vector<CsvRow> read_csv(const std::string& path,
   if (!header_seen)
     throw InputError(path, 0, "file is empty (expected a '#' header line: " + what + ")");
   return rows;
+}
+
+void note_extra_columns(const std::string& path,
+                        int rows,
+                        std::size_t columns,
+                        std::vector<std::string>* notes) {
+  if (rows > 0 && notes)
+    notes->push_back(path + ": " + std::to_string(rows) + " rows have columns beyond the " +
+                     std::to_string(columns) + " read; those were ignored");
 }
 
 std::int64_t parse_timestamp(const std::string& s, const std::string& path, int line) {
@@ -201,9 +217,12 @@ WheelSensor load_wheel_sensor(const std::string& path) {
 
 std::vector<WheelRecord> load_wheel_data(const std::string& path,
                                          const WheelSensor& s,
-                                         double max_speed) {
+                                         double max_speed,
+                                         std::vector<std::string>* notes) {
   std::string header;
-  const auto rows = read_csv(path, 3, "timestamp [ns], left, right", &header);
+  int extra = 0;
+  const auto rows = read_csv(path, 3, "timestamp [ns], left, right", &header, &extra);
+  note_extra_columns(path, extra, 3, notes);
   const bool header_ticks = header.find("[ticks]") != std::string::npos;
   const bool header_meters = header.find("[m]") != std::string::npos;
   if (s.unit == WheelUnit::kMeters && header_ticks) {
@@ -271,7 +290,9 @@ std::vector<WheelRecord> load_wheel_data(const std::string& path,
   return out;
 }
 
-GroundTruth load_ground_truth(const std::string& dir, const std::vector<ImageRecord>& images) {
+GroundTruth load_ground_truth(const std::string& dir,
+                              const std::vector<ImageRecord>& images,
+                              std::vector<std::string>* notes) {
   GroundTruth gt;
   std::error_code ec;
   const std::string ext = rel(dir, "extrinsics.yaml");
@@ -286,8 +307,9 @@ GroundTruth load_ground_truth(const std::string& dir, const std::vector<ImageRec
   const std::string poses = rel(dir, "poses.csv");
   if (fs::exists(poses, ec)) {
     gt.has_poses = true;
-    int prev_line = 0;
-    for (const CsvRow& r : read_csv(poses, 4, "timestamp [ns], x [m], y [m], theta [rad]")) {
+    int prev_line = 0, extra = 0;
+    for (const CsvRow& r :
+         read_csv(poses, 4, "timestamp [ns], x [m], y [m], theta [rad]", nullptr, &extra)) {
       PoseRecord p;
       p.timestamp_ns = parse_timestamp(r.fields[0], poses, r.line);
       if (!gt.poses.empty())
@@ -298,14 +320,18 @@ GroundTruth load_ground_truth(const std::string& dir, const std::vector<ImageRec
       gt.poses.push_back(p);
       prev_line = r.line;
     }
+    note_extra_columns(poses, extra, 4, notes);
   }
   const std::string lines = rel(dir, "lines.csv");
   if (fs::exists(lines, ec)) {
     gt.has_lines = true;
+    int extra = 0;
     for (const CsvRow& r :
          read_csv(lines,
                   6,
-                  "timestamp [ns], frame, line_id, bearing [rad], r_inner [px], r_outer [px]")) {
+                  "timestamp [ns], frame, line_id, bearing [rad], r_inner [px], r_outer [px]",
+                  nullptr,
+                  &extra)) {
       LineRecord l;
       l.timestamp_ns = parse_timestamp(r.fields[0], lines, r.line);
       l.frame = parse_int(r.fields[1], "frame", lines, r.line);
@@ -330,6 +356,7 @@ GroundTruth load_ground_truth(const std::string& dir, const std::vector<ImageRec
       }
       gt.lines.push_back(l);
     }
+    note_extra_columns(lines, extra, 6, notes);
     gt.line_offsets.assign(images.size() + 1, 0);
     for (const LineRecord& l : gt.lines) ++gt.line_offsets[static_cast<std::size_t>(l.frame) + 1];
     for (std::size_t k = 1; k < gt.line_offsets.size(); ++k)
@@ -349,7 +376,8 @@ Dataset Dataset::load(const std::string& dir, const LoadOptions& options) {
 
   // Images.
   const std::string cam_csv = rel(dir, "cam0/data.csv");
-  for (const CsvRow& r : read_csv(cam_csv, 2, "timestamp [ns], filename")) {
+  int extra = 0;
+  for (const CsvRow& r : read_csv(cam_csv, 2, "timestamp [ns], filename", nullptr, &extra)) {
     ImageRecord im;
     im.line = r.line;
     im.timestamp_ns = parse_timestamp(r.fields[0], cam_csv, r.line);
@@ -369,6 +397,7 @@ Dataset Dataset::load(const std::string& dir, const LoadOptions& options) {
     d.images_.push_back(std::move(im));
   }
   if (d.images_.empty()) throw InputError(cam_csv, 0, "no images listed");
+  note_extra_columns(cam_csv, extra, 2, &d.notes_);
   const auto first_present = std::find_if(
       d.images_.begin(), d.images_.end(), [](const ImageRecord& im) { return !im.missing; });
   if (first_present == d.images_.end()) {
@@ -390,7 +419,7 @@ Dataset Dataset::load(const std::string& dir, const LoadOptions& options) {
   if (options.require_wheel || fs::exists(wheel_dir, ec)) {
     d.wheel_sensor_ = load_wheel_sensor(rel(dir, "wheel0/sensor.yaml"));
     const std::string wheel_csv = rel(dir, "wheel0/data.csv");
-    d.wheel_ = load_wheel_data(wheel_csv, d.wheel_sensor_, options.max_wheel_speed);
+    d.wheel_ = load_wheel_data(wheel_csv, d.wheel_sensor_, options.max_wheel_speed, &d.notes_);
     const std::int64_t w0 = d.wheel_.front().timestamp_ns, w1 = d.wheel_.back().timestamp_ns;
     for (const ImageRecord& im : d.images_) {
       if (im.timestamp_ns < w0 || im.timestamp_ns > w1) {
@@ -407,9 +436,16 @@ Dataset Dataset::load(const std::string& dir, const LoadOptions& options) {
       d.travel_at_images_.push_back(d.travel_at(im.timestamp_ns));
   }
 
-  // Ground truth.
+  // Ground truth: optional, and needed only to evaluate; one that cannot be read is recorded
+  // (ground_truth_error) for the tools that use it, and does not stop the others.
   const std::string gt_dir = rel(dir, "ground_truth");
-  if (fs::is_directory(gt_dir, ec)) d.ground_truth_ = load_ground_truth(gt_dir, d.images_);
+  if (fs::is_directory(gt_dir, ec)) {
+    try {
+      d.ground_truth_ = load_ground_truth(gt_dir, d.images_, &d.notes_);
+    } catch (const InputError& e) {
+      d.ground_truth_error_ = e.what();
+    }
+  }
   return d;
 }
 

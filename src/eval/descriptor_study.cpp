@@ -69,6 +69,7 @@ std::size_t StudySet::frame_pairs() const {
 
 StudySet load_study_set(const dataset::Dataset& data, const StudyOptions& o) {
   namespace fs = std::filesystem;
+  if (!data.ground_truth_error().empty()) throw InputError(data.ground_truth_error());
   const auto& gt = data.ground_truth();
   const std::string gt_dir = (fs::path(data.root()) / "ground_truth").string();
   if (!gt || !gt->has_lines)
@@ -242,6 +243,7 @@ MethodFeatures describe_lbd_segments(const StudySet& set,
   auto lsd = LSDDetector::createLSDDetector();
   std::vector<std::vector<int>> ids;
   std::vector<cv::Mat> descs;
+  if (!data.ground_truth_error().empty()) throw InputError(data.ground_truth_error());
   if (!data.ground_truth() || !data.ground_truth()->has_lines)
     throw InputError(data.root() + "/ground_truth/lines.csv",
                      0,

@@ -84,6 +84,11 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
   lo.require_wheel = true;
   lo.allow_missing_images = true;
   const auto data = dataset::Dataset::load(dataset_dir, lo);
+  for (const std::string& n : data.notes()) spdlog::debug("{}", n);
+  // Ground truth is optional here (the report's truth rows): one that cannot be read is a
+  // warning, not a reason to refuse the calibration.
+  if (!data.ground_truth_error().empty())
+    spdlog::warn("ground truth not used: {}", data.ground_truth_error());
   const calib::CalibrationOptions opt = calib::options_from_dataset(data, o.calibration);
   if (!opt.IsValid(&why)) throw InputError("invalid calibration options: " + why);
 

@@ -103,11 +103,32 @@ TEST_F(DatasetTest, UnparsableTimestamp) {
                 ":3: cannot parse timestamp '2000x00000' (expected a non-negative integer in ns)");
 }
 
-TEST_F(DatasetTest, WrongNumberOfColumns) {
-  write("cam0/data.csv", "#timestamp [ns],filename\n1000000000,a.png,extra\n");
+TEST_F(DatasetTest, TooFewColumnsIsAnError) {
+  write("cam0/data.csv", "#timestamp [ns],filename\n1000000000\n");
   EXPECT_EQ(error(),
             p("cam0/data.csv") +
-                ":2: expected 2 comma-separated columns (timestamp [ns], filename), got 3");
+                ":2: expected 2 comma-separated columns (timestamp [ns], filename), got 1");
+}
+
+TEST_F(DatasetTest, ExtraTrailingColumnsAreIgnoredWithANote) {
+  // Another tool's columns after ours, as EuRoC-style readers accept them.
+  write("cam0/data.csv",
+        "#timestamp [ns],filename,exposure\n1000000000,a.png,0.01\n2000000000,b.png,0.02\n"
+        "3000000000,c.png\n");
+  write("wheel0/data.csv",
+        "#timestamp [ns],left [m],right [m],temperature\n500000000,1.0,2.0,20\n"
+        "1000000000,1.1,2.1,20\n1500000000,1.2,2.2\n2000000000,1.3,2.3\n"
+        "2500000000,1.4,2.2\n3000000000,1.5,2.3\n3500000000,1.6,2.4\n");
+  const Dataset d = Dataset::load(root.string());
+  ASSERT_EQ(d.size(), 3u);
+  EXPECT_EQ(d.images()[1].filename, "b.png");
+  EXPECT_EQ(d.images()[1].timestamp_ns, 2000000000);
+  EXPECT_NEAR(d.travel_at(1000000000).left, 0.1, 1e-12);  // travel from the first sample
+  ASSERT_EQ(d.notes().size(), 2u);
+  EXPECT_EQ(d.notes()[0],
+            p("cam0/data.csv") + ": 2 rows have columns beyond the 2 read; those were ignored");
+  EXPECT_EQ(d.notes()[1],
+            p("wheel0/data.csv") + ": 2 rows have columns beyond the 3 read; those were ignored");
 }
 
 TEST_F(DatasetTest, MissingHeader) {
@@ -341,18 +362,36 @@ TEST_F(DatasetTest, GroundTruthIsReadAndChecked) {
     EXPECT_TRUE(gt.lines_in_frame(2).empty());
     EXPECT_TRUE(gt.lines_in_frame(3).empty());
   }
+  // A ground truth that cannot be read does not refuse the dataset: the tools that need it
+  // report the problem (file, line) from ground_truth_error().
+  const auto gt_error = [&] {
+    const Dataset d = Dataset::load(root.string());
+    EXPECT_FALSE(d.ground_truth().has_value());
+    return d.ground_truth_error();
+  };
   write("ground_truth/lines.csv",
         "#timestamp [ns],frame,line_id,bearing [rad],r_inner [px],r_outer "
         "[px]\n1000000000,7,4,0.5,6,19\n");
-  EXPECT_EQ(error(), p("ground_truth/lines.csv") + ":2: frame 7 is not an image index (0..2)");
+  EXPECT_EQ(gt_error(), p("ground_truth/lines.csv") + ":2: frame 7 is not an image index (0..2)");
   write("ground_truth/lines.csv",
         "#timestamp [ns],frame,line_id,bearing [rad],r_inner [px],r_outer "
         "[px]\n1000000001,0,4,0.5,6,19\n");
-  EXPECT_EQ(error(),
+  EXPECT_EQ(gt_error(),
             p("ground_truth/lines.csv") +
                 ":2: timestamp 1000000001 is not that of frame 0 in cam0/data.csv");
   write("ground_truth/extrinsics.yaml", "phi: -0.34\nrho: 0.23\n");
-  EXPECT_EQ(error(), p("ground_truth/extrinsics.yaml") + ": missing required field 'psi'");
+  EXPECT_EQ(gt_error(), p("ground_truth/extrinsics.yaml") + ": missing required field 'psi'");
+  // Another tool's ground truth, one column more than ours: read, the extra column ignored.
+  write("ground_truth/extrinsics.yaml", "phi: -0.34\nrho: 0.23\npsi: 0.33\n");
+  write("ground_truth/lines.csv",
+        "#timestamp [ns],frame,line_id,bearing [rad],r_inner [px],r_outer [px],score\n"
+        "1000000000,0,4,0.5,6,19,0.9\n");
+  const Dataset d = Dataset::load(root.string());
+  ASSERT_TRUE(d.ground_truth().has_value());
+  EXPECT_TRUE(d.ground_truth_error().empty());
+  ASSERT_EQ(d.ground_truth()->lines.size(), 1u);
+  EXPECT_DOUBLE_EQ(d.ground_truth()->lines[0].r_outer, 19.0);
+  ASSERT_EQ(d.notes().size(), 1u);
 }
 
 }  // namespace

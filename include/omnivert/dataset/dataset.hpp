@@ -136,7 +136,13 @@ class Dataset {
   // Wheel travel at each image timestamp (same order as images()).
   const std::vector<WheelTravel>& travel_at_images() const { return travel_at_images_; }
 
+  // Empty when there is no ground_truth/ folder or when it could not be read; then
+  // ground_truth_error() says why (file, line and problem) for the tools that need it.
   const std::optional<GroundTruth>& ground_truth() const { return ground_truth_; }
+  const std::string& ground_truth_error() const { return ground_truth_error_; }
+  // What loading noticed without refusing the data (columns of another tool beyond ours):
+  // for the verbose log.
+  const std::vector<std::string>& notes() const { return notes_; }
 
  private:
   std::string root_;
@@ -146,6 +152,8 @@ class Dataset {
   std::vector<WheelRecord> wheel_;
   std::vector<WheelTravel> travel_at_images_;
   std::optional<GroundTruth> ground_truth_;
+  std::string ground_truth_error_;
+  std::vector<std::string> notes_;
 };
 
 }  // namespace omnivert::dataset
