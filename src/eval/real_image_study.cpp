@@ -28,6 +28,7 @@ RepeatCount& RepeatCount::operator+=(const RepeatCount& o) {
   looked_for += o.looked_for;
   found += o.found;
   nn_correct += o.nn_correct;
+  nn_correct_polarity += o.nn_correct_polarity;
   return *this;
 }
 
@@ -67,13 +68,17 @@ RepeatCount repeat(const FrameFeatures& a,
     if (std::find(which.begin(), which.end(), p.original) == which.end()) continue;
     ++c.found;
     // Right descriptor: the original line's nearest among all of the copy's lines is its match.
-    int nn = -1;
-    double nn_d = 0;
+    // The same among the copy's lines of the line's polarity.
+    int nn = -1, nn_pol = -1;
+    double nn_d = 0, nn_pol_d = 0;
+    const int polarity = a.lines[p.original].polarity;
     for (int j = 0; j < static_cast<int>(b.lines.size()); ++j) {
       const double d = (a.descriptors.row(p.original) - b.descriptors.row(j)).norm();
       if (nn < 0 || d < nn_d) nn = j, nn_d = d;
+      if (b.lines[j].polarity == polarity && (nn_pol < 0 || d < nn_pol_d)) nn_pol = j, nn_pol_d = d;
     }
     if (nn == p.transformed) ++c.nn_correct;
+    if (nn_pol == p.transformed) ++c.nn_correct_polarity;
   }
   return c;
 }
@@ -210,6 +215,15 @@ std::string real_image_table(const std::vector<RealImageResult>& results) {
                 tl[1].found_percent(),
                 tl[1].nn_percent());
   s << b;
+  std::snprintf(b,
+                sizeof b,
+                "NN among the copy's lines of the same polarity: rotation %.1f / %.1f %%, lighting "
+                "%.1f / %.1f %% (detected / given)\n",
+                tr[0].nn_polarity_percent(),
+                tr[1].nn_polarity_percent(),
+                tl[0].nn_polarity_percent(),
+                tl[1].nn_polarity_percent());
+  s << b;
   return s.str();
 }
 
@@ -218,7 +232,8 @@ std::string real_image_csv(const std::vector<RealImageResult>& results) {
   s << "#image,ok,width,height,center_x,center_y,r_min,r_max,lines,max_centre_shift_px";
   for (const char* t :
        {"rotation_detected", "rotation_given", "lighting_detected", "lighting_given"})
-    s << ',' << t << "_looked_for," << t << "_found," << t << "_nn_correct";
+    s << ',' << t << "_looked_for," << t << "_found," << t << "_nn_correct," << t
+        << "_nn_correct_same_polarity";
   s << '\n';
   for (const RealImageResult& r : results) {
     s << r.label << ',' << (r.ok ? 1 : 0) << ',' << r.width << ',' << r.height << ','
@@ -226,7 +241,8 @@ std::string real_image_csv(const std::vector<RealImageResult>& results) {
       << fmt("%.2f", r.circle.r_min) << ',' << fmt("%.2f", r.circle.r_max) << ',' << r.lines << ','
       << fmt("%.3f", r.max_centre_shift_px);
     for (const RepeatCount* c : {&r.rotation[0], &r.rotation[1], &r.lighting[0], &r.lighting[1]})
-      s << ',' << c->looked_for << ',' << c->found << ',' << c->nn_correct;
+      s << ',' << c->looked_for << ',' << c->found << ',' << c->nn_correct << ','
+        << c->nn_correct_polarity;
     s << '\n';
   }
   return s.str();

@@ -14,6 +14,7 @@
 #include "omnivert/dataset/dataset.hpp"
 #include "omnivert/eval/descriptor_study.hpp"
 #include "omnivert/eval/panorama.hpp"
+#include "omnivert/eval/real_image_study.hpp"
 #include "omnivert/eval/similarity_study.hpp"
 #include "omnivert/sim/radial_pattern.hpp"
 #include "omnivert/sim/simulator.hpp"
@@ -291,6 +292,40 @@ TEST(Study, TinySimulatedRun) {
   const cv::Mat1f self = seg.distances(0, 0);
   for (int i = 0; i < self.rows; ++i) EXPECT_EQ(self(i, i), 0.0f);
   fs::remove_all(dir);
+}
+
+
+// The real-image study on a drawn image with known edges and its circle given: the edges are
+// found again at their rotated angle, and a nearest neighbour among the same polarity is
+// right at least as often as one among all lines (a subset of the candidates holding it).
+TEST(RealImageStudy, DrawnEdgesAreFoundAgainUnderRotationAndLighting) {
+  sim::RadialPatternOptions po;
+  po.seed = 3;
+  const auto p = sim::draw_radial_pattern(po);
+  CameraGeometry g;
+  g.width = p.image.cols, g.height = p.image.rows;
+  g.center = p.circle.center;
+  g.r_min = p.circle.r_min, g.r_max = p.circle.r_max;
+  RealImageStudyOptions o;
+  o.strongest = 10;
+  const RealImageResult r = study_real_image("drawn", p.image, g, o);
+  ASSERT_TRUE(r.ok) << r.error;
+  std::printf("drawn: %d lines; rotation found %.1f %%, NN %.1f %%, same polarity %.1f %%\n",
+              r.lines,
+              r.rotation[1].found_percent(),
+              r.rotation[1].nn_percent(),
+              r.rotation[1].nn_polarity_percent());
+  ASSERT_GE(r.lines, 10);
+  EXPECT_EQ(r.rotation[1].looked_for, 10 * 4);
+  EXPECT_GE(r.rotation[1].found_percent(), 95.0);
+  EXPECT_EQ(r.lighting[1].looked_for, 10 * 5);
+  EXPECT_GE(r.lighting[1].found_percent(), 95.0);
+  for (const RepeatCount& c : {r.rotation[1], r.lighting[1]}) {
+    EXPECT_LE(c.nn_correct, c.nn_correct_polarity);
+    EXPECT_LE(c.nn_correct_polarity, c.found);
+  }
+  const std::string csv = real_image_csv({r});
+  EXPECT_NE(csv.find("rotation_given_nn_correct_same_polarity"), std::string::npos);
 }
 
 }  // namespace

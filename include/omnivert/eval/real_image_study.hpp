@@ -37,8 +37,12 @@ struct RepeatCount {
   int looked_for = 0;  // strongest lines of the original, once per copy
   int found = 0;       // found again at the shifted image angle
   int nn_correct = 0;  // of those found: the nearest descriptor in the copy is the right line
+  // Of those found: the nearest descriptor among the copy's lines of the same edge polarity
+  // is the right line (the tracker's recommended rules compare only those).
+  int nn_correct_polarity = 0;
   double found_percent() const { return looked_for ? 100.0 * found / looked_for : 0.0; }
   double nn_percent() const { return found ? 100.0 * nn_correct / found : 0.0; }
+  double nn_polarity_percent() const { return found ? 100.0 * nn_correct_polarity / found : 0.0; }
   RepeatCount& operator+=(const RepeatCount& o);
 };
 
