@@ -1,6 +1,7 @@
 #include "recording/import_steps.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <limits>
 
@@ -68,6 +69,30 @@ double joint_travel(const JointStateMsg& js,
   return js.position[k] * o.wheel_radius;
 }
 
+// A wheel moving faster than o.max_speed between two joint states: the driver restarted
+// (angles back to zero) or a glitch.
+void check_wheel_step(const dataset::WheelRecord& prev,
+                      std::int64_t t,
+                      double left,
+                      double right,
+                      const ImportOptions& o,
+                      const std::string& what) {
+  const double dt = static_cast<double>(t - prev.timestamp_ns) * 1e-9;
+  const double step =
+      std::max(std::abs(left - prev.travel.left), std::abs(right - prev.travel.right));
+  if (step > o.max_speed * dt) {
+    char buf[160];
+    std::snprintf(
+        buf,
+        sizeof buf,
+        ": a wheel moves %.3f m in %.3f s, faster than %g m/s (a reset of the wheel angles?)",
+        step,
+        dt,
+        o.max_speed);
+    throw InputError(what + buf + "; import the parts before and after it separately");
+  }
+}
+
 }  // namespace
 
 void require_topic(const Recording& rec,
@@ -121,6 +146,8 @@ Collected collect(Recording& rec,
                        r = joint_travel(js, o, idx, true, what);
           if (!advances(js.stamp_ns, last_odo, what)) return void(++s.duplicate_stamps);
           if (c.wheel.empty()) left0 = l, right0 = r;
+          if (!c.wheel.empty())
+            check_wheel_step(c.wheel.back(), js.stamp_ns, l - left0, r - right0, o, what);
           last_odo = js.stamp_ns;
           c.wheel.push_back({js.stamp_ns, {l - left0, r - right0}, static_cast<int>(m.index)});
         } else if (m.topic->name == o.odometry_topic) {

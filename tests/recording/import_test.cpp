@@ -201,6 +201,22 @@ TEST_F(ImportTest, OdometryResetIsRefused) {
   EXPECT_NE(e.find("odometry reset"), std::string::npos) << e;
 }
 
+TEST_F(ImportTest, WheelAngleResetIsRefused) {
+  // Message 12: the angles fall from 1.1 and 2.2 rad (message 11) back to 0; with r = 0.5 m the
+  // right wheel would move 1.1 m in 0.05 s.
+  joint_states();
+  o.joint_states_topic = "/joint_states_reset";
+  o.wheel_radius = 0.5;
+  const std::string e = error("ros1_lz4.bag");
+  EXPECT_NE(e.find("topic /joint_states_reset, message 12 (recorded at 170000000"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(
+      e.find("a wheel moves 1.100 m in 0.050 s, faster than 5 m/s (a reset of the wheel angles?)"),
+      std::string::npos)
+      << e;
+}
+
 TEST_F(ImportTest, ExistingOutputIsKeptWithoutOverwrite) {
   joint_states();
   fs::create_directories(o.out);
