@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -215,6 +216,37 @@ TEST_F(ImportTest, WheelAngleResetIsRefused) {
       e.find("a wheel moves 1.100 m in 0.050 s, faster than 5 m/s (a reset of the wheel angles?)"),
       std::string::npos)
       << e;
+}
+
+// A TUM pose file covering frames 1-3 only (0.1 .. 0.7 s): a straight line at 0.5 m/s along
+// yaw 0.3 rad; frames 0 and 4 are left out, the wheels run 0.5 m/s each.
+TEST_F(ImportTest, TumPoseFileAndImagesOutsideTheOdometry) {
+  const fs::path tum = dir / "poses.txt";
+  {
+    std::ofstream f(tum);
+    f.precision(12);
+    for (int i = 0; i <= 6; ++i) {
+      const double t = 1700000000.1 + 0.1 * i, d = 0.05 * i;
+      f << t << " " << d * std::cos(0.3) << " " << d * std::sin(0.3) << " 0 0 0 " << std::sin(0.15)
+        << " " << std::cos(0.15) << "\n";
+    }
+  }
+  o.poses_csv = tum.string();
+  o.wheel_base = 0.5;
+  o.out = (dir / "ds").string();
+  const auto s = run("ros1_bz2.bag");
+  EXPECT_EQ(s.images, 3u);
+  EXPECT_EQ(s.images_outside, 2u);
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("2 image(s) outside the odometry's time span"), std::string::npos);
+  const auto d = dataset::Dataset::load(o.out);
+  ASSERT_EQ(d.size(), 3u);
+  EXPECT_EQ(d.image(0)(3, 3), pixel(1, 3, 3));  // the first image kept is frame 1
+  EXPECT_EQ(
+      std::distance(fs::directory_iterator(dir / "ds" / "cam0" / "data"), fs::directory_iterator()),
+      3);
+  EXPECT_NEAR(d.wheel().back().travel.left, 0.3, 1e-9);
+  EXPECT_NEAR(d.wheel().back().travel.right, 0.3, 1e-9);
 }
 
 TEST_F(ImportTest, ExistingOutputIsKeptWithoutOverwrite) {
