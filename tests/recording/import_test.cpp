@@ -108,6 +108,7 @@ INSTANTIATE_TEST_SUITE_P(Recordings,
                                            "ros1_lz4.bag",
                                            "ros2_lz4.mcap",
                                            "ros2_zstd.mcap",
+                                           "ros2_nosummary.mcap",
                                            "ros2_db3",
                                            "ros2_db3_zstd"));
 

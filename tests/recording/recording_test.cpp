@@ -76,6 +76,7 @@ INSTANTIATE_TEST_SUITE_P(Recordings,
                                            "ros2_none.mcap",
                                            "ros2_lz4.mcap",
                                            "ros2_zstd.mcap",
+                                           "ros2_nosummary.mcap",
                                            "ros2_db3",
                                            "ros2_db3_zstd",
                                            "ros2_db3/ros2_db3_0.db3"));
