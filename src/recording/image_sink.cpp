@@ -55,6 +55,12 @@ void write_bytes(const std::filesystem::path& p, std::span<const std::uint8_t> d
 
 }  // namespace
 
+std::int64_t ImageSink::stamp_or_log_time(std::int64_t stamp, const Message& m) {
+  if (stamp != 0) return stamp;
+  ++unstamped_;
+  return m.log_time_ns;
+}
+
 void ImageSink::check_size(int w, int h, const std::string& enc, const std::string& what) {
   if (width_ == 0) {
     width_ = w;
@@ -93,9 +99,10 @@ std::int64_t ImageSink::add(const Message& m, const std::string& what, std::stri
     } else {
       check_size(width_, height_, kind, what);
     }
-    filename = std::to_string(c.stamp_ns) + (kind == "png" ? ".png" : ".jpg");
+    const std::int64_t t = stamp_or_log_time(c.stamp_ns, m);
+    filename = std::to_string(t) + (kind == "png" ? ".png" : ".jpg");
     write_bytes(dir_ / filename, d);
-    return c.stamp_ns;
+    return t;
   }
   const ImageMsg im = decode_image(m.data, serialization_, what);
   Layout l;
@@ -126,12 +133,15 @@ std::int64_t ImageSink::add(const Message& m, const std::string& what, std::stri
   }
   if (l.conversion >= 0) cv::cvtColor(img, out, l.conversion);
   pixel_.bayer = l.bayer;
-  filename = std::to_string(im.stamp_ns) + ".png";
+  if (im.width == 0 || im.height == 0)
+    throw InputError(what + ": an empty image (width or height 0)");
+  const std::int64_t t = stamp_or_log_time(im.stamp_ns, m);
+  filename = std::to_string(t) + ".png";
   const std::vector<int> params = {cv::IMWRITE_PNG_COMPRESSION, 3};
   if (!cv::imwrite((dir_ / filename).string(), out, params)) {
     throw std::runtime_error("cannot write " + (dir_ / filename).string());
   }
-  return im.stamp_ns;
+  return t;
 }
 
 }  // namespace omnivert::recording

@@ -24,9 +24,13 @@ class ImageSink {
   int height() const { return height_; }
   const std::string& encoding() const { return encoding_; }
   const PixelFormat& pixel_format() const { return pixel_; }
+  // Images whose header stamp was 0: their recording time was used instead.
+  std::size_t unstamped() const { return unstamped_; }
 
  private:
   void check_size(int w, int h, const std::string& enc, const std::string& what);
+  std::int64_t stamp_or_log_time(std::int64_t stamp, const Message& m);
+  std::size_t unstamped_ = 0;
   std::filesystem::path dir_;
   Serialization serialization_;
   bool compressed_;

@@ -127,6 +127,7 @@ Collected collect(Recording& rec,
   std::int64_t last_odo = kNone;
   JointIndex idx;
   double left0 = 0, right0 = 0;
+  std::size_t unstamped = 0;
   rec.read(
       topics,
       [&](const Message& m) {
@@ -141,7 +142,8 @@ Collected collect(Recording& rec,
           }
           c.images.emplace_back(t, name);
         } else if (m.topic->name == o.joint_states_topic) {
-          const JointStateMsg js = decode_joint_state(m.data, rec.serialization(), what);
+          JointStateMsg js = decode_joint_state(m.data, rec.serialization(), what);
+          if (js.stamp_ns == 0) js.stamp_ns = m.log_time_ns, ++unstamped;
           const double l = joint_travel(js, o, idx, false, what),
                        r = joint_travel(js, o, idx, true, what);
           if (!advances(js.stamp_ns, last_odo, what)) return void(++s.duplicate_stamps);
@@ -151,7 +153,8 @@ Collected collect(Recording& rec,
           last_odo = js.stamp_ns;
           c.wheel.push_back({js.stamp_ns, {l - left0, r - right0}, static_cast<int>(m.index)});
         } else if (m.topic->name == o.odometry_topic) {
-          const OdometryMsg od = decode_odometry(m.data, rec.serialization(), what);
+          OdometryMsg od = decode_odometry(m.data, rec.serialization(), what);
+          if (od.stamp_ns == 0) od.stamp_ns = m.log_time_ns, ++unstamped;
           if (!advances(od.stamp_ns, last_odo, what)) return void(++s.duplicate_stamps);
           last_odo = od.stamp_ns;
           c.poses.push_back(
@@ -168,6 +171,10 @@ Collected collect(Recording& rec,
   s.width = c.width;
   s.height = c.height;
   s.image_encoding = c.encoding;
+  if (unstamped + sink.unstamped() > 0) {
+    s.warnings.push_back(std::to_string(unstamped + sink.unstamped()) +
+                         " message(s) had no header stamp (0); their recording time was used");
+  }
   if (s.duplicate_stamps > 0) {
     s.warnings.push_back(std::to_string(s.duplicate_stamps) +
                          " odometry message(s) repeated the previous stamp and were dropped");

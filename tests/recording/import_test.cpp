@@ -250,6 +250,22 @@ TEST_F(ImportTest, TumPoseFileAndImagesOutsideTheOdometry) {
   EXPECT_NEAR(d.wheel().back().travel.right, 0.3, 1e-9);
 }
 
+TEST_F(ImportTest, ImagesWithoutStampsTakeTheRecordingTime) {
+  joint_states();
+  o.image_topic = "/camera/unstamped";
+  const auto s = run("ros1_lz4.bag");
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_EQ(s.warnings[0], "5 message(s) had no header stamp (0); their recording time was used");
+  const auto d = dataset::Dataset::load(o.out);
+  ASSERT_EQ(d.size(), 5u);
+  for (int k = 0; k < 5; ++k) {
+    EXPECT_NEAR(static_cast<double>(d.images()[k].timestamp_ns) * 1e-9 - 1700000000.0,
+                0.01 + 0.2 * k,
+                1e-6);
+    EXPECT_EQ(d.image(k)(1, 2), pixel(k, 2, 1));
+  }
+}
+
 TEST_F(ImportTest, ExistingOutputIsKeptWithoutOverwrite) {
   joint_states();
   fs::create_directories(o.out);

@@ -91,7 +91,8 @@ TEST(Recording, FormatsAndSerialisation) {
 
 // The first `keep` bytes of a fixture, in a temporary file.
 std::string truncated(const std::string& name, double keep) {
-  const fs::path out = fs::temp_directory_path() / ("omnivert_cut_" + name);
+  const fs::path out =
+      fs::temp_directory_path() / ("omnivert_cut_" + std::to_string(keep) + "_" + name);
   fs::copy_file(kFx + "/" + name, out, fs::copy_options::overwrite_existing);
   fs::resize_file(out, static_cast<std::uintmax_t>(static_cast<double>(fs::file_size(out)) * keep));
   return out.string();
@@ -108,10 +109,16 @@ std::string error_of(const std::string& path) {
 }
 
 TEST(Recording, TruncatedFilesAreRefusedByName) {
-  const std::string bag = truncated("ros1_lz4.bag", 0.6);
+  // Cut among the chunks: the bag header points past the end.
+  const std::string bag = truncated("ros1_lz4.bag", 0.3);
   EXPECT_NE(error_of(bag).find(bag + ": the bag's index is missing"), std::string::npos)
       << error_of(bag);
   EXPECT_NE(error_of(bag).find("truncated"), std::string::npos);
+  // Cut inside the index (the connection records with their message definitions).
+  const std::string index = truncated("ros1_lz4.bag", 0.8);
+  EXPECT_NE(error_of(index).find(index + ": connection record"), std::string::npos)
+      << error_of(index);
+  EXPECT_NE(error_of(index).find("(truncated recording?)"), std::string::npos);
   const std::string mcap = truncated("ros2_zstd.mcap", 0.6);
   EXPECT_NE(error_of(mcap).find(mcap + ": the MCAP file is truncated"), std::string::npos)
       << error_of(mcap);
@@ -119,7 +126,7 @@ TEST(Recording, TruncatedFilesAreRefusedByName) {
   EXPECT_NE(error_of(tiny).find(tiny), std::string::npos);
   EXPECT_NE(error_of(kFx + "/make_ros1_bags.py").find("not a recording we read"),
             std::string::npos);
-  for (const auto& f : {bag, mcap, tiny}) fs::remove(f);
+  for (const auto& f : {bag, index, mcap, tiny}) fs::remove(f);
 }
 
 }  // namespace
