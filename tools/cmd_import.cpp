@@ -104,7 +104,9 @@ void add_import_command(CLI::App& app) {
   cmd->add_option("--camera-sensor",
                   a->o.camera_sensor,
                   "A cam0/sensor.yaml to copy (centre, annulus, mask); default: resolution only");
-  cmd->add_option("--max-speed", a->o.max_speed, "A pose step faster than this is a jump [m/s]")
+  cmd->add_option("--max-speed",
+                  a->o.max_speed,
+                  "A pose or wheel step faster than this is refused as a jump or reset [m/s]")
       ->capture_default_str()
       ->check(kPositive);
   cmd->callback([a] { run_import(*a); });
