@@ -7,6 +7,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <random>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -264,6 +266,40 @@ TEST_F(ImportTest, ImagesWithoutStampsTakeTheRecordingTime) {
                 1e-6);
     EXPECT_EQ(d.image(k)(1, 2), pixel(k, 2, 1));
   }
+}
+
+// Damaged recordings (1 to 8 random bytes changed, 30 draws each) either import or end with an
+// InputError; never another exception, a crash or a partial dataset.
+TEST_F(ImportTest, DamagedRecordingsEndWithInputErrorOnly) {
+  joint_states();
+  o.overwrite = true;
+  std::mt19937 rng(7);
+  int refused = 0, imported = 0;
+  for (const char* name : {"ros1_lz4.bag", "ros1_bz2.bag", "ros2_zstd.mcap", "ros2_lz4.mcap"}) {
+    std::ifstream in(kFx + "/" + name, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    for (int draw = 0; draw < 30; ++draw) {
+      std::string bad = bytes;
+      const int n = std::uniform_int_distribution<int>(1, 8)(rng);
+      for (int i = 0; i < n; ++i) {
+        bad[std::uniform_int_distribution<std::size_t>(0, bad.size() - 1)(rng)] =
+            static_cast<char>(rng() & 0xFF);
+      }
+      const fs::path file = dir / (std::string("damaged_") + name);
+      std::ofstream(file, std::ios::binary) << bad;
+      try {
+        auto rec = open_recording(file.string());
+        import_recording(*rec, o);
+        ++imported;
+      } catch (const InputError&) {
+        ++refused;
+        EXPECT_FALSE(fs::exists(o.out)) << name << " draw " << draw;
+      }
+      fs::remove_all(o.out);
+    }
+  }
+  EXPECT_EQ(refused + imported, 120);
+  EXPECT_GT(refused, 0);
 }
 
 TEST_F(ImportTest, ExistingOutputIsKeptWithoutOverwrite) {
