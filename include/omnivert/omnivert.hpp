@@ -17,6 +17,7 @@
 //                                          covariance, observability verdict, checks (Sec. 7-8)
 //   omnivert::calib::CalibrationFilter     the same, frame by frame, as a robot drives (EKF)
 //   omnivert::pipeline::calibrate_dataset  the main job: dataset folder -> every output file
+//   omnivert::recording::import_recording  a ROS 1 / ROS 2 recording -> a dataset folder
 //
 // Example: the main job, then the same from the lines of each image.
 //
@@ -36,7 +37,7 @@
 // problem (core/error.hpp); invalid options are reported by their IsValid(&why).
 //
 // Each stage is also a library of its own (omnivert::core, extract, describe, match, dataset,
-// calib, sim, viz, pipeline, eval); omnivert::omnivert links them all. The estimator
+// recording, calib, sim, viz, pipeline, eval); omnivert::omnivert links them all. The estimator
 // (omnivert::calib) needs only Eigen and Ceres.
 
 #include "omnivert/calib/calibrate.hpp"
@@ -51,3 +52,4 @@
 #include "omnivert/match/tracks_io.hpp"
 #include "omnivert/pipeline/calibrate_dataset.hpp"
 #include "omnivert/pipeline/track_dataset.hpp"
+#include "omnivert/recording/import.hpp"

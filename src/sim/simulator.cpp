@@ -12,6 +12,7 @@
 
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
+#include "omnivert/dataset/writer.hpp"
 #include "omnivert/sim/map_picture.hpp"
 
 namespace omnivert::sim {
@@ -123,38 +124,34 @@ void write_wheel_data(const fs::path& path,
                       const WheelSamples& wheels,
                       const WheelConfig& wc,
                       std::int64_t t0) {
-  FILE* f = open_or_throw(path);
-  FileCloser closer{f};
-  std::fprintf(f,
-               wc.ticks ? "#timestamp [ns],left [ticks],right [ticks]\n"
-                        : "#timestamp [ns],left [m],right [m]\n");
+  dataset::WheelCsvWriter csv(path.string(),
+                              wc.ticks ? dataset::WheelUnit::kTicks : dataset::WheelUnit::kMeters);
   for (std::size_t i = 0; i < wheels.t.size(); ++i) {
     const std::int64_t ts = t0 + std::llround(wheels.t[i] * 1e9);
     if (wc.ticks) {
-      std::fprintf(f,
-                   "%" PRId64 ",%" PRId64 ",%" PRId64 "\n",
-                   ts,
-                   to_ticks(wheels.left[i], wc.ticks_per_meter_left, wc.counter_bits),
-                   to_ticks(wheels.right[i], wc.ticks_per_meter_right, wc.counter_bits));
+      csv.add_ticks(ts,
+                    to_ticks(wheels.left[i], wc.ticks_per_meter_left, wc.counter_bits),
+                    to_ticks(wheels.right[i], wc.ticks_per_meter_right, wc.counter_bits));
     } else {
-      std::fprintf(f, "%" PRId64 ",%.9f,%.9f\n", ts, wheels.left[i], wheels.right[i]);
+      csv.add_meters(ts, wheels.left[i], wheels.right[i]);
     }
   }
+  csv.close();
 }
 
 // wheel0/sensor.yaml.
 void write_wheel_sensor(const fs::path& path, const WheelConfig& wc) {
-  std::string y = "# omnivert simulator: wheel encoders (dataset format: docs/simulator.md)\n";
-  y += "wheel_base: " + fmt("%.9g", wc.wheel_base) + "   # e [m], eq. (15)\n";
-  y += std::string("unit: ") + (wc.ticks ? "ticks" : "meters") + "\n";
-  if (wc.ticks) {
-    y += "ticks_per_meter_left: " + fmt("%.9g", wc.ticks_per_meter_left) + "\n";
-    y += "ticks_per_meter_right: " + fmt("%.9g", wc.ticks_per_meter_right) + "\n";
-    if (wc.counter_bits > 0) y += "counter_bits: " + std::to_string(wc.counter_bits) + "\n";
-  }
-  y += "odometry_k: " + fmt("%.9g", wc.odometry_k) + "   # Chong-Kleeman K [m], eq. (31)\n";
-  y += "rate_hz: " + fmt("%.9g", wc.rate_hz) + "\n";
-  write_text(path, y);
+  dataset::WheelSensor s;
+  s.wheel_base = wc.wheel_base;
+  s.unit = wc.ticks ? dataset::WheelUnit::kTicks : dataset::WheelUnit::kMeters;
+  s.ticks_per_meter_left = wc.ticks_per_meter_left;
+  s.ticks_per_meter_right = wc.ticks_per_meter_right;
+  s.counter_bits = wc.counter_bits;
+  s.odometry_k = wc.odometry_k;
+  write_text(
+      path,
+      dataset::wheel_sensor_yaml(
+          s, wc.rate_hz, "omnivert simulator: wheel encoders (dataset format: docs/simulator.md)"));
 }
 
 // cam0/sensor.yaml.
@@ -272,13 +269,11 @@ void write_frames(const fs::path& dir,
                   const std::function<void(int, int)>& progress) {
   const std::int64_t t0 = cfg.start_ns;
   const int n_frames = times.count;
-  FILE* fcam = open_or_throw(dir / "cam0" / "data.csv");
-  FileCloser ccam{fcam};
+  dataset::ImageCsvWriter fcam((dir / "cam0" / "data.csv").string());
   FILE* fpose = open_or_throw(dir / "ground_truth" / "poses.csv");
   FileCloser cpose{fpose};
   FILE* flines = open_or_throw(dir / "ground_truth" / "lines.csv");
   FileCloser clines{flines};
-  std::fprintf(fcam, "#timestamp [ns],filename\n");
   std::fprintf(fpose, "#timestamp [ns],x [m],y [m],theta [rad]\n");
   std::fprintf(flines, "#timestamp [ns],frame,line_id,bearing [rad],r_inner [px],r_outer [px]\n");
   std::mt19937_64 image_rng(cfg.seed * 2 + 2);
@@ -305,7 +300,7 @@ void write_frames(const fs::path& dir,
     if (!cv::imwrite((dir / "cam0" / "data" / name).string(), img, png_params)) {
       throw std::runtime_error("cannot write image " + (dir / "cam0" / "data" / name).string());
     }
-    std::fprintf(fcam, "%" PRId64 ",%s\n", ts, name.c_str());
+    fcam.add(ts, name);
     std::fprintf(
         fpose, "%" PRId64 ",%.9f,%.9f,%.9f\n", ts, robot.x(), robot.y(), wrap_angle(robot.z()));
     for (const VisibleLine& l : renderer.visible_lines(cam, cfg.min_line_px)) {
@@ -322,7 +317,8 @@ void write_frames(const fs::path& dir,
     if (progress) progress(k + 1, n_frames);
   }
   summary.mean_lines = static_cast<double>(total_lines) / n_frames;
-  for (FILE* f : {fcam, fpose, flines}) {
+  fcam.close();
+  for (FILE* f : {fpose, flines}) {
     if (std::ferror(f)) throw std::runtime_error("write error in " + dir.string());
   }
 }

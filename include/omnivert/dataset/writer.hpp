@@ -1,0 +1,67 @@
+#pragma once
+// Writing the dataset folder (layout in dataset.hpp, format in docs/dataset-format.md): the
+// files every writer of datasets shares (`omnivert simulate`, `omnivert import`), one row at
+// a time so that a long recording is never held in memory.
+
+#include <cstdint>
+#include <cstdio>
+#include <string>
+
+#include "omnivert/dataset/dataset.hpp"
+
+namespace omnivert::dataset {
+
+// A CSV file written row by row; throws std::runtime_error naming the file when it cannot be
+// opened or written.
+class CsvWriter {
+ public:
+  CsvWriter(std::string path, const std::string& header);
+  ~CsvWriter();
+  CsvWriter(const CsvWriter&) = delete;
+  CsvWriter& operator=(const CsvWriter&) = delete;
+  // Writes a finished line (without the newline).
+  void row(const std::string& line);
+  // Flushes and closes; throws when a write failed.
+  void close();
+  std::FILE* file() { return f_; }
+
+ private:
+  std::string path_;
+  std::FILE* f_ = nullptr;
+};
+
+// cam0/data.csv: "#timestamp [ns],filename".
+class ImageCsvWriter {
+ public:
+  explicit ImageCsvWriter(const std::string& path);
+  void add(std::int64_t timestamp_ns, const std::string& filename);
+  void close() { csv_.close(); }
+
+ private:
+  CsvWriter csv_;
+};
+
+// wheel0/data.csv: "#timestamp [ns],left [m],right [m]" (cumulative travel, %.9f) or
+// "#timestamp [ns],left [ticks],right [ticks]".
+class WheelCsvWriter {
+ public:
+  WheelCsvWriter(const std::string& path, WheelUnit unit);
+  void add_meters(std::int64_t timestamp_ns, double left, double right);
+  void add_ticks(std::int64_t timestamp_ns, std::int64_t left, std::int64_t right);
+  void close() { csv_.close(); }
+
+ private:
+  CsvWriter csv_;
+  WheelUnit unit_;
+};
+
+// wheel0/sensor.yaml: wheel_base, unit, ticks per meter and counter_bits (ticks),
+// odometry_k when given, rate_hz when > 0; `provenance` is the first comment line.
+std::string wheel_sensor_yaml(const WheelSensor& sensor,
+                              double rate_hz,
+                              const std::string& provenance);
+
+// Writes `text` to `path`; throws std::runtime_error naming the file on failure.
+void write_text_file(const std::string& path, const std::string& text);
+
+}  // namespace omnivert::dataset

@@ -1,0 +1,86 @@
+#include "omnivert/dataset/writer.hpp"
+
+#include <cinttypes>
+#include <fstream>
+#include <stdexcept>
+
+namespace omnivert::dataset {
+
+namespace {
+
+std::string fmt(const char* format, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, format, v);
+  return buf;
+}
+
+}  // namespace
+
+CsvWriter::CsvWriter(std::string path, const std::string& header) : path_(std::move(path)) {
+  f_ = std::fopen(path_.c_str(), "w");
+  if (!f_) throw std::runtime_error("cannot write " + path_);
+  row(header);
+}
+
+CsvWriter::~CsvWriter() {
+  if (f_) std::fclose(f_);
+}
+
+void CsvWriter::row(const std::string& line) {
+  std::fputs(line.c_str(), f_);
+  std::fputc('\n', f_);
+}
+
+void CsvWriter::close() {
+  if (!f_) return;
+  const bool bad = std::ferror(f_) != 0;
+  const bool close_failed = std::fclose(f_) != 0;
+  f_ = nullptr;
+  if (bad || close_failed) throw std::runtime_error("write error in " + path_);
+}
+
+ImageCsvWriter::ImageCsvWriter(const std::string& path) : csv_(path, "#timestamp [ns],filename") {}
+
+void ImageCsvWriter::add(std::int64_t timestamp_ns, const std::string& filename) {
+  std::fprintf(csv_.file(), "%" PRId64 ",%s\n", timestamp_ns, filename.c_str());
+}
+
+WheelCsvWriter::WheelCsvWriter(const std::string& path, WheelUnit unit)
+    : csv_(path,
+           unit == WheelUnit::kTicks ? "#timestamp [ns],left [ticks],right [ticks]"
+                                     : "#timestamp [ns],left [m],right [m]"),
+      unit_(unit) {}
+
+void WheelCsvWriter::add_meters(std::int64_t timestamp_ns, double left, double right) {
+  if (unit_ != WheelUnit::kMeters) throw std::logic_error("wheel0/data.csv is in ticks");
+  std::fprintf(csv_.file(), "%" PRId64 ",%.9f,%.9f\n", timestamp_ns, left, right);
+}
+
+void WheelCsvWriter::add_ticks(std::int64_t timestamp_ns, std::int64_t left, std::int64_t right) {
+  if (unit_ != WheelUnit::kTicks) throw std::logic_error("wheel0/data.csv is in meters");
+  std::fprintf(csv_.file(), "%" PRId64 ",%" PRId64 ",%" PRId64 "\n", timestamp_ns, left, right);
+}
+
+std::string wheel_sensor_yaml(const WheelSensor& s, double rate_hz, const std::string& provenance) {
+  std::string y = "# " + provenance + "\n";
+  y += "wheel_base: " + fmt("%.9g", s.wheel_base) + "   # e [m], eq. (15)\n";
+  y += std::string("unit: ") + (s.unit == WheelUnit::kTicks ? "ticks" : "meters") + "\n";
+  if (s.unit == WheelUnit::kTicks) {
+    y += "ticks_per_meter_left: " + fmt("%.9g", s.ticks_per_meter_left) + "\n";
+    y += "ticks_per_meter_right: " + fmt("%.9g", s.ticks_per_meter_right) + "\n";
+    if (s.counter_bits > 0) y += "counter_bits: " + std::to_string(s.counter_bits) + "\n";
+  }
+  if (s.odometry_k) {
+    y += "odometry_k: " + fmt("%.9g", *s.odometry_k) + "   # Chong-Kleeman K [m], eq. (31)\n";
+  }
+  if (rate_hz > 0) y += "rate_hz: " + fmt("%.9g", rate_hz) + "\n";
+  return y;
+}
+
+void write_text_file(const std::string& path, const std::string& text) {
+  std::ofstream out(path);
+  out << text;
+  if (!out) throw std::runtime_error("cannot write " + path);
+}
+
+}  // namespace omnivert::dataset
