@@ -11,7 +11,10 @@
 #include <string>
 #include <vector>
 
+#include <spdlog/spdlog.h>
+
 #include "calib/batch_problem.hpp"
+#include "calib/marginal_information.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
 
@@ -21,42 +24,30 @@ using namespace internal;
 
 namespace {
 
-// The Fisher information F = J^T J of the batch problem at its point (n x n, the variables of
-// variable_blocks; the residuals are already divided by their sigmas). Frame 0 is not a
-// variable (gauge).
-Eigen::MatrixXd fisher_information(Built& b) {
-  ceres::Problem::EvaluateOptions eo;
-  eo.parameter_blocks = variable_blocks(b);
-  eo.apply_loss_function = false;
-  ceres::CRSMatrix crs;
-  b.problem->Evaluate(eo, nullptr, nullptr, nullptr, &crs);
-  return information_from_jacobian(crs);
-}
+// Variables up to which the dense reference is a fallback (seconds at this size).
+constexpr Eigen::Index kDenseFallbackLimit = 3000;
 
-// Marginal information of the extrinsics: Schur complement of the nuisance block
-// (pseudo-inverse, so that features without parallax do not poison it). The nuisance
-// variables are scaled to unit information first (Jacobi): poses, features in metres and
-// bearings whitened by a small sigma span many orders of magnitude, and unscaled, the
-// pseudo-inverse's cut (relative to the largest eigenvalue) dropped the depth of a feature
-// seen with little parallax while its coupling to the extrinsics stayed: the bound of
-// phi + psi came out 2.2 times too small against the full inverse's
-// (Observability.BoundIsTheMarginalOfTheFullInverseOfTheSolvedProblem).
-Eigen::Matrix3d marginal_information(const Eigen::MatrixXd& F) {
-  const int n = static_cast<int>(F.rows()), no = n - 3;
-  Eigen::VectorXd scale(no);
-  for (int i = 0; i < no; ++i) scale(i) = F(i, i) > 0.0 ? 1.0 / std::sqrt(F(i, i)) : 1.0;
-  const Eigen::MatrixXd Foo = scale.asDiagonal() * F.topLeftCorner(no, no) * scale.asDiagonal();
-  const Eigen::MatrixXd Foe = scale.asDiagonal() * F.topRightCorner(no, 3);
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Foo);
-  const Eigen::VectorXd& lam = es.eigenvalues();
-  const double lmax = lam.cwiseAbs().maxCoeff();
-  Eigen::VectorXd inv = Eigen::VectorXd::Zero(no);
-  for (int i = 0; i < no; ++i)
-    if (lam(i) > 1e-14 * lmax) inv(i) = 1.0 / lam(i);
-  const Eigen::MatrixXd UtFoe = es.eigenvectors().transpose() * Foe;
-  Eigen::Matrix3d S = F.bottomRightCorner<3, 3>() - UtFoe.transpose() * inv.asDiagonal() * UtFoe;
-  S = 0.5 * (S + S.transpose()).eval();
-  return S;
+// The marginal information of the extrinsics at the problem's point (Sec. 8.1): the Schur
+// complement of the poses, features and track biases, computed on the sparse structure
+// (marginal_information.hpp; docs/calibration.md#cramer-rao-bounds). Should the sparse system
+// not factor, a problem small enough for the dense reference takes it; a larger one is
+// reported as determining nothing.
+Eigen::Matrix3d marginal_information(Built& b, bool dense_reference) {
+  const Eigen::SparseMatrix<double> F = fisher_information(b);
+  if (dense_reference) return marginal_information_dense(Eigen::MatrixXd(F));
+  SparseMarginalStats stats;
+  const Eigen::Matrix3d S = marginal_information_sparse(F, layout_of(b), &stats);
+  spdlog::debug(
+      "observability: {} variables, {} track directions without information, sparse system "
+      "{} nonzeros",
+      F.rows(),
+      stats.dropped_directions,
+      stats.reduced_nonzeros);
+  if (stats.ok) return S;
+  if (F.rows() <= kDenseFallbackLimit) return marginal_information_dense(Eigen::MatrixXd(F));
+  spdlog::warn("observability: the information did not factor; nothing is reported "
+               "determined");
+  return Eigen::Matrix3d::Zero();
 }
 
 // The verdicts on S, the marginal information: its eigenvalues scaled by the thresholds, its
@@ -176,7 +167,7 @@ ObservabilityReport analyse_observability(const CalibrationRun& run,
   std::string why;
   if (!options.IsValid(&why)) throw InputError("calibration options: " + why);
   Built b = build(run, options, at, /*robust=*/false);
-  const Eigen::Matrix3d S = marginal_information(fisher_information(b));
+  const Eigen::Matrix3d S = marginal_information(b, options.observability.dense_reference);
   ObservabilityReport rep;
   judge_information(S, at.extrinsics, options.observability, &rep);
   check_rotation(run, options, at, &rep);

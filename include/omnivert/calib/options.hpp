@@ -211,6 +211,12 @@ struct ObservabilityOptions {
   // its estimated trajectory come from heading noise (a straight run at 0.025 degree of
   // bearing noise: rho's bound 15.6 mm, under the 2 cm above), and they are not determined.
   double min_rotation_sigmas = 5.0;
+  // The marginal information of (phi, rho, psi) is computed on the problem's sparse structure
+  // (each track eliminated on its own, then the poses' chain by a sparse LDLT: linear in the
+  // run's length). true: the plain reference instead, the whole nuisance block eigen-
+  // decomposed (cubic in the run's length, quadratic in memory: for tests; the same numbers
+  // to 1e-6, docs/calibration.md#cramer-rao-bounds).
+  bool dense_reference = false;
 };
 
 struct CalibrationOptions {
