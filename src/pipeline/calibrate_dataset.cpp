@@ -100,7 +100,7 @@ calib::ReportInputs::TimeOffset time_offset_report(const CalibrateDatasetResult&
   t.sigma_s = e.sigma_s;
   t.pairs = e.pairs;
   t.residual_scale = e.residual_scale;
-  t.line = time_offset_line(e, t.given, t.applied);
+  t.line = r.time_offset_message;
   return t;
 }
 
@@ -203,6 +203,8 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
   ri.seconds_calibration = std::chrono::duration<double>(t2 - t1).count();
   ri.warnings = r.warnings;
   ri.wrote_extrinsics = r.wrote_extrinsics;
+  r.time_offset_message =
+      time_offset_line(r.time_offset, r.time_offset_given, r.time_offset_applied, o.time_offset);
   ri.time_offset = time_offset_report(r);
   if (r.wrote_extrinsics) {
     calib::write_extrinsics_yaml((out / "extrinsics.yaml").string(), result);
@@ -296,7 +298,7 @@ std::string CalibrateDatasetResult::BriefReport() const {
               rad2deg(o.phi.crlb),
               o.rho.crlb * 1e3,
               rad2deg(o.psi.crlb));
-  s += time_offset_line(time_offset, time_offset_given, time_offset_applied) + "\n";
+  s += time_offset_message + "\n";
   if (truth) s += truth_lines(*this, refined);
   s += o.message + "\n";
   s += "results in " + out_dir + ": " +

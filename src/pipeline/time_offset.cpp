@@ -120,6 +120,12 @@ double median(std::vector<double> v) {
   return *mid;
 }
 
+std::string fmt_g(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
 }  // namespace
 
 bool TimeOffsetEstimate::significant(const TimeOffsetOptions& o) const {
@@ -221,7 +227,10 @@ TimeOffsetEstimate estimate_time_offset(const dataset::Dataset& data,
   return estimate_time_offset(in, o);
 }
 
-std::string time_offset_line(const TimeOffsetEstimate& e, bool given, bool applied) {
+std::string time_offset_line(const TimeOffsetEstimate& e,
+                             bool given,
+                             bool applied,
+                             const TimeOffsetOptions& o) {
   char buf[400];
   if (given) {
     std::snprintf(buf,
@@ -237,7 +246,10 @@ std::string time_offset_line(const TimeOffsetEstimate& e, bool given, bool appli
                   e.offset_s * 1e3,
                   e.sigma_s * 1e3,
                   e.pairs,
-                  applied ? "applied" : "not applied (not significant)");
+                  applied ? "applied"
+                          : ("not applied (applied above " + fmt_g(o.significance) +
+                             " sigma and " + fmt_g(o.min_applied_s * 1e3) + " ms)")
+                                .c_str());
   }
   return buf;
 }

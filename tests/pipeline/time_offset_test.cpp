@@ -3,7 +3,7 @@
 // simulator's), the camera off the axle (parallax), wheels at 50 Hz, images at 3 Hz whose
 // stamps are late by S, 0.03 degree of bearing noise, the wheels' noise of eq. (31). The offset is recovered within its
 // sigma; constant motion does not determine it; a wheel-base error does not move it, nor do
-// outliers; an offset inside the noise is not significant.
+// outliers; an offset of 80 ms is significant (applied).
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -150,6 +150,10 @@ TEST(TimeOffset, TheLineSaysWhatWasDone) {
   EXPECT_EQ(time_offset_line(e, false, true),
             "time offset: image stamps late by 41.2 +- 0.8 ms (from 92 image pairs); applied");
   EXPECT_EQ(time_offset_line(e, true, true), "time offset: image stamps late by 41.2 ms (given)");
+  e.offset_s = 0.0156;
+  EXPECT_EQ(time_offset_line(e, false, false),
+            "time offset: image stamps late by 15.6 +- 0.8 ms (from 92 image pairs); not applied "
+            "(applied above 3 sigma and 20 ms)");
 }
 
 }  // namespace

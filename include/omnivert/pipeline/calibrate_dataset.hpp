@@ -75,6 +75,7 @@ struct CalibrateDatasetResult {
   bool tilt_corrected = false;        // the frames were rectified with tilt.vector
   TimeOffsetEstimate time_offset;     // estimated, or the given one (time_offset_given)
   bool time_offset_given = false, time_offset_applied = false;
+  std::string time_offset_message;  // time_offset_line(): the terminal's and the report's line
 
   // The answer: the refinement's estimate when it ran and its covariance is usable, else the
   // filter's (the same as calibration.extrinsics / calibration.covariance).

@@ -87,7 +87,10 @@ TimeOffsetEstimate estimate_time_offset(const dataset::Dataset& data,
                                         const TimeOffsetOptions& options = {});
 
 // One line for the terminal and the report, e.g. "time offset: image stamps late by 41.2 +-
-// 0.8 ms (from 92 image pairs); applied".
-std::string time_offset_line(const TimeOffsetEstimate& e, bool given, bool applied);
+// 0.8 ms (from 92 image pairs); applied" (or "not applied (applied above 3 sigma and 20 ms)").
+std::string time_offset_line(const TimeOffsetEstimate& e,
+                             bool given,
+                             bool applied,
+                             const TimeOffsetOptions& options = {});
 
 }  // namespace omnivert::pipeline
