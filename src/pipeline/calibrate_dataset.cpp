@@ -118,13 +118,13 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
                                          const CalibrateDatasetOptions& o) {
   std::string why;
   if (!o.features.IsValid(&why)) throw InputError("invalid extraction options: " + why);
+  if (!o.frames.IsValid(&why)) throw InputError("invalid frame options: " + why);
   dataset::LoadOptions lo;
   lo.require_wheel = true;
   lo.allow_missing_images = true;
   auto data = dataset::Dataset::load(dataset_dir, lo);
   const calib::CalibrationOptions opt = calib::options_from_dataset(data, o.calibration);
   if (!opt.IsValid(&why)) throw InputError("invalid calibration options: " + why);
-  if (!o.frames.IsValid(&why)) throw InputError("invalid frame options: " + why);
 
   // Read before the output folder is cleared: the tracks file may be out_dir/tracks.csv.
   std::optional<TrackDatasetResult> given;
