@@ -6,7 +6,9 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <cstdio>
+#include <exception>
 #include <memory>
 #include <optional>
 #include <string>
@@ -45,6 +47,8 @@ struct CalibrateArgs {
   std::string mask;
   TiltCheckOptions tilt;
   TrackerFlags tracker;
+  calib::RobotFrames frames;  // --base-frame, --camera-frame, --camera-height
+  std::string time_offset = "estimate";  // --time-offset: "estimate" or seconds
 };
 
 // The prior from a YAML file: keys phi, rho, psi, sigma_phi, sigma_rho, sigma_psi [rad, m]
@@ -93,6 +97,11 @@ void run_calibrate(const CalibrateArgs& a) {
   o.input = a.input;
   o.tracks_file = a.tracks_file;
   o.force = a.force;
+  o.frames = a.frames;
+  if (a.time_offset != "estimate") o.time_offset_s = std::stod(a.time_offset);
+  if (!a.frames.camera_height && !a.prior_file.empty())
+    o.frames.camera_height =
+        yaml::optional_number(yaml::load_file(a.prior_file), "camera_height", a.prior_file);
   o.command = command_line();
   if (!a.tracks_file.empty() && !a.unused_with_tracks.empty()) {
     std::string list;
@@ -192,6 +201,26 @@ void add_model_options(CLI::App* cmd, CalibrateArgs& a) {
       ->check(kPositive)
       ->capture_default_str()
       ->group(gm);
+  cmd->add_option("--time-offset",
+                  a.time_offset,
+                  "Camera-odometry time offset [s], positive when the image stamps are late: "
+                  "the stamps are shifted by it before tracking. 'estimate' (default): "
+                  "estimated from the turn the bearings show against the wheels', reported, "
+                  "and applied when significant (docs/calibration.md#time-offset); 0 turns it off")
+      ->check(CLI::Validator(
+          [](const std::string& v) -> std::string {
+            if (v == "estimate") return {};
+            try {
+              std::size_t used = 0;
+              const double d = std::stod(v, &used);
+              if (used == v.size() && std::isfinite(d) && std::abs(d) <= 10.0) return {};
+            } catch (const std::exception&) {
+            }
+            return "expected 'estimate' or a number of seconds in [-10, 10], got '" + v + "'";
+          },
+          "estimate|SECONDS"))
+      ->capture_default_str()
+      ->group(gm);
   cmd->add_option("--max-wheel-gap",
                   a.input.max_wheel_gap_s,
                   "Wheel samples further apart than this [s] are a gap: the bearings of the "
@@ -199,6 +228,24 @@ void add_model_options(CLI::App* cmd, CalibrateArgs& a) {
       ->check(kPositive)
       ->capture_default_str()
       ->group(gm);
+}
+
+// The robot-format files' frames (calib/robot_formats.hpp).
+void add_frame_options(CLI::App* cmd, CalibrateArgs& a) {
+  const std::string g = "Robot formats (camera_joint.urdf, static_transform_publisher.sh, "
+                        "extrinsics_kalibr.yaml)";
+  cmd->add_option("--base-frame", a.frames.base, "The robot's frame (parent)")
+      ->capture_default_str()
+      ->group(g);
+  cmd->add_option("--camera-frame", a.frames.camera, "The camera's frame (child)")
+      ->capture_default_str()
+      ->group(g);
+  cmd->add_option("--camera-height",
+                  a.frames.camera_height,
+                  "Height of the camera centre above the base frame's origin [m], written as z "
+                  "(not estimated: the bearings are 2-D; default: camera_height of --prior, "
+                  "else 0)")
+      ->group(g);
 }
 
 }  // namespace
@@ -258,6 +305,7 @@ void add_calibrate_command(CLI::App& app) {
                 "parameter");
   add_prior_options(cmd, *a);
   add_model_options(cmd, *a);
+  add_frame_options(cmd, *a);
   add_pipeline_options(cmd, a->pipeline);
   add_mask_option(cmd, a->mask);
   add_tilt_options(cmd, a->tilt);

@@ -460,6 +460,19 @@ cv::Mat1b Dataset::image(std::size_t i) const {
   return read_checked_image(im.path, camera_);
 }
 
+int Dataset::set_image_time_offset(std::int64_t offset_ns) {
+  image_time_offset_ns_ = offset_ns;
+  if (wheel_.empty()) return 0;
+  int outside = 0;
+  travel_at_images_.clear();
+  for (std::size_t i = 0; i < images_.size(); ++i) {
+    outside += image_outside_wheel_data(i) ? 1 : 0;
+    travel_at_images_.push_back(travel_at(
+        std::clamp(odometry_time(i), wheel_.front().timestamp_ns, wheel_.back().timestamp_ns)));
+  }
+  return outside;
+}
+
 WheelTravel Dataset::travel_at(std::int64_t t) const {
   if (wheel_.empty() || t < wheel_.front().timestamp_ns || t > wheel_.back().timestamp_ns) {
     throw std::out_of_range("timestamp outside the wheel data");

@@ -38,7 +38,10 @@ constexpr const char* kOutputs[] = {"extrinsics.yaml",
                                     "states.csv",
                                     "convergence.png",
                                     "tracks.csv",
-                                    "tracks.png"};
+                                    "tracks.png",
+                                    calib::kRobotFormatFiles[0],
+                                    calib::kRobotFormatFiles[1],
+                                    calib::kRobotFormatFiles[2]};
 
 std::string few_tracks_warning(int tracks, const FeaturePipelineOptions& features) {
   std::string w = "only " + std::to_string(tracks) +
@@ -66,6 +69,41 @@ TrackDatasetResult tracks_of(const dataset::Dataset& data,
   });
 }
 
+// Shifts the image stamps by the time offset (Dataset::set_image_time_offset); the images
+// whose odometry time then falls outside the wheel data are warned about (their bearings are
+// not used: calibration_run_from_tracks).
+void apply_time_offset(dataset::Dataset& data,
+                       double offset_s,
+                       bool given,
+                       CalibrateDatasetResult& r) {
+  const int outside = data.set_image_time_offset(std::llround(offset_s * 1e9));
+  if (given) {
+    r.time_offset_given = true;
+    r.time_offset.determined = true;
+    r.time_offset.offset_s = offset_s;
+  }
+  r.time_offset_applied = offset_s != 0.0;
+  if (outside > 0)
+    r.warnings.push_back(std::to_string(outside) + " images fall outside the wheel data once " +
+                         "their stamps are shifted by the time offset (" +
+                         std::to_string(offset_s * 1e3) +
+                         " ms); their bearings are not used");
+}
+
+calib::ReportInputs::TimeOffset time_offset_report(const CalibrateDatasetResult& r) {
+  calib::ReportInputs::TimeOffset t;
+  const TimeOffsetEstimate& e = r.time_offset;
+  t.given = r.time_offset_given;
+  t.determined = e.determined;
+  t.applied = r.time_offset_applied;
+  t.offset_s = e.offset_s;
+  t.sigma_s = e.sigma_s;
+  t.pairs = e.pairs;
+  t.residual_scale = e.residual_scale;
+  t.line = r.time_offset_message;
+  return t;
+}
+
 void prepare_out_dir(const std::string& out_dir) {
   std::error_code ec;
   fs::create_directories(out_dir, ec);
@@ -80,10 +118,11 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
                                          const CalibrateDatasetOptions& o) {
   std::string why;
   if (!o.features.IsValid(&why)) throw InputError("invalid extraction options: " + why);
+  if (!o.frames.IsValid(&why)) throw InputError("invalid frame options: " + why);
   dataset::LoadOptions lo;
   lo.require_wheel = true;
   lo.allow_missing_images = true;
-  const auto data = dataset::Dataset::load(dataset_dir, lo);
+  auto data = dataset::Dataset::load(dataset_dir, lo);
   for (const std::string& n : data.notes()) spdlog::debug("{}", n);
   // Ground truth is optional here (the report's truth rows): one that cannot be read is a
   // warning, not a reason to refuse the calibration.
@@ -102,8 +141,9 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
   r.out_dir = out_dir;
   r.noise_check_requested = o.calibration.noise_check.enabled;
   const auto t0 = Clock::now();
+  if (o.time_offset_s) apply_time_offset(data, *o.time_offset_s, true, r);  // before tracking
   const TrackDatasetResult tracked = tracks_of(data, o, std::move(given));
-  r.warnings = tracked.warnings;
+  r.warnings.insert(r.warnings.begin(), tracked.warnings.begin(), tracked.warnings.end());
   r.tilt = tracked.tilt;
   r.tilt_corrected = tracked.tilt_corrected;
   write_tracks_csv(out / "tracks.csv", tracked.rows);
@@ -113,7 +153,14 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
   r.frames_skipped = tracked.frames_skipped;
   r.detections = static_cast<std::int64_t>(tracked.rows.size());
 
-  // Step 2: the calibration's input; step 3: filter, observability, refinement (Sec. 8).
+  // The time offset, estimated from the tracks when not given; step 2: the calibration's
+  // input; step 3: filter, observability, refinement (Sec. 8).
+  if (!o.time_offset_s) {
+    r.time_offset = estimate_time_offset(
+        data, tracked.rows, opt.robot.odometry_K, opt.noise.bearing_sigma, o.time_offset);
+    if (r.time_offset.significant(o.time_offset))
+      apply_time_offset(data, r.time_offset.offset_s, false, r);
+  }
   r.input = calib::calibration_run_from_tracks(data, tracked.rows, o.input);
   r.warnings.insert(r.warnings.end(), r.input.warnings.begin(), r.input.warnings.end());
   if (r.input.tracks < kFewTracks)
@@ -161,7 +208,13 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
   ri.seconds_calibration = std::chrono::duration<double>(t2 - t1).count();
   ri.warnings = r.warnings;
   ri.wrote_extrinsics = r.wrote_extrinsics;
-  if (r.wrote_extrinsics) calib::write_extrinsics_yaml((out / "extrinsics.yaml").string(), result);
+  r.time_offset_message =
+      time_offset_line(r.time_offset, r.time_offset_given, r.time_offset_applied, o.time_offset);
+  ri.time_offset = time_offset_report(r);
+  if (r.wrote_extrinsics) {
+    calib::write_extrinsics_yaml((out / "extrinsics.yaml").string(), result);
+    calib::write_robot_formats(out.string(), result.extrinsics, result.covariance, o.frames);
+  }
   write_text_atomic((out / "summary.json").string(), calib::summary_json(result, ri));
   write_text_atomic((out / "report.html").string(), calib::report_html(result, ri));
   return r;
@@ -250,9 +303,13 @@ std::string CalibrateDatasetResult::BriefReport() const {
               rad2deg(o.phi.crlb),
               o.rho.crlb * 1e3,
               rad2deg(o.psi.crlb));
+  s += time_offset_message + "\n";
   if (truth) s += truth_lines(*this, refined);
   s += o.message + "\n";
-  s += "results in " + out_dir + ": " + (wrote_extrinsics ? "extrinsics.yaml, " : "") +
+  s += "results in " + out_dir + ": " +
+       (wrote_extrinsics ? "extrinsics.yaml (and as camera_joint.urdf, "
+                           "static_transform_publisher.sh, extrinsics_kalibr.yaml), "
+                         : "") +
        "report.html, summary.json, states.csv, convergence.png, tracks.csv, tracks.png\n";
   return s;
 }

@@ -44,7 +44,8 @@ void add_frame_motion(const dataset::Dataset& data, DatasetRun& out) {
   std::vector<Eigen::Vector2d> steps;
   for (std::size_t i = 1; i < n; ++i) {
     FrameInput& f = out.run.frames[i];
-    const std::int64_t t0 = images[i - 1].timestamp_ns, t1 = images[i].timestamp_ns;
+    // On the odometry clock: the stamps shifted by the camera-odometry time offset.
+    const std::int64_t t0 = data.odometry_time(i - 1), t1 = data.odometry_time(i);
     steps.assign(1, Eigen::Vector2d(travel[i - 1].left, travel[i - 1].right));
     for (std::size_t k = sample_before(wheel, t0) + 1;
          k < wheel.size() && wheel[k].timestamp_ns < t1;
@@ -101,9 +102,17 @@ std::vector<char> wheel_gaps(const dataset::Dataset& data,
       gap_first = gap_last = -1;
     };
     for (std::size_t i = 0; i < n; ++i) {
-      const std::size_t k = sample_before(wheel, images[i].timestamp_ns);
+      // An image outside the wheel data (after a time offset: Dataset::set_image_time_offset)
+      // has no known pose either; the caller warns about those.
+      if (data.image_outside_wheel_data(i)) {
+        gap[i] = 1;
+        ++out.frames_dropped_for_gaps;
+        flush();
+        continue;
+      }
+      const std::size_t k = sample_before(wheel, data.odometry_time(i));
       bool is_gap = false;
-      if (wheel[k].timestamp_ns != images[i].timestamp_ns && k + 1 < wheel.size()) {
+      if (wheel[k].timestamp_ns != data.odometry_time(i) && k + 1 < wheel.size()) {
         const double dt =
             static_cast<double>(wheel[k + 1].timestamp_ns - wheel[k].timestamp_ns) * 1e-9;
         is_gap = dt > opt.max_wheel_gap_s;

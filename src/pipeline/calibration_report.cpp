@@ -370,6 +370,17 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
   }
   j["seconds"] = {{"tracking", num(in.seconds_tracking)},
                   {"calibration", num(in.seconds_calibration)}};
+  {
+    const auto& t = in.time_offset;
+    j["time_offset_s"] = t.determined ? num(t.offset_s) : json(nullptr);
+    j["time_offset_sigma_s"] = t.determined && !t.given ? num(t.sigma_s) : json(nullptr);
+    j["time_offset"] = {{"source", t.given ? "given" : "estimated"},
+                        {"determined", t.determined},
+                        {"applied", t.applied},
+                        {"pairs", t.pairs},
+                        {"residual_scale", num(t.residual_scale)},
+                        {"message", t.line}};
+  }
   j["warnings"] = in.warnings;
   return j.dump(2) + "\n";
 }
@@ -445,6 +456,7 @@ void html_inputs(std::ostringstream& h, const CalibrationResult& r, const Report
     kv("frames with too few lines", std::to_string(in.run->starved_frames));
     kv("frames dropped for wheel gaps", std::to_string(in.run->frames_dropped_for_gaps));
   }
+  if (!in.time_offset.line.empty()) kv("camera-odometry time offset", in.time_offset.line);
   kv("wheel base e / Chong-Kleeman K (x inflation)",
      f("%.4f m", in.options.robot.wheel_base) + " / " + f("%.3g m", in.options.robot.odometry_K) +
          " (x" + f("%g", in.options.filter.odometry_inflation) + ")");

@@ -95,8 +95,8 @@ inline nlohmann::json read_json(const fs::path& file) {
   return nlohmann::json::parse(read_text(file));
 }
 
-// The files a calibration run writes (extrinsics.yaml only when it determines the
-// extrinsics, or is forced).
+// The files a calibration run writes (extrinsics.yaml and the robot formats only when it
+// determines the extrinsics, or is forced).
 inline const std::vector<std::string>& calibration_outputs() {
   static const std::vector<std::string> files{"extrinsics.yaml",
                                               "summary.json",
@@ -104,11 +104,15 @@ inline const std::vector<std::string>& calibration_outputs() {
                                               "states.csv",
                                               "convergence.png",
                                               "tracks.csv",
-                                              "tracks.png"};
+                                              "tracks.png",
+                                              "camera_joint.urdf",
+                                              "static_transform_publisher.sh",
+                                              "extrinsics_kalibr.yaml"};
   return files;
 }
 
-// A run's output folder: every output but extrinsics.yaml present, nothing else (no
+// A run's output folder: every output but extrinsics.yaml and the robot formats present
+// (those two together or neither), nothing else (no
 // temporary file), no NaN in any text output, summary.json valid JSON.
 inline void expect_complete_outputs_without_nan(const fs::path& out) {
   const std::set<std::string> known(calibration_outputs().begin(), calibration_outputs().end());
@@ -116,13 +120,18 @@ inline void expect_complete_outputs_without_nan(const fs::path& out) {
     EXPECT_TRUE(known.count(entry.path().filename().string()))
         << "unexpected file in " << out << ": " << entry.path().filename();
   for (const std::string& f : calibration_outputs()) {
-    if (f != "extrinsics.yaml") {
+    if (f == "extrinsics.yaml" || f == "camera_joint.urdf" ||
+        f == "static_transform_publisher.sh" || f == "extrinsics_kalibr.yaml") {
+      EXPECT_EQ(fs::exists(out / f), fs::exists(out / "extrinsics.yaml"))
+          << f << " and extrinsics.yaml: one without the other in " << out;
+    } else {
       EXPECT_TRUE(fs::exists(out / f)) << "no " << f << " in " << out;
     }
   }
   const std::regex nan("[Nn]a[Nn]([^a-zA-Z]|$)");
   for (const char* f :
-       {"extrinsics.yaml", "summary.json", "states.csv", "report.html", "tracks.csv"}) {
+       {"extrinsics.yaml", "summary.json", "states.csv", "report.html", "tracks.csv",
+        "camera_joint.urdf", "static_transform_publisher.sh", "extrinsics_kalibr.yaml"}) {
     if (fs::exists(out / f)) {
       EXPECT_FALSE(std::regex_search(read_text(out / f), nan)) << f << " contains a NaN";
     }

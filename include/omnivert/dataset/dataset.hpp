@@ -133,8 +133,25 @@ class Dataset {
   // Wheel travel interpolated (linearly) at a timestamp inside the wheel data; throws
   // std::out_of_range outside.
   WheelTravel travel_at(std::int64_t timestamp_ns) const;
-  // Wheel travel at each image timestamp (same order as images()).
+  // Wheel travel at each image's odometry time (same order as images()).
   const std::vector<WheelTravel>& travel_at_images() const { return travel_at_images_; }
+
+  // The camera-odometry time offset (docs/calibration.md#time-offset): positive when the
+  // image stamps are late, so that image i was taken at odometry time
+  // timestamp_ns - offset_ns. Recomputes travel_at_images(); an image whose odometry time
+  // falls outside the wheel data gets the travel of the nearest end (its pose is not known:
+  // image_outside_wheel_data(i)). Returns the number of such images. 0 after load.
+  int set_image_time_offset(std::int64_t offset_ns);
+  std::int64_t image_time_offset_ns() const { return image_time_offset_ns_; }
+  // Image i's stamp on the odometry clock: images()[i].timestamp_ns - image_time_offset_ns().
+  std::int64_t odometry_time(std::size_t i) const {
+    return images_[i].timestamp_ns - image_time_offset_ns_;
+  }
+  bool image_outside_wheel_data(std::size_t i) const {
+    return has_wheel() &&
+           (odometry_time(i) < wheel_.front().timestamp_ns ||
+            odometry_time(i) > wheel_.back().timestamp_ns);
+  }
 
   // Empty when there is no ground_truth/ folder or when it could not be read; then
   // ground_truth_error() says why (file, line and problem) for the tools that need it.
@@ -151,6 +168,7 @@ class Dataset {
   WheelSensor wheel_sensor_;
   std::vector<WheelRecord> wheel_;
   std::vector<WheelTravel> travel_at_images_;
+  std::int64_t image_time_offset_ns_ = 0;
   std::optional<GroundTruth> ground_truth_;
   std::string ground_truth_error_;
   std::vector<std::string> notes_;

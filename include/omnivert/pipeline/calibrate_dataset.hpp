@@ -8,7 +8,9 @@
 //      (calib::calibrate);
 //   4. the outputs, each written atomically into `out_dir`: tracks.csv, tracks.png, states.csv,
 //      convergence.png (Fig. 25), summary.json, report.html, and extrinsics.yaml when the run
-//      determines the extrinsics (or `force`). docs/outputs.md describes every field.
+//      determines the extrinsics (or `force`), and with it the same estimate as a URDF joint,
+//      static_transform_publisher lines and a Kalibr-style YAML (calib/robot_formats.hpp).
+//      docs/outputs.md describes every field.
 //
 // Bad input (a missing or malformed dataset, tracks of another dataset, invalid options)
 // throws InputError naming the file, line and problem; nothing of an earlier run is left in
@@ -22,9 +24,11 @@
 #include <vector>
 
 #include "omnivert/calib/calibrate.hpp"
+#include "omnivert/calib/robot_formats.hpp"
 #include "omnivert/describe/feature_pipeline.hpp"
 #include "omnivert/match/tracker.hpp"
 #include "omnivert/pipeline/calibration_input.hpp"
+#include "omnivert/pipeline/time_offset.hpp"
 #include "omnivert/pipeline/track_dataset.hpp"
 
 namespace omnivert::pipeline {
@@ -45,6 +49,14 @@ struct CalibrateDatasetOptions {
   std::string command;             // the command line, recorded in the report
   std::vector<std::string> notes;  // extra warnings of the caller, reported with the rest
   TiltCheckOptions tilt;           // the tilt of the mirror axis (pipeline/tilt_check.hpp)
+  // Frame names and camera height of the robot-format files written with extrinsics.yaml
+  // (calib/robot_formats.hpp).
+  calib::RobotFrames frames;
+  // The camera-odometry time offset [s], positive when the image stamps are late: given (the
+  // stamps shifted before tracking), or empty: estimated from the tracks and applied to the
+  // calibration's input when significant (pipeline/time_offset.hpp, docs/calibration.md).
+  std::optional<double> time_offset_s;
+  TimeOffsetOptions time_offset;
   // Called while tracking (stage "track", frames done, frames in all) and once before the
   // calibration (stage "calibrate", 0, 0).
   std::function<void(const std::string& stage, std::size_t done, std::size_t total)> progress;
@@ -61,6 +73,9 @@ struct CalibrateDatasetResult {
   bool noise_check_requested = true;  // CalibrationOptions::noise_check.enabled of the run
   TiltEstimate tilt;                  // measured before tracking (not valid: not measured)
   bool tilt_corrected = false;        // the frames were rectified with tilt.vector
+  TimeOffsetEstimate time_offset;     // estimated, or the given one (time_offset_given)
+  bool time_offset_given = false, time_offset_applied = false;
+  std::string time_offset_message;  // time_offset_line(): the terminal's and the report's line
 
   // The answer: the refinement's estimate when it ran and its covariance is usable, else the
   // filter's (the same as calibration.extrinsics / calibration.covariance).

@@ -45,6 +45,16 @@ struct ReportInputs {
   double seconds_tracking = 0, seconds_calibration = 0;
   std::vector<std::string> warnings;  // tracking's and the run's
   bool wrote_extrinsics = false;
+  // The camera-odometry time offset (pipeline/time_offset.hpp).
+  struct TimeOffset {
+    bool given = false;       // --time-offset S, else estimated
+    bool determined = false;  // given, or estimated with a usable sigma
+    bool applied = false;     // the image stamps were shifted by it
+    double offset_s = 0, sigma_s = 0;
+    int pairs = 0;
+    double residual_scale = 0;
+    std::string line;  // time_offset_line(): the terminal's and the report's words
+  } time_offset;
 };
 
 // One line on the noise check (docs/theory/noise-check.md), for the terminal and the

@@ -1,0 +1,257 @@
+#include "omnivert/pipeline/time_offset.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+#include <Eigen/Geometry>
+
+#include "omnivert/core/angles.hpp"
+
+namespace omnivert::pipeline {
+
+namespace {
+
+// theta_w(t): the wheels' heading, linear between samples, held beyond the ends.
+double heading_at(const std::vector<double>& t, const std::vector<double>& h, double x) {
+  if (x <= t.front()) return h.front();
+  if (x >= t.back()) return h.back();
+  const auto it = std::upper_bound(t.begin(), t.end(), x);
+  const std::size_t b = static_cast<std::size_t>(it - t.begin()), a = b - 1;
+  const double f = (x - t[a]) / (t[b] - t[a]);
+  return h[a] + f * (h[b] - h[a]);
+}
+
+double median(std::vector<double> v);
+
+// The triples of pairs (i-1, i, i+1), by the middle image i, and the lines spanning them.
+struct Triple {
+  std::size_t i = 0;
+  std::vector<Eigen::Vector3d> b;  // per line, its turns over the three pairs
+};
+
+struct Problem {
+  const TimeOffsetInput& in;
+  std::vector<Triple> triples;
+  std::vector<std::size_t> used;  // indices into triples
+
+  // The wheels' (d_theta, d_rho) between the images j-1 and j stamped late by S, and the
+  // variance of d_theta under eq. (31): K (|d_R| + |d_L|) / e^2, with |d_R| + |d_L| from the
+  // turn and the travel (2 max(|d_rho|, |d_theta| e / 2)).
+  Eigen::Vector3d wheel_step(std::size_t j, double S) const {
+    const double a = in.image_t[j - 1] - S, b = in.image_t[j] - S;
+    const double dth = heading_at(in.wheel_t, in.wheel_heading, b) -
+                       heading_at(in.wheel_t, in.wheel_heading, a);
+    const double drho = heading_at(in.wheel_t, in.wheel_distance, b) -
+                        heading_at(in.wheel_t, in.wheel_distance, a);
+    const double e = in.wheel_base;
+    const double wheels = 2.0 * std::max(std::abs(drho), 0.5 * std::abs(dth) * e);
+    return {dth, drho, in.odometry_k * wheels / (e * e)};
+  }
+  // e(i, S)^2 / sigma_i(S)^2: e(i, S) the median over the triple's lines of
+  // |P b_j|, P = I - A (A^T A)^-1 A^T the projection away from the wheels' columns A
+  // (d_theta, d_rho over the three pairs; by Gram-Schmidt, a column the wheels leave at zero is
+  // no direction), sigma_i^2 = trace(P Sigma P) with Sigma the noise of the three turns: the
+  // wheels' d_theta (eq. 31, common to every line) and two bearings per turn.
+  double weighted_residual(const Triple& t, double S) const {
+    Eigen::Vector3d theta, rho;
+    Eigen::Matrix3d Sigma = Eigen::Matrix3d::Zero();
+    const double sb2 = in.bearing_sigma * in.bearing_sigma;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d w = wheel_step(t.i - 1 + static_cast<std::size_t>(k), S);
+      theta(k) = w(0), rho(k) = w(1);
+      Sigma(k, k) = w(2) + 2.0 * sb2;
+      if (k > 0) Sigma(k, k - 1) = Sigma(k - 1, k) = -sb2;  // the image the two turns share
+    }
+    std::vector<Eigen::Vector3d> basis;
+    for (Eigen::Vector3d a : {theta, rho}) {
+      const double scale = a.norm();
+      for (const Eigen::Vector3d& u : basis) a -= u.dot(a) * u;
+      if (a.norm() > 1e-9 && a.norm() > 1e-6 * scale) basis.push_back(a.normalized());
+    }
+    Eigen::Matrix3d P = Eigen::Matrix3d::Identity();
+    for (const Eigen::Vector3d& u : basis) P -= u * u.transpose();
+    std::vector<double> e;
+    for (const Eigen::Vector3d& b : t.b) e.push_back((P * b).norm());
+    const double var = (P * Sigma * P).trace();
+    return var > 0 ? std::pow(median(e), 2) / var : 0.0;
+  }
+  double cost(double S) const {
+    double J = 0;
+    for (std::size_t k : used) J += weighted_residual(triples[k], S);
+    return J;
+  }
+};
+
+struct Minimum {
+  double S = 0, cost = 0, curvature = 0;  // J ~ cost + curvature (s - S)^2
+  double rise = 0;  // the median of J over the grid minus the minimum
+};
+
+// The grid minimum of J, refined by the parabola through it and its two neighbours.
+Minimum grid_minimum(const Problem& p, const TimeOffsetOptions& o) {
+  const int half = static_cast<int>(std::lround(o.max_offset_s / o.step_s));
+  std::vector<double> J(static_cast<std::size_t>(2 * half + 1));
+  for (int k = -half; k <= half; ++k) J[static_cast<std::size_t>(k + half)] = p.cost(k * o.step_s);
+  const std::size_t best =
+      static_cast<std::size_t>(std::min_element(J.begin(), J.end()) - J.begin());
+  Minimum m;
+  m.S = (static_cast<double>(best) - half) * o.step_s;
+  m.cost = J[best];
+  m.rise = median(J) - J[best];
+  if (best > 0 && best + 1 < J.size()) {
+    const double jm = J[best - 1], j0 = J[best], jp = J[best + 1];
+    const double c2 = (jp + jm - 2 * j0) / (2 * o.step_s * o.step_s);  // curvature a
+    if (c2 > 0) {
+      const double shift = (jm - jp) / (4 * c2 * o.step_s);  // the parabola's vertex
+      m.S += shift;
+      m.cost = j0 - c2 * shift * shift;
+      m.curvature = c2;
+    }
+  }
+  return m;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+std::string fmt_g(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+}  // namespace
+
+bool TimeOffsetEstimate::significant(const TimeOffsetOptions& o) const {
+  return determined && std::abs(offset_s) > o.significance * sigma_s &&
+         std::abs(offset_s) >= o.min_applied_s;
+}
+
+TimeOffsetEstimate estimate_time_offset(const TimeOffsetInput& in, const TimeOffsetOptions& o) {
+  TimeOffsetEstimate e;
+  Problem p{in, {}, {}};
+  // The triples: lines seen in the four images i-2 .. i+1, inside the wheel data for every
+  // S searched (the set must not change with S).
+  for (std::size_t i = 2; i + 1 < in.image_t.size() && i + 1 < in.turns.size(); ++i) {
+    if (in.wheel_t.empty() || in.image_t[i - 2] - o.max_offset_s < in.wheel_t.front() ||
+        in.image_t[i + 1] + o.max_offset_s > in.wheel_t.back())
+      continue;
+    Triple t;
+    t.i = i;
+    for (const auto& [id, turn] : in.turns[i]) {
+      auto find = [&](std::size_t j) {
+        const auto& v = in.turns[j];
+        const auto it = std::lower_bound(
+            v.begin(), v.end(), id, [](const auto& x, std::int64_t y) { return x.first < y; });
+        return it != v.end() && it->first == id ? it->second : NAN;
+      };
+      const Eigen::Vector3d b(find(i - 1), turn, find(i + 1));
+      if (b.allFinite()) t.b.push_back(b);
+    }
+    if (static_cast<int>(t.b.size()) >= o.min_common_tracks) p.triples.push_back(std::move(t));
+  }
+  for (std::size_t k = 0; k < p.triples.size(); ++k) p.used.push_back(k);
+  if (in.wheel_t.size() < 2 || static_cast<int>(p.used.size()) < o.min_pairs) {
+    e.why = "too few image pairs with " + std::to_string(o.min_common_tracks) +
+            " or more lines tracked through them (" + std::to_string(p.used.size()) + ")";
+    return e;
+  }
+  // A line that changed line or crossed another has a wrong turn: the median over the lines
+  // of each triple leaves it out.
+  const Minimum m = grid_minimum(p, o);
+  e.pairs = static_cast<int>(p.used.size());
+  e.offset_s = m.S;
+  // J is weighted by the noise model, so sigma_S^2 = 1 / a; s^2 = J_min / (n - 1) above 1
+  // (more noise than eq. 31 and the bearing sigma say) scales it up. Below 1 it is not
+  // trusted: most triples' residuals lose their noise to the fit of k_j and c_j.
+  const double s2 = std::max(m.cost, 0.0) / (e.pairs - 1);
+  e.residual_scale = std::sqrt(s2);
+  e.sigma_s = m.curvature > 0 ? std::sqrt(std::max(s2, 1.0) / m.curvature) : INFINITY;
+  if (!(m.curvature > 0) || std::abs(m.S) >= o.max_offset_s - o.step_s) {
+    e.why = "no minimum inside +-" + std::to_string(o.max_offset_s) + " s";
+  } else if (!(e.sigma_s <= o.max_sigma_s) || !(m.rise >= o.min_rise * std::max(s2, 1.0))) {
+    e.why = "the run has too few turns starting or ending to tell it";
+  } else {
+    e.determined = true;
+  }
+  return e;
+}
+
+TimeOffsetEstimate estimate_time_offset(const dataset::Dataset& data,
+                                        const std::vector<TrackRow>& rows,
+                                        double odometry_k,
+                                        double bearing_sigma,
+                                        const TimeOffsetOptions& o) {
+  const auto& images = data.images();
+  const auto& wheel = data.wheel();
+  const double e = data.wheel_sensor().wheel_base;
+  if (wheel.size() < 2 || !(e > 0)) {
+    TimeOffsetEstimate none;
+    none.why = "no wheel data with a wheel base";
+    return none;
+  }
+  // Bearings per frame and track; a track holding two lines of a frame is left out there.
+  std::vector<std::map<std::int64_t, double>> seen(images.size());
+  std::vector<std::map<std::int64_t, int>> count(images.size());
+  for (const TrackRow& r : rows) {
+    if (r.frame < 0 || static_cast<std::size_t>(r.frame) >= images.size()) continue;
+    seen[static_cast<std::size_t>(r.frame)][r.track_id] = r.bearing;
+    ++count[static_cast<std::size_t>(r.frame)][r.track_id];
+  }
+  const std::int64_t t0 = wheel.front().timestamp_ns;
+  TimeOffsetInput in;
+  in.wheel_base = e;
+  in.odometry_k = odometry_k;
+  in.bearing_sigma = bearing_sigma;
+  in.turns.resize(images.size());
+  for (std::size_t i = 0; i < images.size(); ++i) {
+    in.image_t.push_back(static_cast<double>(images[i].timestamp_ns - t0) * 1e-9);
+    if (i == 0) continue;
+    for (const auto& [id, beta] : seen[i]) {
+      const auto prev = seen[i - 1].find(id);
+      if (prev == seen[i - 1].end() || count[i].at(id) > 1 || count[i - 1].at(id) > 1) continue;
+      in.turns[i].emplace_back(id, -angle_diff(beta, prev->second));  // -d_beta (map order)
+    }
+  }
+  for (const auto& w : wheel) {
+    in.wheel_t.push_back(static_cast<double>(w.timestamp_ns - t0) * 1e-9);
+    in.wheel_heading.push_back((w.travel.right - w.travel.left) / e);  // eq. (15)
+    in.wheel_distance.push_back(0.5 * (w.travel.right + w.travel.left));
+  }
+  return estimate_time_offset(in, o);
+}
+
+std::string time_offset_line(const TimeOffsetEstimate& e,
+                             bool given,
+                             bool applied,
+                             const TimeOffsetOptions& o) {
+  char buf[400];
+  if (given) {
+    std::snprintf(buf,
+                  sizeof buf,
+                  "time offset: image stamps late by %.1f ms (given)",
+                  e.offset_s * 1e3);
+  } else if (!e.determined) {
+    std::snprintf(buf, sizeof buf, "time offset: not determined (%s); none applied", e.why.c_str());
+  } else {
+    std::snprintf(buf,
+                  sizeof buf,
+                  "time offset: image stamps late by %.1f +- %.1f ms (from %d image pairs); %s",
+                  e.offset_s * 1e3,
+                  e.sigma_s * 1e3,
+                  e.pairs,
+                  applied ? "applied"
+                          : ("not applied (applied above " + fmt_g(o.significance) +
+                             " sigma and " + fmt_g(o.min_applied_s * 1e3) + " ms)")
+                                .c_str());
+  }
+  return buf;
+}
+
+}  // namespace omnivert::pipeline
