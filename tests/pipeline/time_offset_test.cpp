@@ -113,7 +113,9 @@ TEST(TimeOffset, ShiftedStampsAreRecoveredWithinTheirSigma) {
       // starts and ends of turns and straights.
       EXPECT_LT(e.sigma_s, 0.006);
       EXPECT_GT(e.sigma_s, 0.0005);
-      if (std::abs(S) > 0.06) EXPECT_TRUE(e.significant({})) << e.offset_s << " +- " << e.sigma_s;
+      if (std::abs(S) > 0.06) {
+        EXPECT_TRUE(e.significant({})) << e.offset_s << " +- " << e.sigma_s;
+      }
     }
   }
 }
