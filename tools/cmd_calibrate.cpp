@@ -47,7 +47,7 @@ struct CalibrateArgs {
   std::string mask;
   TiltCheckOptions tilt;
   TrackerFlags tracker;
-  calib::RobotFrames frames;  // --base-frame, --camera-frame, --camera-height
+  calib::RobotFrames frames;             // --base-frame, --camera-frame, --camera-height
   std::string time_offset = "estimate";  // --time-offset: "estimate" or seconds
 };
 
@@ -232,8 +232,9 @@ void add_model_options(CLI::App* cmd, CalibrateArgs& a) {
 
 // The robot-format files' frames (calib/robot_formats.hpp).
 void add_frame_options(CLI::App* cmd, CalibrateArgs& a) {
-  const std::string g = "Robot formats (camera_joint.urdf, static_transform_publisher.sh, "
-                        "extrinsics_kalibr.yaml)";
+  const std::string g =
+      "Robot formats (camera_joint.urdf, static_transform_publisher.sh, "
+      "extrinsics_kalibr.yaml)";
   cmd->add_option("--base-frame", a.frames.base, "The robot's frame (parent)")
       ->capture_default_str()
       ->group(g);

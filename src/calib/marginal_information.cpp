@@ -153,7 +153,8 @@ class NuisanceSolver {
     const int n = static_cast<int>(Fs.rows()), ex = layout.extrinsics_column;
     std::vector<int> owner(static_cast<std::size_t>(n), -1);
     for (std::size_t t = 0; t < layout.track_columns.size(); ++t)
-      for (int c : layout.track_columns[t]) owner[static_cast<std::size_t>(c)] = static_cast<int>(t);
+      for (int c : layout.track_columns[t])
+        owner[static_cast<std::size_t>(c)] = static_cast<int>(t);
     for (int c = np_; c < ex; ++c)
       if (owner[static_cast<std::size_t>(c)] < 0)
         throw std::logic_error("marginal information: a column of no track");

@@ -45,8 +45,9 @@ Eigen::Matrix3d marginal_information(Built& b, bool dense_reference) {
       stats.reduced_nonzeros);
   if (stats.ok) return S;
   if (F.rows() <= kDenseFallbackLimit) return marginal_information_dense(Eigen::MatrixXd(F));
-  spdlog::warn("observability: the information did not factor; nothing is reported "
-               "determined");
+  spdlog::warn(
+      "observability: the information did not factor; nothing is reported "
+      "determined");
   return Eigen::Matrix3d::Zero();
 }
 

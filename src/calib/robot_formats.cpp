@@ -114,16 +114,16 @@ std::string static_transform_commands(const MountingTransform& m, const RobotFra
   s += "# Copy ONE of the command lines below into a terminal or a launch file (each publishes\n"
        "# the same transform; units m and rad); do not run this file as a whole.\n";
   s += "\n# ROS 1, tf (x y z yaw pitch roll frame_id child_frame_id period_ms):\n";
-  s += "rosrun tf static_transform_publisher " + xyz + " " + ypr + " " + f.base + " " +
-       f.camera + " 100\n";
+  s += "rosrun tf static_transform_publisher " + xyz + " " + ypr + " " + f.base + " " + f.camera +
+       " 100\n";
   s += "\n# ROS 1, tf2_ros (x y z yaw pitch roll frame_id child_frame_id):\n";
   s += "rosrun tf2_ros static_transform_publisher " + xyz + " " + ypr + " " + f.base + " " +
        f.camera + "\n";
   s += "\n# ROS 2 (Humble and later):\n";
   s += "ros2 run tf2_ros static_transform_publisher --x " + num(m.xyz(0)) + " --y " +
        num(m.xyz(1)) + " --z " + num(m.xyz(2)) + " --yaw " + num(m.rpy(2)) + " --pitch " +
-       num(m.rpy(1)) + " --roll " + num(m.rpy(0)) + " --frame-id " + f.base +
-       " --child-frame-id " + f.camera + "\n";
+       num(m.rpy(1)) + " --roll " + num(m.rpy(0)) + " --frame-id " + f.base + " --child-frame-id " +
+       f.camera + "\n";
   return s;
 }
 

@@ -233,7 +233,7 @@ std::string real_image_csv(const std::vector<RealImageResult>& results) {
   for (const char* t :
        {"rotation_detected", "rotation_given", "lighting_detected", "lighting_given"})
     s << ',' << t << "_looked_for," << t << "_found," << t << "_nn_correct," << t
-        << "_nn_correct_same_polarity";
+      << "_nn_correct_same_polarity";
   s << '\n';
   for (const RealImageResult& r : results) {
     s << r.label << ',' << (r.ok ? 1 : 0) << ',' << r.width << ',' << r.height << ','

@@ -86,8 +86,7 @@ void apply_time_offset(dataset::Dataset& data,
   if (outside > 0)
     r.warnings.push_back(std::to_string(outside) + " images fall outside the wheel data once " +
                          "their stamps are shifted by the time offset (" +
-                         std::to_string(offset_s * 1e3) +
-                         " ms); their bearings are not used");
+                         std::to_string(offset_s * 1e3) + " ms); their bearings are not used");
 }
 
 calib::ReportInputs::TimeOffset time_offset_report(const CalibrateDatasetResult& r) {

@@ -41,10 +41,10 @@ struct Problem {
   // turn and the travel (2 max(|d_rho|, |d_theta| e / 2)).
   Eigen::Vector3d wheel_step(std::size_t j, double S) const {
     const double a = in.image_t[j - 1] - S, b = in.image_t[j] - S;
-    const double dth = heading_at(in.wheel_t, in.wheel_heading, b) -
-                       heading_at(in.wheel_t, in.wheel_heading, a);
-    const double drho = heading_at(in.wheel_t, in.wheel_distance, b) -
-                        heading_at(in.wheel_t, in.wheel_distance, a);
+    const double dth =
+        heading_at(in.wheel_t, in.wheel_heading, b) - heading_at(in.wheel_t, in.wheel_heading, a);
+    const double drho =
+        heading_at(in.wheel_t, in.wheel_distance, b) - heading_at(in.wheel_t, in.wheel_distance, a);
     const double e = in.wheel_base;
     const double wheels = 2.0 * std::max(std::abs(drho), 0.5 * std::abs(dth) * e);
     return {dth, drho, in.odometry_k * wheels / (e * e)};
@@ -86,7 +86,7 @@ struct Problem {
 
 struct Minimum {
   double S = 0, cost = 0, curvature = 0;  // J ~ cost + curvature (s - S)^2
-  double rise = 0;  // the median of J over the grid minus the minimum
+  double rise = 0;                        // the median of J over the grid minus the minimum
 };
 
 // The grid minimum of J, refined by the parabola through it and its two neighbours.
@@ -233,10 +233,8 @@ std::string time_offset_line(const TimeOffsetEstimate& e,
                              const TimeOffsetOptions& o) {
   char buf[400];
   if (given) {
-    std::snprintf(buf,
-                  sizeof buf,
-                  "time offset: image stamps late by %.1f ms (given)",
-                  e.offset_s * 1e3);
+    std::snprintf(
+        buf, sizeof buf, "time offset: image stamps late by %.1f ms (given)", e.offset_s * 1e3);
   } else if (!e.determined) {
     std::snprintf(buf, sizeof buf, "time offset: not determined (%s); none applied", e.why.c_str());
   } else {
@@ -247,8 +245,8 @@ std::string time_offset_line(const TimeOffsetEstimate& e,
                   e.sigma_s * 1e3,
                   e.pairs,
                   applied ? "applied"
-                          : ("not applied (applied above " + fmt_g(o.significance) +
-                             " sigma and " + fmt_g(o.min_applied_s * 1e3) + " ms)")
+                          : ("not applied (applied above " + fmt_g(o.significance) + " sigma and " +
+                             fmt_g(o.min_applied_s * 1e3) + " ms)")
                                 .c_str());
   }
   return buf;

@@ -46,8 +46,8 @@ void expect_same_verdict(const ParameterVerdict& fast,
                          const std::string& what,
                          double tolerance) {
   EXPECT_EQ(fast.determined, plain.determined) << what;
-  EXPECT_LT(relative(fast.crlb, plain.crlb), tolerance) << what << ": " << fast.crlb << " against "
-                                                   << plain.crlb;
+  EXPECT_LT(relative(fast.crlb, plain.crlb), tolerance)
+      << what << ": " << fast.crlb << " against " << plain.crlb;
 }
 
 // The message without its numbers (the bounds, printed to 6 digits, are compared above).
@@ -88,8 +88,7 @@ Eigen::Matrix3d long_double_marginal(const Eigen::MatrixXd& F) {
   const Eigen::Index n = F.rows(), no = n - 3;
   const M Fl = F.cast<long double>();
   Eigen::Matrix<long double, Eigen::Dynamic, 1> s(no);
-  for (Eigen::Index i = 0; i < no; ++i)
-    s(i) = Fl(i, i) > 0 ? 1.0L / std::sqrt(Fl(i, i)) : 1.0L;
+  for (Eigen::Index i = 0; i < no; ++i) s(i) = Fl(i, i) > 0 ? 1.0L / std::sqrt(Fl(i, i)) : 1.0L;
   const M Foo = s.asDiagonal() * Fl.topLeftCorner(no, no) * s.asDiagonal();
   const M Foe = s.asDiagonal() * Fl.topRightCorner(no, 3);
   const Eigen::PartialPivLU<M> lu(Foo);
@@ -153,10 +152,10 @@ TEST(MarginalInformation, SparseEqualsDenseOnDegenerateRuns) {
 // A full turn in place after 1 mm of straight: the wheels give no distance, so nothing fixes
 // the scale of the camera's circle and of the features around it; psi is determined (0.3
 // degree), phi and rho are not (bounds of 9.6 rad and 2 m): the marginal information is
-// nearly singular, its small eigenvalues the differences of large numbers. There the dense reference is
-// itself off by 8.7e-6 relative (against long double), the sparse path (with its refinement
-// step) by 2e-7: the verdicts agree, the bounds to 2e-5 with each other and to 1e-6 with the
-// long double reference.
+// nearly singular, its small eigenvalues the differences of large numbers. There the dense
+// reference is itself off by 8.7e-6 relative (against long double), the sparse path (with its
+// refinement step) by 2e-7: the verdicts agree, the bounds to 2e-5 with each other and to 1e-6 with
+// the long double reference.
 TEST(MarginalInformation, TurnInPlaceAgreesWithTheLongDoubleReference) {
   SyntheticRunOptions rot;
   rot.straight_length = 0.001;
@@ -174,8 +173,7 @@ TEST(MarginalInformation, TurnInPlaceAgreesWithTheLongDoubleReference) {
   const Eigen::Matrix3d exact = long_double_marginal(Eigen::MatrixXd(F)).inverse();
   const Eigen::Matrix3d fast =
       internal::marginal_information_sparse(F, internal::layout_of(b)).inverse();
-  const Eigen::Matrix3d plain =
-      internal::marginal_information_dense(Eigen::MatrixXd(F)).inverse();
+  const Eigen::Matrix3d plain = internal::marginal_information_dense(Eigen::MatrixXd(F)).inverse();
   double worst_fast = 0.0, worst_plain = 0.0;
   for (int i = 0; i < 3; ++i) {
     const double e = std::sqrt(exact(i, i));

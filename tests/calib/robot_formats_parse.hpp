@@ -23,8 +23,8 @@ struct ParsedTransform {
   bool found = false;
 };
 
-inline Eigen::Matrix4d transform_from_xyz_rpy(double x, double y, double z, double roll,
-                                              double pitch, double yaw) {
+inline Eigen::Matrix4d transform_from_xyz_rpy(
+    double x, double y, double z, double roll, double pitch, double yaw) {
   Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
   T.block<3, 3>(0, 0) = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
                          Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
@@ -45,7 +45,8 @@ inline ParsedTransform parse_urdf_joint(const std::string& text) {
   ParsedTransform p;
   std::smatch m;
   const std::regex origin("<origin xyz=\"([^\"]*)\" rpy=\"([^\"]*)\"\\s*/>");
-  const std::regex parent("<parent link=\"([^\"]*)\"\\s*/>"), child("<child link=\"([^\"]*)\"\\s*/>");
+  const std::regex parent("<parent link=\"([^\"]*)\"\\s*/>"),
+      child("<child link=\"([^\"]*)\"\\s*/>");
   if (!std::regex_search(text, m, origin)) return p;
   const auto xyz = numbers_of(m[1]), rpy = numbers_of(m[2]);
   if (xyz.size() != 3 || rpy.size() != 3) return p;
@@ -82,8 +83,12 @@ inline ParsedTransform parse_ros2_line(const std::string& text) {
       "ros2 run tf2_ros static_transform_publisher --x (\\S+) --y (\\S+) --z (\\S+) --yaw (\\S+) "
       "--pitch (\\S+) --roll (\\S+) --frame-id (\\S+) --child-frame-id (\\S+)");
   if (!std::regex_search(text, m, line)) return p;
-  p.T = transform_from_xyz_rpy(std::stod(m[1]), std::stod(m[2]), std::stod(m[3]),
-                               std::stod(m[6]), std::stod(m[5]), std::stod(m[4]));
+  p.T = transform_from_xyz_rpy(std::stod(m[1]),
+                               std::stod(m[2]),
+                               std::stod(m[3]),
+                               std::stod(m[6]),
+                               std::stod(m[5]),
+                               std::stod(m[4]));
   p.parent = m[7];
   p.child = m[8];
   p.found = true;

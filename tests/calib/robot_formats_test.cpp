@@ -58,15 +58,18 @@ TEST(RobotFormats, KnownMountingGivesTheExpectedLines) {
                         "--child-frame-id camera_link\n"));
 
   const std::string yaml = kalibr_yaml(m, f);
-  EXPECT_THAT(yaml, HasSubstr("\nT_base_cam:\n  - [0.8660254038, -0.5, 0, 0.1]\n"
-                              "  - [0.5, 0.8660254038, 0, 0.05]\n  - [0, 0, 1, 0]\n"
-                              "  - [0, 0, 0, 1]\n"));
+  EXPECT_THAT(yaml,
+              HasSubstr("\nT_base_cam:\n  - [0.8660254038, -0.5, 0, 0.1]\n"
+                        "  - [0.5, 0.8660254038, 0, 0.05]\n  - [0, 0, 1, 0]\n"
+                        "  - [0, 0, 0, 1]\n"));
   // T_cam_base = [R^T | -R^T t]: -(c 0.1 + s 0.05, -s 0.1 + c 0.05).
-  EXPECT_THAT(yaml, HasSubstr("\nT_cam_base:\n  - [0.8660254038, 0.5, 0, -0.1116025404]\n"
-                              "  - [-0.5, 0.8660254038, 0, 0.006698729811]\n"));
+  EXPECT_THAT(yaml,
+              HasSubstr("\nT_cam_base:\n  - [0.8660254038, 0.5, 0, -0.1116025404]\n"
+                        "  - [-0.5, 0.8660254038, 0, 0.006698729811]\n"));
   EXPECT_THAT(yaml, HasSubstr("\nquaternion_xyzw: [0, 0, 0.2588190451, 0.9659258263]\n"));
-  EXPECT_THAT(yaml, HasSubstr("\nestimated: {x: true, y: true, z: false, roll: false, "
-                              "pitch: false, yaw: true}\n"));
+  EXPECT_THAT(yaml,
+              HasSubstr("\nestimated: {x: true, y: true, z: false, roll: false, "
+                        "pitch: false, yaw: true}\n"));
   EXPECT_THAT(yaml, HasSubstr("\ncovariance_order: [x, y, z, roll, pitch, yaw]\n"));
 }
 

@@ -294,7 +294,6 @@ TEST(Study, TinySimulatedRun) {
   fs::remove_all(dir);
 }
 
-
 // The real-image study on a drawn image with known edges and its circle given: the edges are
 // found again at their rotated angle, and a nearest neighbour among the same polarity is
 // right at least as often as one among all lines (a subset of the candidates holding it).

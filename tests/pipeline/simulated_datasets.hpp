@@ -129,9 +129,14 @@ inline void expect_complete_outputs_without_nan(const fs::path& out) {
     }
   }
   const std::regex nan("[Nn]a[Nn]([^a-zA-Z]|$)");
-  for (const char* f :
-       {"extrinsics.yaml", "summary.json", "states.csv", "report.html", "tracks.csv",
-        "camera_joint.urdf", "static_transform_publisher.sh", "extrinsics_kalibr.yaml"}) {
+  for (const char* f : {"extrinsics.yaml",
+                        "summary.json",
+                        "states.csv",
+                        "report.html",
+                        "tracks.csv",
+                        "camera_joint.urdf",
+                        "static_transform_publisher.sh",
+                        "extrinsics_kalibr.yaml"}) {
     if (fs::exists(out / f)) {
       EXPECT_FALSE(std::regex_search(read_text(out / f), nan)) << f << " contains a NaN";
     }

@@ -1,9 +1,9 @@
 // The camera-odometry time offset estimator (pipeline/time_offset.hpp) on a robot driving
 // past static lines: rests, straights at 0.2 m/s and turns in place at 0.3 rad/s (the
 // simulator's), the camera off the axle (parallax), wheels at 50 Hz, images at 3 Hz whose
-// stamps are late by S, 0.03 degree of bearing noise, the wheels' noise of eq. (31). The offset is recovered within its
-// sigma; constant motion does not determine it; a wheel-base error does not move it, nor do
-// outliers; an offset of 80 ms is significant (applied).
+// stamps are late by S, 0.03 degree of bearing noise, the wheels' noise of eq. (31). The offset is
+// recovered within its sigma; constant motion does not determine it; a wheel-base error does not
+// move it, nor do outliers; an offset of 80 ms is significant (applied).
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -57,7 +57,9 @@ std::vector<Segment> driving() {
   return {{0, 0, 1.5}, {0.2, 0, 6}, {0, 0.3, 5}, {0.2, 0, 4}, {0, -0.3, 4}, {0, 0, 1.5}};
 }
 
-TimeOffsetInput simulate(const std::vector<Segment>& run, double S, double wheel_scale,
+TimeOffsetInput simulate(const std::vector<Segment>& run,
+                         double S,
+                         double wheel_scale,
                          std::uint32_t seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> noise(0.0, deg2rad(0.03));

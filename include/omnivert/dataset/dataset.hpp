@@ -148,9 +148,8 @@ class Dataset {
     return images_[i].timestamp_ns - image_time_offset_ns_;
   }
   bool image_outside_wheel_data(std::size_t i) const {
-    return has_wheel() &&
-           (odometry_time(i) < wheel_.front().timestamp_ns ||
-            odometry_time(i) > wheel_.back().timestamp_ns);
+    return has_wheel() && (odometry_time(i) < wheel_.front().timestamp_ns ||
+                           odometry_time(i) > wheel_.back().timestamp_ns);
   }
 
   // Empty when there is no ground_truth/ folder or when it could not be read; then

@@ -56,7 +56,7 @@ struct TimeOffsetEstimate {
   double offset_s = 0.0;  // S: positive when the image stamps are late [s]
   double sigma_s = 0.0;
   int pairs = 0;                // triples of image pairs used
-  double residual_scale = 0.0;    // s: the residuals' RMS in units of their modelled sigma
+  double residual_scale = 0.0;  // s: the residuals' RMS in units of their modelled sigma
   std::string why;              // why not determined
   // Whether the estimate is significant (TimeOffsetOptions::significance, min_applied_s).
   bool significant(const TimeOffsetOptions& o) const;
