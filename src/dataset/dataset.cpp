@@ -36,13 +36,14 @@ std::string trim(const std::string& s) {
 
 // Reads a CSV file whose first line is a '#' header with at least `columns` columns; returns
 // the header and the data rows (blank lines skipped), each cut to `columns` fields: columns
-// beyond those are another tool's, ignored as EuRoC-style readers do, and counted in
-// `*extra_rows` (rows that had any). `what` names the columns for messages.
+// beyond those are another tool's, ignored as EuRoC-style readers do, and the rows that had
+// any are counted in a note appended to `notes`. `what` names the columns for messages.
 std::vector<CsvRow> read_csv(const std::string& path,
                              std::size_t columns,
                              const std::string& what,
-                             std::string* header_out = nullptr,
-                             int* extra_rows = nullptr) {
+                             std::string* header_out,
+                             std::vector<std::string>* notes) {
+  int extra_rows = 0;
   std::error_code ec;
   if (!fs::exists(path, ec)) throw InputError(path, 0, "file not found");
   std::ifstream in(path);
@@ -76,7 +77,7 @@ std::vector<CsvRow> read_csv(const std::string& path,
     }
     if (row.fields.size() > columns) {
       row.fields.resize(columns);
-      if (extra_rows) ++*extra_rows;
+      ++extra_rows;
     }
     if (row.fields.size() != columns) {
       throw InputError(path,
@@ -88,16 +89,10 @@ std::vector<CsvRow> read_csv(const std::string& path,
   }
   if (!header_seen)
     throw InputError(path, 0, "file is empty (expected a '#' header line: " + what + ")");
-  return rows;
-}
-
-void note_extra_columns(const std::string& path,
-                        int rows,
-                        std::size_t columns,
-                        std::vector<std::string>* notes) {
-  if (rows > 0 && notes)
-    notes->push_back(path + ": " + std::to_string(rows) + " rows have columns beyond the " +
+  if (extra_rows > 0 && notes)
+    notes->push_back(path + ": " + std::to_string(extra_rows) + " rows have columns beyond the " +
                      std::to_string(columns) + " read; those were ignored");
+  return rows;
 }
 
 std::int64_t parse_timestamp(const std::string& s, const std::string& path, int line) {
@@ -220,9 +215,7 @@ std::vector<WheelRecord> load_wheel_data(const std::string& path,
                                          double max_speed,
                                          std::vector<std::string>* notes) {
   std::string header;
-  int extra = 0;
-  const auto rows = read_csv(path, 3, "timestamp [ns], left, right", &header, &extra);
-  note_extra_columns(path, extra, 3, notes);
+  const auto rows = read_csv(path, 3, "timestamp [ns], left, right", &header, notes);
   const bool header_ticks = header.find("[ticks]") != std::string::npos;
   const bool header_meters = header.find("[m]") != std::string::npos;
   if (s.unit == WheelUnit::kMeters && header_ticks) {
@@ -307,9 +300,9 @@ GroundTruth load_ground_truth(const std::string& dir,
   const std::string poses = rel(dir, "poses.csv");
   if (fs::exists(poses, ec)) {
     gt.has_poses = true;
-    int prev_line = 0, extra = 0;
+    int prev_line = 0;
     for (const CsvRow& r :
-         read_csv(poses, 4, "timestamp [ns], x [m], y [m], theta [rad]", nullptr, &extra)) {
+         read_csv(poses, 4, "timestamp [ns], x [m], y [m], theta [rad]", nullptr, notes)) {
       PoseRecord p;
       p.timestamp_ns = parse_timestamp(r.fields[0], poses, r.line);
       if (!gt.poses.empty())
@@ -320,18 +313,16 @@ GroundTruth load_ground_truth(const std::string& dir,
       gt.poses.push_back(p);
       prev_line = r.line;
     }
-    note_extra_columns(poses, extra, 4, notes);
   }
   const std::string lines = rel(dir, "lines.csv");
   if (fs::exists(lines, ec)) {
     gt.has_lines = true;
-    int extra = 0;
     for (const CsvRow& r :
          read_csv(lines,
                   6,
                   "timestamp [ns], frame, line_id, bearing [rad], r_inner [px], r_outer [px]",
                   nullptr,
-                  &extra)) {
+                  notes)) {
       LineRecord l;
       l.timestamp_ns = parse_timestamp(r.fields[0], lines, r.line);
       l.frame = parse_int(r.fields[1], "frame", lines, r.line);
@@ -356,7 +347,6 @@ GroundTruth load_ground_truth(const std::string& dir,
       }
       gt.lines.push_back(l);
     }
-    note_extra_columns(lines, extra, 6, notes);
     gt.line_offsets.assign(images.size() + 1, 0);
     for (const LineRecord& l : gt.lines) ++gt.line_offsets[static_cast<std::size_t>(l.frame) + 1];
     for (std::size_t k = 1; k < gt.line_offsets.size(); ++k)
@@ -376,8 +366,7 @@ Dataset Dataset::load(const std::string& dir, const LoadOptions& options) {
 
   // Images.
   const std::string cam_csv = rel(dir, "cam0/data.csv");
-  int extra = 0;
-  for (const CsvRow& r : read_csv(cam_csv, 2, "timestamp [ns], filename", nullptr, &extra)) {
+  for (const CsvRow& r : read_csv(cam_csv, 2, "timestamp [ns], filename", nullptr, &d.notes_)) {
     ImageRecord im;
     im.line = r.line;
     im.timestamp_ns = parse_timestamp(r.fields[0], cam_csv, r.line);
@@ -397,7 +386,6 @@ Dataset Dataset::load(const std::string& dir, const LoadOptions& options) {
     d.images_.push_back(std::move(im));
   }
   if (d.images_.empty()) throw InputError(cam_csv, 0, "no images listed");
-  note_extra_columns(cam_csv, extra, 2, &d.notes_);
   const auto first_present = std::find_if(
       d.images_.begin(), d.images_.end(), [](const ImageRecord& im) { return !im.missing; });
   if (first_present == d.images_.end()) {
