@@ -6,6 +6,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -15,6 +16,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "core/parallel.hpp"
 #include "core/progress.hpp"
 #include "core/yaml_fields.hpp"
 #include "omnivert/calib/calibrate.hpp"
@@ -49,6 +51,7 @@ struct CalibrateArgs {
   TrackerFlags tracker;
   calib::RobotFrames frames;             // --base-frame, --camera-frame, --camera-height
   std::string time_offset = "estimate";  // --time-offset: "estimate" or seconds
+  int threads = 0;                       // --threads
 };
 
 // The prior from a YAML file: keys phi, rho, psi, sigma_phi, sigma_rho, sigma_psi [rad, m]
@@ -98,6 +101,7 @@ void run_calibrate(const CalibrateArgs& a) {
   o.tracks_file = a.tracks_file;
   o.force = a.force;
   o.frames = a.frames;
+  o.threads = a.threads;
   if (a.time_offset != "estimate") o.time_offset_s = std::stod(a.time_offset);
   if (!a.frames.camera_height && !a.prior_file.empty())
     o.frames.camera_height =
@@ -110,12 +114,15 @@ void run_calibrate(const CalibrateArgs& a) {
                       " (extraction and tracking options) did nothing");
   }
   std::optional<Progress> bar;
+  const auto start = std::chrono::steady_clock::now();
+  double tracking_s = 0;  // from the call to the end of tracking
   o.progress = [&](const std::string& stage, std::size_t done, std::size_t total) {
     if (stage == "track") {
       if (!bar) bar.emplace("track", total);
       bar->update(done);
       return;
     }
+    tracking_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (bar) bar->finish();
     if (Progress::enabled())
       std::fprintf(stderr,
@@ -127,6 +134,9 @@ void run_calibrate(const CalibrateArgs& a) {
     std::printf("%s%s\n", r.tilt.describe().c_str(), r.tilt_corrected ? "; frames rectified" : "");
   }
   std::printf("%s", r.BriefReport().c_str());
+  if (a.tracks_file.empty() && tracking_s > 0)
+    std::printf("tracking: %s\n",
+                throughput(r.frames, tracking_s, resolve_threads(a.threads)).c_str());
   if (!r.wrote_extrinsics) {
     std::fprintf(stderr,
                  "omnivert: the extrinsics are not determined by this run (%s); extrinsics.yaml "
@@ -311,6 +321,7 @@ void add_calibrate_command(CLI::App& app) {
   add_mask_option(cmd, a->mask);
   add_tilt_options(cmd, a->tilt);
   add_tracker_options(cmd, a->tracker);
+  add_threads_option(cmd, a->threads);
   cmd->callback([a, cmd] {
     // Extraction and tracking flags given with --tracks do nothing: say so.
     a->unused_with_tracks.clear();

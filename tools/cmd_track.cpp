@@ -1,5 +1,6 @@
 // omnivert track DATASET --out DIR: lines tracked through a video (Sec. 4, 9.1).
 
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -7,6 +8,7 @@
 #include <spdlog/spdlog.h>
 
 #include "commands.hpp"
+#include "core/parallel.hpp"
 #include "core/progress.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
@@ -26,6 +28,7 @@ struct TrackArgs {
   std::string mask;
   TiltCheckOptions tilt;
   TrackerFlags tracker;
+  int threads = 0;
 };
 
 void run_track(const TrackArgs& a) {
@@ -46,8 +49,11 @@ void run_track(const TrackArgs& a) {
   o.mask = a.mask;
   o.tilt = a.tilt;
   o.tracker = a.tracker.options();
+  o.threads = a.threads;
   Progress bar("track", data.size());
+  const auto start = std::chrono::steady_clock::now();
   const auto r = track_dataset(data, o, [&](std::size_t done, std::size_t) { bar.update(done); });
+  const std::chrono::duration<double> took = std::chrono::steady_clock::now() - start;
   bar.finish();
   for (const auto& w : r.warnings) spdlog::warn("{}", w);
 
@@ -64,6 +70,7 @@ void run_track(const TrackArgs& a) {
   if (r.tilt.valid) {
     std::printf("%s%s\n", r.tilt.describe().c_str(), r.tilt_corrected ? "; frames rectified" : "");
   }
+  std::printf("%s\n", throughput(r.frames, took.count(), resolve_threads(a.threads)).c_str());
   std::printf("wrote %s and %s\n", csv.c_str(), png.c_str());
 }
 
@@ -79,6 +86,7 @@ void add_track_command(CLI::App& app) {
   add_mask_option(cmd, a->mask);
   add_tilt_options(cmd, a->tilt);
   add_tracker_options(cmd, a->tracker);
+  add_threads_option(cmd, a->threads);
   cmd->callback([a] { run_track(*a); });
 }
 

@@ -2,6 +2,8 @@
 // Command-line options of the frame pipeline (extraction and descriptor), shared by every
 // subcommand that reads images.
 
+#include <cstdint>
+#include <cstdio>
 #include <map>
 #include <string>
 
@@ -25,6 +27,30 @@ inline void add_mask_option(CLI::App* cmd, std::string& mask) {
                   "Image mask: a one-channel image of the camera's size, non-zero = usable pixel "
                   "(instead of the mask: of sensor.yaml)")
       ->group(kExtractionGroup);
+}
+
+// --threads N: threads of the frame pipeline (track_dataset); the result does not depend on it.
+inline void add_threads_option(CLI::App* cmd, int& threads) {
+  cmd->add_option("--threads",
+                  threads,
+                  "Threads reading and extracting frames (0: every core); the result is the same "
+                  "for every count")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+}
+
+// Frames per second of a job's frame stage, for the line printed at its end.
+inline std::string throughput(std::int64_t frames, double seconds, int threads) {
+  char buf[128];
+  std::snprintf(buf,
+                sizeof buf,
+                "%lld frames in %.1f s: %.1f frames/s on %d thread%s",
+                static_cast<long long>(frames),
+                seconds,
+                seconds > 0 ? frames / seconds : 0.0,
+                threads,
+                threads == 1 ? "" : "s");
+  return buf;
 }
 
 // The tilt check of a dataset (docs/extraction.md, "Tilt").

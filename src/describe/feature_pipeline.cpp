@@ -16,23 +16,44 @@ bool FeaturePipelineOptions::IsValid(std::string* why) const {
   return center.IsValid(why) && lines.IsValid(why) && descriptor.IsValid(why);
 }
 
+FrameDescriber::FrameDescriber(const CameraGeometry& geometry,
+                               const FeaturePipelineOptions& options,
+                               const cv::Mat& usable)
+    : geometry_(&geometry), lines_(options.lines), descriptors_(options.descriptor) {
+  if (!usable.empty()) {
+    lines_.set_mask(usable);
+    descriptors_.set_mask(usable);
+  }
+  if (!options.tilt.isZero() && geometry.has_projection())
+    rectifier_.emplace(geometry, options.tilt);
+}
+
+void FrameDescriber::describe(const cv::Mat& gray, const MirrorCircle& circle, FrameFeatures& out) {
+  out.circle = circle;
+  const cv::Mat* frame = &gray;
+  if (rectifier_) {
+    rectifier_->apply(gray, out.circle, upright_);
+    frame = &upright_;
+  }
+  lines_.extract(*frame, out.circle, out.lines);
+  for (VerticalLine& l : out.lines) l.bearing = geometry_->bearing_of_image_angle(l.image_angle);
+  descriptors_.compute(*frame, out.circle, out.lines, out.descriptors);
+}
+
 FeaturePipeline::FeaturePipeline(CameraGeometry geometry, FeaturePipelineOptions options)
     : geometry_(std::move(geometry)),
       options_(std::move(options)),
       center_(options_.center),
-      lines_(options_.lines),
-      descriptors_(options_.descriptor) {
+      describer_(geometry_, options_, cv::Mat()) {
   if (geometry_.mask) set_mask(read_mask(*geometry_.mask, geometry_.width, geometry_.height));
-  if (!options_.tilt.isZero() && geometry_.has_projection())
-    rectifier_.emplace(geometry_, options_.tilt);
 }
 
 void FeaturePipeline::set_mask(const cv::Mat& usable) {
   CV_Assert(usable.empty() || usable.type() == CV_8UC1);
   mask_ = usable;
   center_.set_mask(usable);
-  lines_.set_mask(usable);
-  descriptors_.set_mask(usable);
+  describer_.line_extractor().set_mask(usable);
+  describer_.descriptor_extractor().set_mask(usable);
 }
 
 bool FeaturePipeline::to_gray8(const cv::Mat& image, cv::Mat& gray) {
@@ -71,27 +92,37 @@ double annulus_fraction_usable(const MirrorCircle& c, const cv::Mat& usable) {
 }
 
 bool FeaturePipeline::process(const cv::Mat& image, FrameFeatures& out, std::string* why) {
+  MirrorCircle circle;
+  if (!locate(image, gray_, circle, why)) return false;
+  describer_.describe(gray_, circle, out);
+  return true;
+}
+
+bool FeaturePipeline::locate(const cv::Mat& image,
+                             cv::Mat& gray,
+                             MirrorCircle& circle,
+                             std::string* why) {
   if (why) why->clear();
-  if (!to_grey8(image, geometry_.pixel_format, gray_, why)) return false;
-  if (geometry_.width > 0 && (gray_.cols != geometry_.width || gray_.rows != geometry_.height)) {
+  if (!to_grey8(image, geometry_.pixel_format, gray, why)) return false;
+  if (geometry_.width > 0 && (gray.cols != geometry_.width || gray.rows != geometry_.height)) {
     if (why)
-      *why = "image is " + std::to_string(gray_.cols) + "x" + std::to_string(gray_.rows) +
+      *why = "image is " + std::to_string(gray.cols) + "x" + std::to_string(gray.rows) +
              " but the camera's resolution is " + std::to_string(geometry_.width) + "x" +
              std::to_string(geometry_.height);
     return false;
   }
   const std::string mask_name = geometry_.mask ? "the mask " + *geometry_.mask : "the mask";
-  if (!mask_.empty() && mask_.size() != gray_.size()) {
+  if (!mask_.empty() && mask_.size() != gray.size()) {
     if (why)
       *why = mask_name + " is " + std::to_string(mask_.cols) + "x" + std::to_string(mask_.rows) +
-             " but the image is " + std::to_string(gray_.cols) + "x" + std::to_string(gray_.rows);
+             " but the image is " + std::to_string(gray.cols) + "x" + std::to_string(gray.rows);
     return false;
   }
   // A centre given in sensor.yaml is used as it is (FeaturePipelineOptions).
   const bool center_as_given = geometry_.center && !options_.refine_given_center;
   if (!circle_) {
     std::string reason;
-    auto c = center_.estimate(gray_, geometry_, &reason);
+    auto c = center_.estimate(gray, geometry_, &reason);
     if (!c) {
       if (why) {
         *why = reason;
@@ -104,7 +135,7 @@ bool FeaturePipeline::process(const cv::Mat& image, FrameFeatures& out, std::str
       }
       return false;
     }
-    const double inside = annulus_fraction_inside(*c, gray_.cols, gray_.rows);
+    const double inside = annulus_fraction_inside(*c, gray.cols, gray.rows);
     if (inside < 0.25) {
       if (why) {
         char buf[256];
@@ -112,8 +143,8 @@ bool FeaturePipeline::process(const cv::Mat& image, FrameFeatures& out, std::str
                       sizeof buf,
                       "the image (%dx%d) is smaller than the annulus r_min..r_max = %.1f..%.1f "
                       "px around (%.1f, %.1f): only %.0f%% of it is inside",
-                      gray_.cols,
-                      gray_.rows,
+                      gray.cols,
+                      gray.rows,
                       c->r_min,
                       c->r_max,
                       c->center.x(),
@@ -146,21 +177,13 @@ bool FeaturePipeline::process(const cv::Mat& image, FrameFeatures& out, std::str
     circle_ = c;
   } else if (options_.track_center && circle_->rim_radius > 0 && !center_as_given) {
     std::string reason;
-    if (auto c = center_.detect(gray_, *circle_, &reason)) {
+    if (auto c = center_.detect(gray, *circle_, &reason)) {
       circle_ = c;
     } else if (why) {
       *why = reason + "; keeping the previous centre";
     }
   }
-  out.circle = *circle_;
-  const cv::Mat* frame = &gray_;
-  if (rectifier_) {
-    rectifier_->apply(gray_, out.circle, upright_);
-    frame = &upright_;
-  }
-  lines_.extract(*frame, out.circle, out.lines);
-  for (VerticalLine& l : out.lines) l.bearing = geometry_.bearing_of_image_angle(l.image_angle);
-  descriptors_.compute(*frame, out.circle, out.lines, out.descriptors);
+  circle = *circle_;
   return true;
 }
 

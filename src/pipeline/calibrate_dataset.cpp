@@ -64,6 +64,7 @@ TrackDatasetResult tracks_of(const dataset::Dataset& data,
   to.mask = o.mask;
   to.tracker = o.tracker;
   to.tilt = o.tilt;
+  to.threads = o.threads;
   return track_dataset(data, to, [&](std::size_t done, std::size_t total) {
     if (o.progress) o.progress("track", done, total);
   });

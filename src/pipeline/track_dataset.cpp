@@ -4,6 +4,7 @@
 #include <string>
 
 #include "omnivert/core/error.hpp"
+#include "pipeline/frame_source.hpp"
 
 namespace omnivert {
 
@@ -37,26 +38,18 @@ TrackDatasetResult track_dataset(const dataset::Dataset& data,
     if (!w.empty()) out.warnings.push_back(w);
   }
   FeaturePipeline pipe(camera, po);
-  std::vector<TrackAssignment> assignments;
+  FrameSource frames(data, pipe, options.threads);
   FrameFeatures f;
+  std::vector<TrackAssignment> assignments;
   const auto& travel = data.travel_at_images();
-  for (std::size_t i = 0; i < data.size(); ++i) {
-    const auto& rec = data.images()[i];
-    bool ok = true;
-    try {
-      const cv::Mat img = data.image(i);
-      std::string why;
-      ok = pipe.process(img, f, &why);
-      if (!ok) {
-        out.warnings.push_back(rec.path + ": " + why + "; frame " + std::to_string(i) + " skipped");
-      } else if (!why.empty()) {
-        out.warnings.push_back(rec.path + ": " + why);
-      }
-    } catch (const InputError& e) {
-      ok = false;
-      out.warnings.push_back(std::string(e.what()) + "; frame " + std::to_string(i) + " skipped");
-    }
-    if (!ok) {
+  const std::size_t n = data.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const FrameSource::Frame& fr = frames.next();
+    for (const std::string& w : fr.warnings) out.warnings.push_back(w);
+    if (fr.ok) {
+      f = fr.features;
+    } else {
+      // Skipped: no lines, the previous circle (the tracker and the rows need only lines).
       ++out.frames_skipped;
       f.lines.clear();
       f.descriptors.resize(0, options.pipeline.descriptor.size());
@@ -70,10 +63,11 @@ TrackDatasetResult track_dataset(const dataset::Dataset& data,
     } else {
       tracker.add_frame(f, &assignments);
     }
-    append_track_rows(static_cast<std::int64_t>(i), rec.timestamp_ns, f, assignments, &out.rows);
+    append_track_rows(
+        static_cast<std::int64_t>(i), data.images()[i].timestamp_ns, f, assignments, &out.rows);
     if (keep_features) out.features.push_back(f);
     ++out.frames;
-    if (progress) progress(i + 1, data.size());
+    if (progress) progress(i + 1, n);
   }
   if (out.frames_skipped == out.frames) {
     throw InputError(csv,

@@ -2,7 +2,8 @@
 // paper's trajectory in the corridor, as `omnivert simulate --world corridor --trajectory
 // paper --frames 12 --seed 1` renders it): end to end against the ground truth, a corrupt,
 // missing or line-less image in the middle (warned about, tracking goes on and bridges the
-// gap), and datasets without images (a clear InputError).
+// gap), datasets without images (a clear InputError), and the same tracks for every thread
+// count.
 
 #include <algorithm>
 #include <set>
@@ -156,6 +157,61 @@ TEST_F(TrackDataset, FrameWithoutLinesIsNotReportedUnreadable) {
   const TrackDatasetResult r = track_dataset(load_for_tracking(dir), cli_track_options());
   EXPECT_THAT(joined(r.warnings), Not(HasSubstr("cannot be read")));
   expect_frame_5_skipped_and_bridged(dir, r);
+}
+
+// Every field of two track tables, exactly (the thread count must not change a bit).
+void expect_identical_rows(const std::vector<TrackRow>& a,
+                           const std::vector<TrackRow>& b,
+                           const std::string& what) {
+  ASSERT_EQ(a.size(), b.size()) << what;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const TrackRow &x = a[i], &y = b[i];
+    const bool same =
+        x.frame == y.frame && x.timestamp_ns == y.timestamp_ns && x.track_id == y.track_id &&
+        x.bearing == y.bearing && x.image_angle == y.image_angle &&
+        x.edge_pixels == y.edge_pixels && x.r_inner == y.r_inner && x.r_outer == y.r_outer &&
+        x.matched_frame == y.matched_frame && x.distance == y.distance && x.line == y.line &&
+        x.matched_line == y.matched_line && x.crowded == y.crowded;
+    ASSERT_TRUE(same) << what << ": row " << i << " differs (frame " << x.frame << ")";
+  }
+}
+
+// Frames are read and described on several threads and located in order (the centre search
+// of each frame starts from the previous one, Sec. 2 step 1): the tracks, the warnings and
+// the counts are the same, bit for bit, for 1, 2, 3 and 7 threads. On the centre as the
+// simulator writes it in sensor.yaml, on the centre searched frame after frame (no centre in
+// sensor.yaml), and with a damaged frame in the middle.
+TEST_F(TrackDataset, TracksAreIdenticalForEveryThreadCount) {
+  const fs::path searched = tiny_copy("threads-searched");
+  std::string yaml;
+  for (const std::string& line : read_lines(searched / "cam0/sensor.yaml"))
+    if (line.rfind("center:", 0) != 0) yaml += line + "\n";
+  write_text(searched / "cam0/sensor.yaml", yaml);
+  const fs::path damaged = tiny_copy("threads-damaged");
+  write_text(damaged / "cam0/data" / image_names(damaged)[5], "not an image\n");
+  for (const fs::path& dir : {tiny(), searched, damaged}) {
+    const auto data = load_for_tracking(dir);
+    TrackDatasetOptions o = cli_track_options();
+    o.threads = 1;
+    const TrackDatasetResult one = track_dataset(data, o, {}, true);
+    ASSERT_EQ(one.frames, 12);
+    EXPECT_GE(one.rows.size(), 40u) << dir;
+    for (int threads : {2, 3, 7}) {
+      o.threads = threads;
+      const TrackDatasetResult r = track_dataset(data, o, {}, true);
+      const std::string what =
+          dir.filename().string() + ", " + std::to_string(threads) + " threads";
+      expect_identical_rows(one.rows, r.rows, what);
+      EXPECT_EQ(r.warnings, one.warnings) << what;
+      EXPECT_EQ(r.frames_skipped, one.frames_skipped) << what;
+      EXPECT_EQ(r.stats.new_tracks, one.stats.new_tracks) << what;
+      ASSERT_EQ(r.features.size(), one.features.size()) << what;
+      for (std::size_t f = 0; f < r.features.size(); ++f) {
+        EXPECT_EQ(r.features[f].circle.center, one.features[f].circle.center) << what;
+        EXPECT_TRUE(r.features[f].descriptors == one.features[f].descriptors) << what << f;
+      }
+    }
+  }
 }
 
 TEST_F(TrackDataset, DatasetWithoutImagesIsAnInputErrorNamingCam0DataCsv) {

@@ -49,6 +49,7 @@ struct CalibrateDatasetOptions {
   std::string command;             // the command line, recorded in the report
   std::vector<std::string> notes;  // extra warnings of the caller, reported with the rest
   TiltCheckOptions tilt;           // the tilt of the mirror axis (pipeline/tilt_check.hpp)
+  int threads = 0;                 // threads of the frame pipeline (TrackDatasetOptions)
   // Frame names and camera height of the robot-format files written with extrinsics.yaml
   // (calib/robot_formats.hpp).
   calib::RobotFrames frames;

@@ -33,6 +33,10 @@ struct TrackDatasetOptions {
   // The tilt of the mirror axis: measured first (when pipeline.tilt is zero and the camera's
   // xi and gamma are known), warned about and corrected above its thresholds.
   TiltCheckOptions tilt;
+  // Threads reading images and extracting lines and descriptors (0: every core). The
+  // mirror centre is located frame after frame and the tracker sees the frames in order, so
+  // the result is the same, byte for byte, for every thread count.
+  int threads = 0;
 };
 
 struct TrackDatasetResult {
