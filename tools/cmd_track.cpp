@@ -24,7 +24,7 @@ struct TrackArgs {
   std::string out;
   FeaturePipelineOptions pipeline;
   std::string mask;
-  TiltCheckOptions tilt;
+  pipeline::TiltCheckOptions tilt;
   TrackerFlags tracker;
 };
 
@@ -41,20 +41,21 @@ void run_track(const TrackArgs& a) {
   fs::create_directories(a.out, ec);
   if (ec) throw InputError(a.out, 0, "cannot create the output folder: " + ec.message());
 
-  TrackDatasetOptions o;
+  pipeline::TrackDatasetOptions o;
   o.pipeline = a.pipeline;
   o.mask = a.mask;
   o.tilt = a.tilt;
   o.tracker = a.tracker.options();
   Progress bar("track", data.size());
-  const auto r = track_dataset(data, o, [&](std::size_t done, std::size_t) { bar.update(done); });
+  const auto r =
+      pipeline::track_dataset(data, o, [&](std::size_t done, std::size_t) { bar.update(done); });
   bar.finish();
   for (const auto& w : r.warnings) spdlog::warn("{}", w);
 
   const fs::path csv = fs::path(a.out) / "tracks.csv";
   const fs::path png = fs::path(a.out) / "tracks.png";
   write_tracks_csv(csv, r.rows);
-  write_tracks_png(png, r.rows);
+  viz::write_tracks_png(png, r.rows);
   std::printf("%lld frames (%lld skipped), %zu detections, %lld tracks\n%s\n",
               static_cast<long long>(r.frames),
               static_cast<long long>(r.frames_skipped),

@@ -28,7 +28,7 @@ inline void add_mask_option(CLI::App* cmd, std::string& mask) {
 }
 
 // The tilt check of a dataset (docs/extraction.md, "Tilt").
-inline void add_tilt_options(CLI::App* cmd, TiltCheckOptions& o) {
+inline void add_tilt_options(CLI::App* cmd, pipeline::TiltCheckOptions& o) {
   const std::string g = kExtractionGroup;
   cmd->add_flag("!--no-tilt-check",
                 o.enabled,

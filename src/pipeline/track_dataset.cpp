@@ -5,7 +5,7 @@
 
 #include "omnivert/core/error.hpp"
 
-namespace omnivert {
+namespace omnivert::pipeline {
 
 TrackDatasetResult track_dataset(const dataset::Dataset& data,
                                  const TrackDatasetOptions& options,
@@ -112,4 +112,4 @@ TrackDatasetResult read_tracks_for_dataset(const std::string& file, const datase
   return t;
 }
 
-}  // namespace omnivert
+}  // namespace omnivert::pipeline
