@@ -32,26 +32,19 @@ namespace {
 struct CalibrateArgs {
   std::string dataset;
   std::string out;
-  // The estimator's and the input's options: flags without a unit to convert are bound to
-  // their fields; the prior file and the flags that override it are applied in run_calibrate.
-  calib::CalibrationOptions calibration = calib::recommended_options();
-  calib::DatasetRunOptions input;
-  bool force = false;
+  // The job's options tree (recommended presets): flags without a unit to convert are bound
+  // to its fields; the prior file, the flags that override it, the tracker's flags and the
+  // time offset are applied in run_calibrate.
+  pipeline::CalibrateDatasetOptions options;
   std::string prior_file;
-  std::string tracks_file;  // --tracks: an existing tracks.csv instead of tracking
   std::vector<std::string> unused_with_tracks;  // extraction/tracking flags given with --tracks
   std::optional<double> phi, rho, psi, sigma_phi, sigma_rho, sigma_psi;
   std::optional<double> bearing_sigma_deg;
   std::optional<double> odometry_inflation;
   std::optional<double> track_bias_sigma_deg;
   double crossing_guard_deg = rad2deg(calib::AssociationOptions{}.crossing_guard);
-  FeaturePipelineOptions pipeline;
-  std::string mask;
-  TiltCheckOptions tilt;
   TrackerFlags tracker;
-  calib::RobotFrames frames;             // --base-frame, --camera-frame, --camera-height
   std::string time_offset = "estimate";  // --time-offset: "estimate" or seconds
-  int threads = 0;                       // --threads
 };
 
 // The prior from a YAML file: keys phi, rho, psi, sigma_phi, sigma_rho, sigma_psi [rad, m]
@@ -75,7 +68,7 @@ void read_prior_file(const std::string& path, calib::CalibrationOptions* o) {
 // file, then the flags that override it (the wheel base and K come from wheel0/sensor.yaml in
 // the pipeline).
 calib::CalibrationOptions calibration_options(const CalibrateArgs& a) {
-  calib::CalibrationOptions opt = a.calibration;
+  calib::CalibrationOptions opt = a.options.calibration;
   if (!a.prior_file.empty()) read_prior_file(a.prior_file, &opt);
   if (a.phi) opt.prior.mean.phi = *a.phi;
   if (a.rho) opt.prior.mean.rho = *a.rho;
@@ -91,26 +84,18 @@ calib::CalibrationOptions calibration_options(const CalibrateArgs& a) {
 }
 
 void run_calibrate(const CalibrateArgs& a) {
-  pipeline::CalibrateDatasetOptions o;
-  o.features = a.pipeline;
-  o.mask = a.mask;
-  o.tilt = a.tilt;
+  pipeline::CalibrateDatasetOptions o = a.options;
   o.tracker = a.tracker.options();
   o.calibration = calibration_options(a);
-  o.input = a.input;
-  o.tracks_file = a.tracks_file;
-  o.force = a.force;
-  o.frames = a.frames;
-  o.threads = a.threads;
   if (a.time_offset != "estimate") o.time_offset_s = std::stod(a.time_offset);
-  if (!a.frames.camera_height && !a.prior_file.empty())
+  if (!o.frames.camera_height && !a.prior_file.empty())
     o.frames.camera_height =
         yaml::optional_number(yaml::load_file(a.prior_file), "camera_height", a.prior_file);
   o.command = command_line();
-  if (!a.tracks_file.empty() && !a.unused_with_tracks.empty()) {
+  if (!o.tracks_file.empty() && !a.unused_with_tracks.empty()) {
     std::string list;
     for (const std::string& n : a.unused_with_tracks) list += (list.empty() ? "" : ", ") + n;
-    o.notes.push_back("--tracks: the tracks are read from " + a.tracks_file + "; " + list +
+    o.notes.push_back("--tracks: the tracks are read from " + o.tracks_file + "; " + list +
                       " (extraction and tracking options) did nothing");
   }
   std::optional<Progress> bar;
@@ -127,7 +112,7 @@ void run_calibrate(const CalibrateArgs& a) {
     if (Progress::enabled())
       std::fprintf(stderr,
                    "calibrate: filter%s...\n",
-                   a.calibration.refinement.enabled ? " and refinement" : "");
+                   o.calibration.refinement.enabled ? " and refinement" : "");
   };
   const pipeline::CalibrateDatasetResult r = pipeline::calibrate_dataset(a.dataset, a.out, o);
   if (r.tilt.valid) {
@@ -136,7 +121,7 @@ void run_calibrate(const CalibrateArgs& a) {
   std::printf("%s", r.BriefReport().c_str());
   if (a.tracks_file.empty() && tracking_s > 0)
     std::printf("tracking: %s\n",
-                throughput(r.frames, tracking_s, resolve_threads(a.threads)).c_str());
+                throughput(r.frames, tracking_s, resolve_threads(a.options.threads)).c_str());
   if (!r.wrote_extrinsics) {
     std::fprintf(stderr,
                  "omnivert: the extrinsics are not determined by this run (%s); extrinsics.yaml "
@@ -197,7 +182,7 @@ void add_model_options(CLI::App* cmd, CalibrateArgs& a) {
       ->check(kNonNegative)
       ->group(gm);
   cmd->add_option("--lateral-sigma",
-                  a.calibration.robot.lateral_sigma,
+                  a.options.calibration.robot.lateral_sigma,
                   "Sideways slip per image step [m] allowed by the batch problems (the filter's "
                   "window and the refinement); eq. (14) has none. Raise it for a robot that "
                   "slips sideways (docs/theory/refinement.md#odometry-factor)")
@@ -205,7 +190,7 @@ void add_model_options(CLI::App* cmd, CalibrateArgs& a) {
       ->capture_default_str()
       ->group(gm);
   cmd->add_option("--crowded-sigma",
-                  a.input.crowded_sigma_scale,
+                  a.options.input.crowded_sigma_scale,
                   "The bearing sigma of a crowded line (tracks.csv's crowded column: another edge "
                   "within a few pixels all along it) is --bearing-sigma times this")
       ->check(kPositive)
@@ -232,7 +217,7 @@ void add_model_options(CLI::App* cmd, CalibrateArgs& a) {
       ->capture_default_str()
       ->group(gm);
   cmd->add_option("--max-wheel-gap",
-                  a.input.max_wheel_gap_s,
+                  a.options.input.max_wheel_gap_s,
                   "Wheel samples further apart than this [s] are a gap: the bearings of the "
                   "images inside it are not used")
       ->check(kPositive)
@@ -245,14 +230,14 @@ void add_frame_options(CLI::App* cmd, CalibrateArgs& a) {
   const std::string g =
       "Robot formats (camera_joint.urdf, static_transform_publisher.sh, "
       "extrinsics_kalibr.yaml)";
-  cmd->add_option("--base-frame", a.frames.base, "The robot's frame (parent)")
+  cmd->add_option("--base-frame", a.options.frames.base, "The robot's frame (parent)")
       ->capture_default_str()
       ->group(g);
-  cmd->add_option("--camera-frame", a.frames.camera, "The camera's frame (child)")
+  cmd->add_option("--camera-frame", a.options.frames.camera, "The camera's frame (child)")
       ->capture_default_str()
       ->group(g);
   cmd->add_option("--camera-height",
-                  a.frames.camera_height,
+                  a.options.frames.camera_height,
                   "Height of the camera centre above the base frame's origin [m], written as z "
                   "(not estimated: the bearings are 2-D; default: camera_height of --prior, "
                   "else 0)")
@@ -272,17 +257,17 @@ void add_calibrate_command(CLI::App& app) {
   cmd->add_option("--out", a->out, "Output folder")->required();
   cmd->add_flag(
       "--refine",
-      a->calibration.refinement.enabled,
+      a->options.calibration.refinement.enabled,
       "Refine the filter's result by batch maximum likelihood over the whole run (Ceres)");
   cmd->add_option("--split-chi2",
-                  a->calibration.association.split_chi2,
+                  a->options.calibration.association.split_chi2,
                   "Filter's window and refinement: split a track in two where two features "
                   "explain its bearings better than one by this likelihood-ratio statistic (a "
                   "track that slipped onto a neighbouring line); 0 turns splitting off")
       ->check(kNonNegative)
       ->capture_default_str();
   cmd->add_flag("!--no-join",
-                a->calibration.association.join_pieces,
+                a->options.calibration.association.join_pieces,
                 "Filter (window and after) and refinement: keep a track that starts where a line "
                 "the tracker lost is predicted as a line of its own, instead of joining it to that "
                 "line (docs/theory/association.md#pieces-of-one-line)");
@@ -294,11 +279,11 @@ void add_calibrate_command(CLI::App& app) {
       ->check(CLI::Range(0.0, 20.0))
       ->capture_default_str();
   cmd->add_flag("!--no-noise-check",
-                a->calibration.noise_check.enabled,
+                a->options.calibration.noise_check.enabled,
                 "Report the model's covariances as they are, without the data's check of the "
                 "bearing noise (errors summed along each track; docs/theory/noise-check.md)");
   cmd->add_option("--noise-check-lower-level",
-                  a->calibration.noise_check.lower_level,
+                  a->options.calibration.noise_check.lower_level,
                   "The noise check finds the bearings less noisy than the model assumes when "
                   "errors this small have at most this probability under the model, and then "
                   "shrinks the bearings' share of the covariance where the tracker kept its "
@@ -306,22 +291,22 @@ void add_calibrate_command(CLI::App& app) {
       ->check(kTestLevel)
       ->capture_default_str();
   cmd->add_option("--tracks",
-                  a->tracks_file,
+                  a->options.tracks_file,
                   "Calibrate from this tracks.csv (of `omnivert track` or an earlier calibrate "
                   "on the same dataset) instead of extracting and tracking the images")
       ->check(CLI::ExistingFile);
   cmd->add_flag("--force",
-                a->force,
+                a->options.force,
                 "Write extrinsics.yaml (and exit 0) even when the run does not determine every "
                 "parameter");
   add_prior_options(cmd, *a);
   add_model_options(cmd, *a);
   add_frame_options(cmd, *a);
-  add_pipeline_options(cmd, a->pipeline);
-  add_mask_option(cmd, a->mask);
-  add_tilt_options(cmd, a->tilt);
+  add_pipeline_options(cmd, a->options.features);
+  add_mask_option(cmd, a->options.mask);
+  add_tilt_options(cmd, a->options.tilt);
   add_tracker_options(cmd, a->tracker);
-  add_threads_option(cmd, a->threads);
+  add_threads_option(cmd, a->options.threads);
   cmd->callback([a, cmd] {
     // Extraction and tracking flags given with --tracks do nothing: say so.
     a->unused_with_tracks.clear();

@@ -158,7 +158,7 @@ void run_camera(const CameraArgs& a) {
   write_text_atomic(a.out, camera_sensor_yaml(e, mask_entry, provenance));
   std::printf("sensor.yaml written to %s\n", a.out.c_str());
   if (!a.overlay.empty()) {
-    write_image_atomic(a.overlay, draw_camera_overlay(frames[frames.size() / 2], e));
+    write_image_atomic(a.overlay, viz::draw_camera_overlay(frames[frames.size() / 2], e));
     std::printf("overlay written to %s\n", a.overlay.c_str());
   }
 }

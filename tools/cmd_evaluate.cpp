@@ -42,17 +42,17 @@ void add_evaluate_command(CLI::App& app) {
       throw InputError((fs::path(a->dataset) / "cam0/sensor.yaml").string(),
                        0,
                        "r_min and r_max are needed to tell long lines (>= 60% of the annulus)");
-    std::vector<GroundTruthLine> truth;
+    std::vector<eval::GroundTruthLine> truth;
     truth.reserve(gt->lines.size());
     for (const auto& l : gt->lines)
       truth.push_back({l.frame, l.line_id, l.bearing, l.r_inner, l.r_outer});
     const auto rows = read_tracks_csv(fs::path(a->dir) / "tracks.csv");
-    TrackingEvalOptions o;
+    eval::TrackingEvalOptions o;
     o.annulus_r_min = *cam.r_min;
     o.annulus_r_max = *cam.r_max;
     o.num_frames = static_cast<std::int64_t>(data.size());
-    const auto ev = evaluate_tracking(rows, truth, o);
-    const std::string table = format_tracking_table(ev);
+    const auto ev = eval::evaluate_tracking(rows, truth, o);
+    const std::string table = eval::format_tracking_table(ev);
     std::printf("%s", table.c_str());
     const fs::path txt = fs::path(a->dir) / "evaluation.txt";
     write_text_atomic(txt.string(), table);

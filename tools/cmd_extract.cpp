@@ -43,7 +43,7 @@ struct ExtractArgs {
 TiltEstimate measure_image_tilt(const cv::Mat& image,
                                 const CameraGeometry& geometry,
                                 const FeaturePipelineOptions& pipeline) {
-  const TiltCheckOptions check;
+  const pipeline::TiltCheckOptions check;
   TiltEstimator estimator(geometry, check.estimator);
   if (!geometry.has_projection()) return estimator.estimate();
   FeaturePipelineOptions po = pipeline;
@@ -83,14 +83,14 @@ void run_extract(const ExtractArgs& a) {
   if (a.xi > 0.0) geometry.xi = a.xi;
   if (a.gamma > 0.0) geometry.gamma = a.gamma;
   const TiltEstimate tilt = measure_image_tilt(image, geometry, a.pipeline);
-  const TiltCheckOptions check;
+  const pipeline::TiltCheckOptions check;
   FeaturePipelineOptions po = a.pipeline;
   const bool corrected = a.correct_tilt && tilt.valid && tilt.tilt_deg() > check.correct_deg;
   if (corrected) po.tilt = tilt.vector;
   FeaturePipeline pipe(geometry, po);
   FrameFeatures f;
   if (!pipe.process(image, f, &why)) throw InputError(a.image, 0, why);
-  const std::string warning = tilt_warning(tilt, check, corrected);
+  const std::string warning = pipeline::tilt_warning(tilt, check, corrected);
   if (!warning.empty()) std::fprintf(stderr, "warning: %s\n", warning.c_str());
 
   if (a.json) {
@@ -163,7 +163,8 @@ void run_extract(const ExtractArgs& a) {
   if (!a.overlay.empty()) {
     cv::Mat grey;  // the picture the lines were found in (a Bayer mosaic demosaiced)
     to_grey8(image, geometry.pixel_format, grey, nullptr);
-    write_image_atomic(a.overlay, draw_overlay(grey, f, pipe.descriptor_extractor(), a.highlight));
+    write_image_atomic(a.overlay,
+                       viz::draw_overlay(grey, f, pipe.descriptor_extractor(), a.highlight));
     if (!a.json) std::printf("overlay written to %s\n", a.overlay.c_str());
   }
 }

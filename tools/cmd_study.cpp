@@ -87,17 +87,17 @@ void run_similarity(const SimilarityArgs& a) {
   ensure_dir(a.out);  // after the input is known to be good
   cv::Mat gray;
   FeaturePipeline::to_gray8(image, gray);
-  SimilarityOptions o;
+  eval::SimilarityOptions o;
   o.steps = a.steps;
   o.band_deg = a.band;
   o.descriptor = a.pipeline.descriptor;
   o.bearing_sign = geometry.bearing_sign;
-  const SimilarityResult r = similarity_study(gray, f.circle, o);
+  const eval::SimilarityResult r = eval::similarity_study(gray, f.circle, o);
 
   struct M {
     const char* name;
     const cv::Mat1f* m;
-    const Distinctiveness* d;
+    const eval::Distinctiveness* d;
     const char* title;
     const char* scale;
   };
@@ -133,7 +133,7 @@ void run_similarity(const SimilarityArgs& a) {
   for (const auto& m : ms) {
     write_matrix_csv(
         out_path(a.out, std::string("similarity_") + m.name + ".csv"), *m.m, r.bearings);
-    HeatmapOptions h;
+    viz::HeatmapOptions h;
     char t[200];
     std::snprintf(t,
                   sizeof t,
@@ -146,7 +146,7 @@ void run_similarity(const SimilarityArgs& a) {
     h.scale_label = m.scale;
     h.cell = std::max(1, 720 / std::max(1, r.descriptor.rows));
     write_image_atomic(out_path(a.out, std::string("similarity_") + m.name + ".png"),
-                       draw_heatmap(*m.m, h));
+                       viz::draw_heatmap(*m.m, h));
     sum << m.name << ',' << f6(m.d->gap) << ',' << f6(m.d->median_gap) << ',' << f6(m.d->ambiguous)
         << ',' << f6(m.d->valley_deg) << ',' << f6(m.d->median_distance) << ',' << f6(a.band)
         << '\n';
@@ -181,17 +181,17 @@ struct DatasetArgs {
   FeaturePipelineOptions pipeline;
 };
 
-StudySet load_set(const DatasetArgs& a, dataset::Dataset& data) {
+eval::StudySet load_set(const DatasetArgs& a, dataset::Dataset& data) {
   dataset::LoadOptions lo;
   lo.require_wheel = false;
   data = dataset::Dataset::load(a.dataset, lo);
-  StudyOptions so;
+  eval::StudyOptions so;
   so.max_baseline = a.max_baseline;
   so.frame_stride = a.stride;
   so.max_frames = a.max_frames;
   so.pipeline = a.pipeline;
   so.progress = Progress::enabled();
-  StudySet set = load_study_set(data, so);
+  eval::StudySet set = eval::load_study_set(data, so);
   std::printf(
       "%s: %zu frames, %zu lines (%zu associated to ground truth), %zu frame pairs within %.2f m\n",
       a.dataset.c_str(),
@@ -203,19 +203,21 @@ StudySet load_set(const DatasetArgs& a, dataset::Dataset& data) {
   return set;
 }
 
-void write_plot(const std::string& path, const std::vector<PlotSeries>& s, const PlotOptions& o) {
-  write_image_atomic(path, draw_plot(s, o));
+void write_plot(const std::string& path,
+                const std::vector<viz::PlotSeries>& s,
+                const viz::PlotOptions& o) {
+  write_image_atomic(path, viz::draw_plot(s, o));
 }
 
 void run_sensitivity(const DatasetArgs& a) {
   dataset::Dataset data;
-  const StudySet set = load_set(a, data);  // validates the input before any output exists
+  const eval::StudySet set = load_set(a, data);  // validates the input before any output exists
   ensure_dir(a.out);
-  SensitivityStudyOptions o;
+  eval::SensitivityStudyOptions o;
   o.descriptor = a.pipeline.descriptor;
   o.max_baseline = a.max_baseline;
   o.seed = a.seed;
-  run_sensitivity_study(set, o, a.out, stdout);
+  eval::run_sensitivity_study(set, o, a.out, stdout);
   std::printf(
       "wrote %s/sensitivity_{clip,noise,bins}.{csv,png}, rule{1,2,3}_pdf.{csv,png}, rules.csv\n",
       a.out.c_str());
@@ -224,16 +226,16 @@ void run_sensitivity(const DatasetArgs& a) {
 // ---------------------------------------------------------------- baselines
 void run_baselines(const DatasetArgs& a) {
   dataset::Dataset data;
-  const StudySet set = load_set(a, data);  // validates the input before any output exists
+  const eval::StudySet set = load_set(a, data);  // validates the input before any output exists
   ensure_dir(a.out);
-  std::vector<MethodFeatures> methods;
-  methods.push_back(describe_ours(set, a.pipeline.descriptor, 0.0, a.seed));
-  methods.push_back(describe_zncc(set));
-  methods.push_back(describe_lbd_on_our_lines(set));
-  LbdOptions lo;
-  methods.push_back(describe_lbd_segments(set, data, lo, deg2rad(1.0)));
+  std::vector<eval::MethodFeatures> methods;
+  methods.push_back(eval::describe_ours(set, a.pipeline.descriptor, 0.0, a.seed));
+  methods.push_back(eval::describe_zncc(set));
+  methods.push_back(eval::describe_lbd_on_our_lines(set));
+  eval::LbdOptions lo;
+  methods.push_back(eval::describe_lbd_segments(set, data, lo, deg2rad(1.0)));
   lo.use_lsd = true;
-  methods.push_back(describe_lbd_segments(set, data, lo, deg2rad(1.0)));
+  methods.push_back(eval::describe_lbd_segments(set, data, lo, deg2rad(1.0)));
 
   const std::vector<double> levels = {0.5, 0.6, 0.7, 0.8, 0.9};
   std::ostringstream bs, cs;
@@ -242,7 +244,7 @@ void run_baselines(const DatasetArgs& a) {
   for (double r : levels) bs << ",precision_at_recall_" << f6(r);
   bs << '\n';
   cs << "#method,ratio_threshold,precision,recall\n";
-  std::vector<PlotSeries> series;
+  std::vector<viz::PlotSeries> series;
   std::printf(
       "%-14s %6s %7s %8s %7s %6s %7s", "method", "lines", "queries", "NN db %", "AP", "max R", "");
   for (double r : levels) std::printf(" P@R%.1f", r);
@@ -254,10 +256,10 @@ void run_baselines(const DatasetArgs& a) {
       lines += ids.size();
       for (int id : ids) queries += id >= 0;
     }
-    const auto records = match_frame_pairs(set, m);
-    const auto full = precision_recall(records, 0);
-    const auto nn = nearest_neighbour_score(set, m);
-    const double ap = average_precision(full);
+    const auto records = eval::match_frame_pairs(set, m);
+    const auto full = eval::precision_recall(records, 0);
+    const auto nn = eval::nearest_neighbour_score(set, m);
+    const double ap = eval::average_precision(full);
     const double max_r = full.empty() ? 0.0 : full.back().recall;
     const double nf = static_cast<double>(set.frames.size());
     bs << m.name << ',' << f6(lines / nf) << ',' << f6(queries / nf) << ',' << records.size() << ','
@@ -271,7 +273,7 @@ void run_baselines(const DatasetArgs& a) {
                 max_r,
                 "");
     for (double r : levels) {
-      const double p = precision_at_recall(full, r);
+      const double p = eval::precision_at_recall(full, r);
       bs << ',' << (std::isnan(p) ? std::string("") : f6(p));
       if (std::isnan(p)) {
         std::printf(" %6s", "-");
@@ -281,8 +283,8 @@ void run_baselines(const DatasetArgs& a) {
     }
     bs << '\n';
     std::printf("\n");
-    PlotSeries s{m.name, {}, {}, plot_color(static_cast<int>(mi)), false};
-    for (const auto& p : precision_recall(records, 300)) {
+    viz::PlotSeries s{m.name, {}, {}, viz::plot_color(static_cast<int>(mi)), false};
+    for (const auto& p : eval::precision_recall(records, 300)) {
       cs << m.name << ',' << f6(p.threshold) << ',' << f6(p.precision) << ',' << f6(p.recall)
          << '\n';
       s.x.push_back(p.recall), s.y.push_back(p.precision);
@@ -290,7 +292,7 @@ void run_baselines(const DatasetArgs& a) {
     series.push_back(s);
     if (mi == 0) {
       const MatchOptions F;
-      const auto op = rules_operating_point(records, F.f1, F.f2, F.f3);
+      const auto op = eval::rules_operating_point(records, F.f1, F.f2, F.f3);
       bs << "ours_three_rules,,,,,,," << f6(op.precision) << ',' << f6(op.recall)
          << "  # precision, recall at F1, F2, F3\n";
       std::printf("%-14s precision %.3f at recall %.3f (F1 %.2f, F2 %.2f, F3 %.2f)\n",
@@ -304,9 +306,9 @@ void run_baselines(const DatasetArgs& a) {
   }
   write_text_atomic(out_path(a.out, "baselines.csv"), bs.str());
   write_text_atomic(out_path(a.out, "baselines_pr.csv"), cs.str());
-  PlotOptions po{"Precision-recall, ratio test nearest / second (frame pairs within baseline)",
-                 "recall",
-                 "precision"};
+  viz::PlotOptions po{"Precision-recall, ratio test nearest / second (frame pairs within baseline)",
+                      "recall",
+                      "precision"};
   po.x_lo = 0, po.x_hi = 1, po.y_lo = 0, po.y_hi = 1.02;
   po.legend_bottom = true;
   write_plot(out_path(a.out, "baselines_pr.png"), series, po);

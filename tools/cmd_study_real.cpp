@@ -28,7 +28,7 @@ namespace fs = std::filesystem;
 struct RealImagesArgs {
   std::string dir, out;
   std::vector<std::string> sensors;  // SUBFOLDER=FILE
-  RealImageStudyOptions study;
+  eval::RealImageStudyOptions study;
 };
 
 bool is_image(const fs::path& p) {
@@ -58,18 +58,18 @@ void run_real_images(const RealImagesArgs& a) {
   std::error_code ec;
   fs::create_directories(a.out, ec);
   if (!fs::is_directory(a.out)) throw InputError(a.out, 0, "cannot create the output folder");
-  std::vector<RealImageResult> results;
+  std::vector<eval::RealImageResult> results;
   for (const fs::path& f : files) {
     const std::string rel = f.lexically_relative(a.dir).string();
     CameraGeometry g;
     const auto it = sensors.find(fs::path(rel).parent_path().lexically_normal().string());
     if (it != sensors.end()) g = it->second;
     std::fprintf(stderr, "%s\n", rel.c_str());
-    results.push_back(study_real_image(rel, read_image(f.string()), g, a.study));
+    results.push_back(eval::study_real_image(rel, read_image(f.string()), g, a.study));
   }
-  const std::string table = real_image_table(results);
+  const std::string table = eval::real_image_table(results);
   write_text_atomic((fs::path(a.out) / "real_images.txt").string(), table);
-  write_text_atomic((fs::path(a.out) / "real_images.csv").string(), real_image_csv(results));
+  write_text_atomic((fs::path(a.out) / "real_images.csv").string(), eval::real_image_csv(results));
   std::printf("%s", table.c_str());
   std::printf("wrote %s/real_images.txt, real_images.csv\n", a.out.c_str());
 }

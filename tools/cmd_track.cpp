@@ -26,7 +26,7 @@ struct TrackArgs {
   std::string out;
   FeaturePipelineOptions pipeline;
   std::string mask;
-  TiltCheckOptions tilt;
+  pipeline::TiltCheckOptions tilt;
   TrackerFlags tracker;
   int threads = 0;
 };
@@ -44,7 +44,7 @@ void run_track(const TrackArgs& a) {
   fs::create_directories(a.out, ec);
   if (ec) throw InputError(a.out, 0, "cannot create the output folder: " + ec.message());
 
-  TrackDatasetOptions o;
+  pipeline::TrackDatasetOptions o;
   o.pipeline = a.pipeline;
   o.mask = a.mask;
   o.tilt = a.tilt;
@@ -52,7 +52,8 @@ void run_track(const TrackArgs& a) {
   o.threads = a.threads;
   Progress bar("track", data.size());
   const auto start = std::chrono::steady_clock::now();
-  const auto r = track_dataset(data, o, [&](std::size_t done, std::size_t) { bar.update(done); });
+  const auto r =
+      pipeline::track_dataset(data, o, [&](std::size_t done, std::size_t) { bar.update(done); });
   const std::chrono::duration<double> took = std::chrono::steady_clock::now() - start;
   bar.finish();
   for (const auto& w : r.warnings) spdlog::warn("{}", w);
@@ -60,7 +61,7 @@ void run_track(const TrackArgs& a) {
   const fs::path csv = fs::path(a.out) / "tracks.csv";
   const fs::path png = fs::path(a.out) / "tracks.png";
   write_tracks_csv(csv, r.rows);
-  write_tracks_png(png, r.rows);
+  viz::write_tracks_png(png, r.rows);
   std::printf("%lld frames (%lld skipped), %zu detections, %lld tracks\n%s\n",
               static_cast<long long>(r.frames),
               static_cast<long long>(r.frames_skipped),

@@ -54,7 +54,7 @@ inline std::string throughput(std::int64_t frames, double seconds, int threads) 
 }
 
 // The tilt check of a dataset (docs/extraction.md, "Tilt").
-inline void add_tilt_options(CLI::App* cmd, TiltCheckOptions& o) {
+inline void add_tilt_options(CLI::App* cmd, pipeline::TiltCheckOptions& o) {
   const std::string g = kExtractionGroup;
   cmd->add_flag("!--no-tilt-check",
                 o.enabled,

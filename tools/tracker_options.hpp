@@ -2,6 +2,7 @@
 // Command-line options of the tracker (Sec. 4, 9.1), shared by track and calibrate.
 
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -18,18 +19,17 @@ struct TrackerFlags {
   bool no_mutual = false;
   bool no_gate = false;
   int look_back = 20;
-  double f1 = -1.0, f2 = -1.0, f3 = -1.0;                      // < 0: the rule set's
-  std::string gate_candidates = "default";                     // on|off|default (the rule set's)
-  double gate_min_distance = -1.0, gate_tolerance_deg = -1.0;  // < 0: the default
-  std::string same_polarity = "default";                       // on|off|default (the rule set's)
-  double continuity_deg = -1.0;                                // < 0: the rule set's
-  std::string continuity_model = "default";                    // link|track|default
-  double continuity_path_curvature = -1.0;                     // < 0: the default
-  double continuity_turn_curvature = -1.0;                     // < 0: the default
-  double look_back_f1 = -1.0;                                  // < 0: the rule set's
-  std::string heads_only = "default";                          // on|off|default
-  double confirm_f1 = -1.0;                                    // < 0: the rule set's
-  double confirm_deg = -1.0;                                   // < 0: the rule set's
+  // Each flag not given keeps the value of the rule set (--rules) or of TrackerOptions.
+  std::optional<double> f1, f2, f3;
+  std::string gate_candidates = "default";  // on|off|default (the rule set's)
+  std::optional<double> gate_min_distance, gate_tolerance_deg;
+  std::string same_polarity = "default";  // on|off|default (the rule set's)
+  std::optional<double> continuity_deg;
+  std::string continuity_model = "default";  // link|track|default
+  std::optional<double> continuity_path_curvature, continuity_turn_curvature;
+  std::optional<double> look_back_f1;
+  std::string heads_only = "default";  // on|off|default
+  std::optional<double> confirm_f1, confirm_deg;
 
   // The options these flags select (the wheel base is filled in from the dataset).
   TrackerOptions options() const {
@@ -38,24 +38,24 @@ struct TrackerFlags {
     if (no_mutual) o.mutual = false;
     if (no_gate) o.gate.enabled = false;
     o.look_back = look_back;
-    if (f1 > 0.0) o.match.f1 = f1;
-    if (f2 > 0.0) o.match.f2 = f2;
-    if (f3 > 0.0) o.match.f3 = f3;
+    if (f1) o.match.f1 = *f1;
+    if (f2) o.match.f2 = *f2;
+    if (f3) o.match.f3 = *f3;
     if (gate_candidates != "default") o.gate_candidates = gate_candidates == "on";
-    if (continuity_deg >= 0.0) o.continuity_tolerance = deg2rad(continuity_deg);
+    if (continuity_deg) o.continuity_tolerance = deg2rad(*continuity_deg);
     if (continuity_model != "default") {
       o.continuity_model = continuity_model == "track" ? TrackerOptions::ContinuityModel::kTrack
                                                        : TrackerOptions::ContinuityModel::kLink;
     }
-    if (continuity_path_curvature >= 0.0) o.continuity_path_curvature = continuity_path_curvature;
-    if (continuity_turn_curvature >= 0.0) o.continuity_turn_curvature = continuity_turn_curvature;
-    if (look_back_f1 >= 0.0) o.look_back_f1 = look_back_f1;
+    if (continuity_path_curvature) o.continuity_path_curvature = *continuity_path_curvature;
+    if (continuity_turn_curvature) o.continuity_turn_curvature = *continuity_turn_curvature;
+    if (look_back_f1) o.look_back_f1 = *look_back_f1;
     if (heads_only != "default") o.heads_only = heads_only == "on";
-    if (confirm_f1 >= 0.0) o.confirm_f1 = confirm_f1;
-    if (confirm_deg >= 0.0) o.confirm_tolerance = deg2rad(confirm_deg);
+    if (confirm_f1) o.confirm_f1 = *confirm_f1;
+    if (confirm_deg) o.confirm_tolerance = deg2rad(*confirm_deg);
     if (same_polarity != "default") o.same_polarity = same_polarity == "on";
-    if (gate_min_distance > 0.0) o.gate.min_feature_distance = gate_min_distance;
-    if (gate_tolerance_deg >= 0.0) o.gate.bearing_tolerance = deg2rad(gate_tolerance_deg);
+    if (gate_min_distance) o.gate.min_feature_distance = *gate_min_distance;
+    if (gate_tolerance_deg) o.gate.bearing_tolerance = deg2rad(*gate_tolerance_deg);
     return o;
   }
 };

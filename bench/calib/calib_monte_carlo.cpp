@@ -39,15 +39,15 @@
 #include <string>
 #include <vector>
 
+#include "calib/batch_point.hpp"
 #include "calib/synthetic_run.hpp"
+#include "calib/updater.hpp"
 #include "core/progress.hpp"
-#include "omnivert/calib/batch_point.hpp"
 #include "omnivert/calib/calibrate.hpp"
 #include "omnivert/calib/calibration_filter.hpp"
 #include "omnivert/calib/observability.hpp"
 #include "omnivert/calib/refinement.hpp"
 #include "omnivert/calib/track_ids.hpp"
-#include "omnivert/calib/updater.hpp"
 #include "omnivert/core/angles.hpp"
 
 using namespace omnivert;
@@ -319,7 +319,7 @@ void add_refinement(int r, const SyntheticRun& run, const CalibrationResult& cr,
     ++t.ref.failures;
   }
   // Joins of two different lines (pieces whose true features differ).
-  auto of_two_lines = [&run](const std::vector<std::pair<int, int>>& joins) {
+  auto of_two_lines = [&run](const std::vector<omnivert::calib::TrackJoin>& joins) {
     int n = 0;
     for (const auto& [a, c] : joins) {
       const auto ia = run.track_feature.find(a), ic = run.track_feature.find(c);

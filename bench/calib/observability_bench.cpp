@@ -17,8 +17,8 @@
 
 #include <benchmark/benchmark.h>
 
+#include "calib/batch_point.hpp"
 #include "calib/synthetic_run.hpp"
-#include "omnivert/calib/batch_point.hpp"
 #include "omnivert/calib/observability.hpp"
 
 namespace omnivert::calib {

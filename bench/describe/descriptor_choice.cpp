@@ -33,7 +33,7 @@ struct Input {
 struct Acc {
   int pairs = 0, nn_correct = 0;
   std::vector<double> dist, ratio;
-  void add(const LinePairing& p) {
+  void add(const eval::LinePairing& p) {
     ++pairs;
     nn_correct += p.nearest_is_correct;
     dist.push_back(p.descriptor_distance);
@@ -142,22 +142,21 @@ void measure(const Input& in, const Config& c, Acc acc[4]) {
   if (in.real) geo.center = f0.circle.center;
   geo.r_min = f0.circle.r_min;
   // Real images: the annulus ends where a rotation brings no new content into a descriptor.
-  geo.r_max =
-      in.real
-          ? std::min(f0.circle.r_max,
-                     rotation_safe_r_max(f0.circle.center, gray.cols, gray.rows, f0.circle.r_min))
-          : f0.circle.r_max;
+  geo.r_max = in.real ? std::min(f0.circle.r_max,
+                                 eval::rotation_safe_r_max(
+                                     f0.circle.center, gray.cols, gray.rows, f0.circle.r_min))
+                      : f0.circle.r_max;
   FeaturePipeline base(geo, po);
   if (!base.process(gray, f0)) return;
   auto run = [&](const cv::Mat& img, double shift, Acc& a) {
     FeaturePipeline p(geo, po);
     FrameFeatures f;
     if (!p.process(img, f)) return;
-    for (const auto& pr : pair_lines(f0, f, shift, deg2rad(0.3))) a.add(pr);
+    for (const auto& pr : eval::pair_lines(f0, f, shift, deg2rad(0.3))) a.add(pr);
   };
   for (double r : kRotations) {
     if (in.real) {
-      run(rotate_about(gray, f0.circle.center, deg2rad(r)), deg2rad(r), acc[0]);
+      run(eval::rotate_about(gray, f0.circle.center, deg2rad(r)), deg2rad(r), acc[0]);
     } else {
       auto o = in.pattern;
       o.rotation_rad = deg2rad(r);
@@ -172,8 +171,8 @@ void measure(const Input& in, const Config& c, Acc acc[4]) {
       run(sim::draw_radial_pattern(o).image, 0.0, acc[3]);
     }
   }
-  for (double g : kGains) run(relight(gray, g, 1.0), 0.0, acc[1]);
-  for (double g : kGammas) run(relight(gray, 1.0, g), 0.0, acc[2]);
+  for (double g : kGains) run(eval::relight(gray, g, 1.0), 0.0, acc[1]);
+  for (double g : kGammas) run(eval::relight(gray, 1.0, g), 0.0, acc[2]);
 }
 
 void print_rows(const Config& c, int real, const Acc acc[4]) {

@@ -12,7 +12,7 @@
 //   omnivert::FeaturePipeline::process     one image -> mirror circle, radial lines with their
 //                                          bearings, 192-D descriptors (Sec. 2-3)
 //   omnivert::Tracker::add_frame           frame by frame -> a track id per line (Sec. 4, 9.1)
-//   omnivert::track_dataset                a whole dataset folder -> tracks.csv rows
+//   omnivert::pipeline::track_dataset      a whole dataset folder -> tracks.csv rows
 //   omnivert::calib::calibrate             bearings + wheel increments -> extrinsics with
 //                                          covariance, observability verdict, checks (Sec. 7-8)
 //   omnivert::calib::CalibrationFilter     the same, frame by frame, as a robot drives (EKF)
@@ -39,6 +39,10 @@
 // Each stage is also a library of its own (omnivert::core, extract, describe, match, dataset,
 // recording, calib, sim, viz, pipeline, eval); omnivert::omnivert links them all. The estimator
 // (omnivert::calib) needs only Eigen and Ceres.
+//
+// Namespaces: the image front end (core, image, extract, describe, match: cameras, images,
+// lines, descriptors, tracks) is `omnivert`; every stage above it has its own, named after it:
+// omnivert::dataset, recording, calib, sim, viz, pipeline, eval.
 
 #include "omnivert/calib/calibrate.hpp"
 #include "omnivert/calib/calibration_filter.hpp"

@@ -4,16 +4,16 @@
 #include <cmath>
 #include <set>
 
+#include "calib/updater.hpp"
 #include "omnivert/calib/model.hpp"
 #include "omnivert/calib/track_ids.hpp"
-#include "omnivert/calib/updater.hpp"
 
 namespace omnivert::calib::internal {
 
 CalibrationRun split_round(const CalibrationRun& original,
                            const CalibrationRun& current,
                            const std::map<int, int>& found,
-                           std::vector<std::pair<int, int>>* splits,
+                           std::vector<TrackSplit>* splits,
                            std::map<int, int>* origin,
                            BatchPoint* at) {
   for (const auto& [id, frame] : found) {
@@ -42,8 +42,8 @@ bool merge_round(Built* b,
                  const CalibrationOptions& options,
                  CalibrationRun* run,
                  BatchPoint* at,
-                 std::vector<std::pair<int, int>>* joins) {
-  const std::vector<std::pair<int, int>> found =
+                 std::vector<TrackJoin>* joins) {
+  const std::vector<TrackJoin> found =
       find_merges(b,
                   options.association.max_missed_frames,
                   chi2_quantile(options.association.gate_probability, 2));
@@ -68,7 +68,7 @@ Built final_with_bias(const CalibrationRun& run,
                       const CalibrationOptions& options,
                       bool robust,
                       int min_track_length) {
-  const std::set<std::pair<int, int>> keep(b.bearing_keys.begin(), b.bearing_keys.end());
+  const std::set<BearingKey> keep(b.bearing_keys.begin(), b.bearing_keys.end());
   CalibrationRun kept = run;
   for (std::size_t k = 0; k < kept.frames.size(); ++k) {
     auto& obs = kept.frames[k].observations;

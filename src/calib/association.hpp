@@ -11,8 +11,8 @@
 #include <utility>
 #include <vector>
 
+#include "calib/batch_point.hpp"
 #include "calib/batch_problem.hpp"
-#include "omnivert/calib/batch_point.hpp"
 #include "omnivert/calib/types.hpp"
 
 namespace omnivert::calib::internal {
@@ -92,7 +92,7 @@ double one_point_statistic(Built* b, const std::vector<std::size_t>& blocks, int
 // predecessor per round, the pairs with the smallest first statistic first (each track in at
 // most one join per round: 100 synthetic runs broken every ~10 frames, refinement NEES 4.25
 // against 3.17). Returns (a, c) pairs, a the piece seen first: c's bearings are a's line.
-std::vector<std::pair<int, int>> find_merges(Built* b, int max_gap, double chi2);
+std::vector<TrackJoin> find_merges(Built* b, int max_gap, double chi2);
 
 // Track splitting (CalibrationOptions::association.split_chi2). A track that slipped onto a
 // neighbouring line (a door leaf 6 cm inside its frame) is two features glued together: from the
@@ -114,7 +114,7 @@ std::map<int, int> find_splits(const Built& b, const AssociationOptions& split);
 CalibrationRun split_round(const CalibrationRun& original,
                            const CalibrationRun& current,
                            const std::map<int, int>& found,
-                           std::vector<std::pair<int, int>>* splits,
+                           std::vector<TrackSplit>* splits,
                            std::map<int, int>* origin,
                            BatchPoint* at);
 
@@ -129,7 +129,7 @@ bool merge_round(Built* b,
                  const CalibrationOptions& options,
                  CalibrationRun* run,
                  BatchPoint* at,
-                 std::vector<std::pair<int, int>>* joins);
+                 std::vector<TrackJoin>* joins);
 
 // CalibrationOptions::noise.track_bias_sigma: which bearings belong together (lines that cross,
 // outliers, pieces of one line joined, tracks split where they slipped) is decided under the white
@@ -179,9 +179,9 @@ struct AssociationSetup {
 struct Association {
   CalibrationRun merged;  // the run with the joined pieces under their line's first id
   CalibrationRun split;   // `merged` with the slipped tracks split (when splits is not empty)
-  std::vector<std::pair<int, int>> merges;  // (earlier piece's id, joined piece's id)
-  std::vector<std::pair<int, int>> splits;  // (id in `merged`, first frame of the new part)
-  std::map<int, int> origin;                // id of a split part -> its id in `merged`
+  std::vector<TrackJoin> merges;   // (earlier piece's id, joined piece's id)
+  std::vector<TrackSplit> splits;  // (id in `merged`, first frame of the new part)
+  std::map<int, int> origin;       // id of a split part -> its id in `merged`
   int num_splits = 0;
   int num_rejected = 0;  // outliers rejected by the last rejection
   // The run the solved problem's ids are of.

@@ -113,13 +113,13 @@ int reject_crossings(Built* b,
     if (it != merged.end()) return it->second;
     return merged[key] = one_line(b, a, c, merge_chi2, &covariance);
   };
-  std::set<std::pair<int, int>> crossing;  // (track id, frame)
+  std::set<BearingKey> crossing;  // (track id, frame)
   for (int k = 0; k < frames; ++k)
     for (int id :
          crowded_directions(std::move(seen[static_cast<std::size_t>(k)]), guard, same_line))
-      crossing.emplace(id, k);
+      crossing.insert({id, k});
   if (crossing.empty()) return 0;
-  const int n = filter_bearings(b, [&](ceres::ResidualBlockId id, const std::pair<int, int>& key) {
+  const int n = filter_bearings(b, [&](ceres::ResidualBlockId id, const BearingKey& key) {
     if (!crossing.count(key)) return true;
     b->problem->RemoveResidualBlock(id);
     b->guarded.push_back(key);

@@ -56,11 +56,11 @@ double one_point_statistic(Built* b, const std::vector<std::size_t>& blocks, int
   return best - separate;
 }
 
-std::vector<std::pair<int, int>> find_merges(Built* b, int max_gap, double chi2) {
+std::vector<TrackJoin> find_merges(Built* b, int max_gap, double chi2) {
   const std::map<int, std::vector<int>> frames_of = track_frames(*b);
   std::map<int, std::vector<std::size_t>> blocks;  // track id -> its bearings' blocks
   for (std::size_t i = 0; i < b->bearing_keys.size(); ++i)
-    blocks[b->bearing_keys[i].first].push_back(i);
+    blocks[b->bearing_keys[i].track].push_back(i);
   FeatureCovariance covariance;
   std::vector<std::tuple<double, int, int>> passing;  // (statistic, a, c)
   for (auto ia = frames_of.begin(); ia != frames_of.end(); ++ia)
@@ -82,7 +82,7 @@ std::vector<std::pair<int, int>> find_merges(Built* b, int max_gap, double chi2)
     }
   std::sort(passing.begin(), passing.end());
   std::set<int> has_successor, has_predecessor;
-  std::vector<std::pair<int, int>> out;
+  std::vector<TrackJoin> out;
   for (const auto& [t, a, c] : passing) {
     if (has_successor.count(a) || has_predecessor.count(c)) continue;
     has_successor.insert(a);
@@ -109,8 +109,8 @@ std::map<int, int> find_splits(const Built& b, const AssociationOptions& split) 
             b.bearing_blocks[i], /*apply_loss_function=*/false, &cost, &r, jac) ||
         !std::isfinite(r) || !std::isfinite(jf[0]) || !std::isfinite(jf[1]))
       continue;
-    seq[b.bearing_keys[i].first].push_back(
-        {b.bearing_keys[i].second, r, Eigen::Vector2d(jf[0], jf[1])});
+    seq[b.bearing_keys[i].track].push_back(
+        {b.bearing_keys[i].frame, r, Eigen::Vector2d(jf[0], jf[1])});
   }
   std::vector<std::tuple<double, int, int>> candidates;  // (statistic, track id, split frame)
   const int m = std::max(split.split_min_bearings, 2);

@@ -1,4 +1,4 @@
-#include "omnivert/calib/batch_point.hpp"
+#include "calib/batch_point.hpp"
 
 #include "omnivert/calib/model.hpp"
 

@@ -14,9 +14,8 @@ namespace omnivert::calib::internal {
 
 int remove_features(Built* b, const std::set<int>& drop) {
   if (drop.empty()) return 0;
-  filter_bearings(b, [&](ceres::ResidualBlockId, const std::pair<int, int>& key) {
-    return !drop.count(key.first);
-  });
+  filter_bearings(
+      b, [&](ceres::ResidualBlockId, const BearingKey& key) { return !drop.count(key.track); });
   for (int id : drop) {
     if (auto it = b->biases.find(id); it != b->biases.end()) {
       b->problem->RemoveParameterBlock(&it->second);  // and its prior
@@ -52,7 +51,7 @@ int drop_collapsed_features(Built* b, double min_range) {
 }
 
 int reject_outliers(Built* b, double threshold, int min_bearings) {
-  const int n = filter_bearings(b, [&](ceres::ResidualBlockId id, const std::pair<int, int>&) {
+  const int n = filter_bearings(b, [&](ceres::ResidualBlockId id, const BearingKey&) {
     double r = 0.0, cost = 0.0;
     b->problem->EvaluateResidualBlock(id, /*apply_loss_function=*/false, &cost, &r, nullptr);
     if (std::abs(r) <= threshold) return true;  // (false for NaN)

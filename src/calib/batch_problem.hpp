@@ -13,7 +13,7 @@
 #include <utility>
 #include <vector>
 
-#include "omnivert/calib/batch_point.hpp"
+#include "calib/batch_point.hpp"
 #include "omnivert/calib/types.hpp"
 
 namespace omnivert::calib::internal {
@@ -30,9 +30,9 @@ struct Built {
   std::unique_ptr<ceres::Problem> problem;
   int num_bearings = 0;
   std::vector<ceres::ResidualBlockId> bearing_blocks;
-  std::vector<std::pair<int, int>> bearing_keys;  // (track id, frame) of each bearing block
+  std::vector<BearingKey> bearing_keys;  // (track id, frame) of each bearing block
   std::vector<ceres::ResidualBlockId> odometry_blocks;
-  std::vector<std::pair<int, int>> guarded;  // (track id, frame) left out by reject_crossings
+  std::vector<BearingKey> guarded;  // (track id, frame) left out by reject_crossings
 };
 
 // Keeps the bearings for which keep(block, (track id, frame)) is true; the others leave the
@@ -41,7 +41,7 @@ struct Built {
 template <typename Keep>
 int filter_bearings(Built* b, Keep keep) {
   std::vector<ceres::ResidualBlockId> kept;
-  std::vector<std::pair<int, int>> kept_keys;
+  std::vector<BearingKey> kept_keys;
   for (std::size_t i = 0; i < b->bearing_blocks.size(); ++i) {
     if (!keep(b->bearing_blocks[i], b->bearing_keys[i])) continue;
     kept.push_back(b->bearing_blocks[i]);
@@ -61,13 +61,11 @@ int remove_features(Built* b, const std::set<int>& drop);
 // those of features removed), as (track id of `run`, frame); `to_run` maps the problem's
 // track ids to `run`'s (renamed parts of a track).
 template <typename ToRun>
-std::vector<std::pair<int, int>> unused_bearings(const CalibrationRun& run,
-                                                 const Built& b,
-                                                 ToRun to_run) {
-  std::set<std::pair<int, int>> out;
+std::vector<BearingKey> unused_bearings(const CalibrationRun& run, const Built& b, ToRun to_run) {
+  std::set<BearingKey> out;
   for (std::size_t k = 0; k < run.frames.size(); ++k)
     for (const BearingObservation& o : run.frames[k].observations)
-      out.emplace(o.track_id, static_cast<int>(k));
+      out.insert({o.track_id, static_cast<int>(k)});
   for (const auto& [id, k] : b.bearing_keys) out.erase({to_run(id), k});
   for (const auto& [id, k] : b.guarded) out.erase({to_run(id), k});
   return {out.begin(), out.end()};

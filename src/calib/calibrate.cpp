@@ -14,7 +14,8 @@
 #include <spdlog/spdlog.h>
 #include <Eigen/Cholesky>
 
-#include "omnivert/calib/updater.hpp"
+#include "calib/batch_point.hpp"
+#include "calib/updater.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
 
@@ -24,8 +25,8 @@ namespace {
 // The run without the given (track id, frame) bearings: those guarded where lines cross and
 // those refused as outliers.
 CalibrationRun without_bearings(const CalibrationRun& run,
-                                const std::vector<std::pair<int, int>>& guarded,
-                                const std::vector<std::pair<int, int>>& rejected) {
+                                const std::vector<BearingKey>& guarded,
+                                const std::vector<BearingKey>& rejected) {
   if (guarded.empty() && rejected.empty()) return run;
   std::map<int, std::set<int>> by_frame;  // frame -> track ids
   for (const auto& [id, k] : guarded) by_frame[k].insert(id);
@@ -221,13 +222,19 @@ CalibrationResult calibrate_once(const CalibrationRun& run, const CalibrationOpt
   }
   r.extrinsics = r.filter.extrinsics;
   r.covariance = r.filter.covariance;
+  r.source = Estimator::kFilter;
   if (r.refined && r.refinement.covariance_ok) {
     r.extrinsics = r.refinement.extrinsics;
     r.covariance = r.refinement.covariance;
+    r.source = Estimator::kRefinement;
   }
   return r;
 }
 }  // namespace
+
+const char* estimator_name(Estimator e) {
+  return e == Estimator::kRefinement ? "refinement" : "filter";
+}
 
 CalibrationResult calibrate(const CalibrationRun& run, const CalibrationOptions& options) {
   return calibrate_once(run, options);
@@ -302,7 +309,7 @@ void write_extrinsics_yaml(const std::string& path, const CalibrationResult& r) 
   y << "observable: " << (o.all_determined() ? "true" : "false") << "\n";
   y << "crlb_phi: " << num(o.phi.crlb) << "\ncrlb_rho: " << num(o.rho.crlb)
     << "\ncrlb_psi: " << num(o.psi.crlb) << "\ncrlb_yaw: " << num(o.yaw.crlb) << "\n";
-  y << "source: " << (r.refined && r.refinement.covariance_ok ? "refinement" : "filter") << "\n";
+  y << "source: " << estimator_name(r.source) << "\n";
   std::string msg = o.message;
   for (char& c : msg)
     if (c == '"') c = '\'';

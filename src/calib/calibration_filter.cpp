@@ -6,7 +6,9 @@
 #include <map>
 #include <set>
 #include <string>
+#include <utility>
 
+#include "calib/filter_impl.hpp"
 #include "calib/window.hpp"
 #include "omnivert/calib/model.hpp"
 #include "omnivert/calib/track_ids.hpp"
@@ -24,6 +26,39 @@ CalibrationOptions checked(const CalibrationOptions& options) {
 }  // namespace
 
 CalibrationFilter::CalibrationFilter(const CalibrationOptions& options)
+    : impl_(std::make_unique<Impl>(options)) {}
+CalibrationFilter::~CalibrationFilter() = default;
+CalibrationFilter::CalibrationFilter(const CalibrationFilter& other)
+    : impl_(std::make_unique<Impl>(*other.impl_)) {}
+CalibrationFilter& CalibrationFilter::operator=(const CalibrationFilter& other) {
+  if (this != &other) impl_ = std::make_unique<Impl>(*other.impl_);
+  return *this;
+}
+CalibrationFilter::CalibrationFilter(CalibrationFilter&& other) noexcept = default;
+CalibrationFilter& CalibrationFilter::operator=(CalibrationFilter&& other) noexcept = default;
+
+void CalibrationFilter::process(const FrameInput& frame) { impl_->process(frame); }
+void CalibrationFilter::guard_ahead(std::map<BearingKey, int> keys) {
+  impl_->ahead_ = std::move(keys);
+}
+void CalibrationFilter::finish() { impl_->finish(); }
+Extrinsics CalibrationFilter::extrinsics() const { return impl_->state_.extrinsics(); }
+Eigen::Matrix3d CalibrationFilter::covariance() const {
+  return impl_->state_.extrinsics_covariance();
+}
+int CalibrationFilter::num_features() const { return impl_->state_.num_features(); }
+const std::vector<FrameEstimate>& CalibrationFilter::history() const { return impl_->history_; }
+const std::map<int, TrackEstimate>& CalibrationFilter::tracks() const { return impl_->tracks_; }
+const std::vector<TrackSplit>& CalibrationFilter::splits() const { return impl_->splits_; }
+int CalibrationFilter::window_frames() const { return impl_->window_frames_; }
+const std::string& CalibrationFilter::window_failure() const { return impl_->window_failure_; }
+const std::vector<BearingKey>& CalibrationFilter::guarded() const { return impl_->guarded_; }
+const std::vector<BearingKey>& CalibrationFilter::rejected() const { return impl_->rejected_; }
+const std::vector<TrackJoin>& CalibrationFilter::joins() const { return impl_->joins_; }
+int CalibrationFilter::frames_processed() const { return impl_->frame_; }
+const CalibrationOptions& CalibrationFilter::options() const { return impl_->options_; }
+
+CalibrationFilter::Impl::Impl(const CalibrationOptions& options)
     : options_(checked(options)),
       state_(options.prior.mean,
              options.prior.sigma,
@@ -36,7 +71,7 @@ CalibrationFilter::CalibrationFilter(const CalibrationOptions& options)
       bootstrapping_(options.filter.feature_init == FeatureInit::kAnchoredInverseDepth &&
                      options.filter.bootstrap_rotation > 0.0) {}
 
-void CalibrationFilter::process(const FrameInput& frame) {
+void CalibrationFilter::Impl::process(const FrameInput& frame) {
   const std::string where = "frame " + std::to_string(frame_);
   if (!std::isfinite(frame.d_right) || !std::isfinite(frame.d_left) ||
       !std::isfinite(frame.lateral))
@@ -66,9 +101,9 @@ void CalibrationFilter::process(const FrameInput& frame) {
   admit(frame);
 }
 
-int CalibrationFilter::leave_out_ahead(std::vector<BearingObservation>* obs,
-                                       int frame,
-                                       int started_after) {
+int CalibrationFilter::Impl::leave_out_ahead(std::vector<BearingObservation>* obs,
+                                             int frame,
+                                             int started_after) {
   const auto gone = std::remove_if(obs->begin(), obs->end(), [&](const BearingObservation& o) {
     const auto it = ahead_.find({o.track_id, frame});
     return it != ahead_.end() && it->second > started_after;
@@ -80,12 +115,12 @@ int CalibrationFilter::leave_out_ahead(std::vector<BearingObservation>* obs,
   return n;
 }
 
-int CalibrationFilter::guarded_ahead(int frame) const {
+int CalibrationFilter::Impl::guarded_ahead(int frame) const {
   const auto it = ahead_count_.find(frame);
   return it == ahead_count_.end() ? 0 : it->second;
 }
 
-void CalibrationFilter::admit(const FrameInput& frame) {
+void CalibrationFilter::Impl::admit(const FrameInput& frame) {
   // Delayed initialisation: the first bootstrap_frames frames are solved as a batch
   // (bootstrap_filter_state), the filter starts from that.
   if (bootstrapping_) {
@@ -111,7 +146,7 @@ void CalibrationFilter::admit(const FrameInput& frame) {
   step(frame);
 }
 
-void CalibrationFilter::finish() {
+void CalibrationFilter::Impl::finish() {
   if (!bootstrapping_ || window_.frames.empty()) return;
   --frame_;
   FrameEstimate rec = history_.back();
@@ -119,7 +154,7 @@ void CalibrationFilter::finish() {
   end_bootstrap(rec);
 }
 
-void CalibrationFilter::end_bootstrap(FrameEstimate rec) {
+void CalibrationFilter::Impl::end_bootstrap(FrameEstimate rec) {
   {
     bootstrapping_ = false;
     window_frames_ = static_cast<int>(window_.frames.size());
@@ -185,7 +220,7 @@ void CalibrationFilter::end_bootstrap(FrameEstimate rec) {
   }
 }
 
-void CalibrationFilter::step(const FrameInput& frame) {
+void CalibrationFilter::Impl::step(const FrameInput& frame) {
   FrameEstimate rec;
   rec.frame = frame_;
   rec.num_guarded = guarded_ahead(frame_);
@@ -238,7 +273,7 @@ void CalibrationFilter::step(const FrameInput& frame) {
 // (eq. 27). A track that starts within the guard of another line enters the state at its first
 // bearing outside it: entered inside, its first bearing is pulled towards the other line, and with
 // its depth unknown its prediction stays by the other line, which is then left out as long.
-std::vector<char> CalibrationFilter::crossing_entries(const FrameInput& frame) const {
+std::vector<char> CalibrationFilter::Impl::crossing_entries(const FrameInput& frame) const {
   const int n = state_.num_features();
   std::vector<char> crossing(frame.observations.size() + static_cast<std::size_t>(n), 0);
   if (options_.association.crossing_guard > 0.0) {
@@ -280,12 +315,12 @@ std::vector<char> CalibrationFilter::crossing_entries(const FrameInput& frame) c
   return crossing;
 }
 
-void CalibrationFilter::sort_bearings(const FrameInput& frame,
-                                      const std::vector<char>& crossing,
-                                      FrameEstimate* rec,
-                                      std::vector<const BearingObservation*>* fresh,
-                                      std::vector<BearingMeasurement>* z,
-                                      std::vector<int>* z_ids) {
+void CalibrationFilter::Impl::sort_bearings(const FrameInput& frame,
+                                            const std::vector<char>& crossing,
+                                            FrameEstimate* rec,
+                                            std::vector<const BearingObservation*>* fresh,
+                                            std::vector<BearingMeasurement>* z,
+                                            std::vector<int>* z_ids) {
   const int n = state_.num_features();
   std::set<int> measured;  // slots with a bearing in this frame
   for (std::size_t i = 0; i < frame.observations.size(); ++i) {
@@ -314,7 +349,7 @@ void CalibrationFilter::sort_bearings(const FrameInput& frame,
 }
 
 // (D, theta) of eq. (28) for kInverseDistance, a robot-frame point for kAnchored.
-void CalibrationFilter::convert_known_depths() {
+void CalibrationFilter::Impl::convert_known_depths() {
   if (options_.filter.convert_ratio > 0.0) {
     for (int s = 0; s < state_.num_features(); ++s) {
       const FeatureSlot& slot = state_.slots()[s];
@@ -339,7 +374,7 @@ void CalibrationFilter::convert_known_depths() {
   }
 }
 
-int CalibrationFilter::slot_of(int track_id) const {
+int CalibrationFilter::Impl::slot_of(int track_id) const {
   // A joined track's feature, while it is in the state; after it left (its line unseen for
   // max_missed_frames frames) the track is a feature of its own again once it has entered.
   if (const auto it = joined_to_.find(track_id); it != joined_to_.end())
@@ -357,7 +392,7 @@ int CalibrationFilter::slot_of(int track_id) const {
 // the state for max_missed_frames frames unseen, and would crowd the new piece of the same
 // line. Without the crowding test a new track of a door's edge can be joined to the feature
 // of the edge beside it, which puts the filter a degree off in yaw.)
-std::vector<const BearingObservation*> CalibrationFilter::join_pieces(
+std::vector<const BearingObservation*> CalibrationFilter::Impl::join_pieces(
     std::vector<const BearingObservation*> fresh,
     std::vector<BearingMeasurement>* z,
     std::vector<int>* z_ids) {
@@ -417,7 +452,7 @@ std::vector<const BearingObservation*> CalibrationFilter::join_pieces(
   return left;
 }
 
-void CalibrationFilter::record_tracks() {
+void CalibrationFilter::Impl::record_tracks() {
   std::map<int, std::vector<int>> joined;  // feature's track id -> tracks joined to it
   for (const auto& [id, to] : joined_to_) joined[to].push_back(id);
   for (int s = 0; s < state_.num_features(); ++s) {
@@ -436,9 +471,9 @@ void CalibrationFilter::record_tracks() {
   }
 }
 
-std::map<std::pair<int, int>, int> guard_before_starts(const CalibrationRun& run,
-                                                       const CalibrationOptions& options) {
-  std::map<std::pair<int, int>, int> out;
+std::map<BearingKey, int> guard_before_starts(const CalibrationRun& run,
+                                              const CalibrationOptions& options) {
+  std::map<BearingKey, int> out;
   const double guard = options.association.crossing_guard;
   if (!(guard > 0.0)) return out;
   std::map<int, std::map<int, double>> at;  // track id -> frame -> bearing
@@ -460,7 +495,7 @@ std::map<std::pair<int, int>, int> guard_before_starts(const CalibrationRun& run
           rate = (angle_diff(it->second, ai->second) - sep0) / (it->first - k0);
       for (auto it = of_a.lower_bound(k0 - options.association.max_missed_frames); it != a0; ++it)
         if (std::abs(sep0 - rate * (k0 - it->first)) < guard) {
-          const auto [o, fresh] = out.emplace(std::make_pair(a, it->first), k0);
+          const auto [o, fresh] = out.emplace(BearingKey{a, it->first}, k0);
           if (!fresh) o->second = std::min(o->second, k0);
         }
     }

@@ -5,7 +5,7 @@
 #include <Eigen/Cholesky>
 
 #include "calib/noise_check.hpp"
-#include "omnivert/calib/updater.hpp"
+#include "calib/updater.hpp"
 #include "omnivert/core/angles.hpp"
 
 namespace omnivert::calib {

@@ -1,4 +1,4 @@
-#include "omnivert/calib/feature_initializer.hpp"
+#include "calib/feature_initializer.hpp"
 
 #include <cmath>
 

@@ -1,4 +1,4 @@
-#include "omnivert/calib/filter_state.hpp"
+#include "calib/filter_state.hpp"
 
 #include <algorithm>
 #include <cassert>

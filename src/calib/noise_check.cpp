@@ -53,7 +53,7 @@ bool evaluate_clusters(Built& b, ClusteredRows* out) {
     if (fresh) ++next;
     return it->second;
   };
-  for (const auto& key : b.bearing_keys) cluster[row++] = track_cluster(key.first);
+  for (const auto& key : b.bearing_keys) cluster[row++] = track_cluster(key.track);
   for (const auto& [id, block] : b.bias_priors) cluster[row++] = track_cluster(id);
   if (row != m) return false;
   out->rows_of.assign(next, {});

@@ -1,8 +1,8 @@
 #pragma once
 // The checks of diagnostics.hpp on a solved batch problem.
 
+#include "calib/batch_point.hpp"
 #include "calib/batch_problem.hpp"
-#include "omnivert/calib/batch_point.hpp"
 #include "omnivert/calib/diagnostics.hpp"
 #include "omnivert/calib/types.hpp"
 

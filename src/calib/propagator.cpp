@@ -1,4 +1,4 @@
-#include "omnivert/calib/propagator.hpp"
+#include "calib/propagator.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -94,7 +94,7 @@ std::string association_text(const CalibrationResult& r) {
 }  // namespace
 
 std::string CalibrationResult::BriefReport() const {
-  const bool from_refinement = refined && refinement.covariance_ok;
+  const bool from_refinement = source == Estimator::kRefinement;
   std::string s = (from_refinement ? "refined estimate: " : "filter estimate: ") +
                   estimate_text(extrinsics, covariance) + "\n";
   const Eigen::Vector2d p = extrinsics.position();

@@ -8,8 +8,8 @@
 
 #include <Eigen/Cholesky>
 
+#include "calib/updater.hpp"
 #include "omnivert/calib/calibrate.hpp"
-#include "omnivert/calib/updater.hpp"
 #include "omnivert/core/angles.hpp"
 
 namespace omnivert::calib {

@@ -5,7 +5,7 @@
 
 namespace omnivert::calib {
 
-std::map<int, int> join_roots(const std::vector<std::pair<int, int>>& joins) {
+std::map<int, int> join_roots(const std::vector<TrackJoin>& joins) {
   std::map<int, int> earlier;  // joined piece -> the piece it continues
   auto root_of = [&earlier](int x) {
     for (auto it = earlier.find(x); it != earlier.end(); it = earlier.find(x)) x = it->second;
@@ -28,7 +28,7 @@ std::map<int, int> join_roots(const std::vector<std::pair<int, int>>& joins) {
 }
 
 CalibrationRun join_tracks(const CalibrationRun& run,
-                           const std::vector<std::pair<int, int>>& joins,
+                           const std::vector<TrackJoin>& joins,
                            std::map<int, int>* renamed) {
   std::map<int, int> root = join_roots(joins);
   CalibrationRun out = run;
@@ -40,7 +40,7 @@ CalibrationRun join_tracks(const CalibrationRun& run,
 }
 
 CalibrationRun split_tracks(const CalibrationRun& run,
-                            const std::vector<std::pair<int, int>>& splits,
+                            const std::vector<TrackSplit>& splits,
                             std::map<int, int>* origin) {
   if (origin) origin->clear();
   if (splits.empty()) return run;

@@ -1,4 +1,4 @@
-#include "omnivert/calib/updater.hpp"
+#include "calib/updater.hpp"
 
 #include <Eigen/Cholesky>
 #include <cassert>

@@ -11,8 +11,8 @@
 
 #include "calib/association.hpp"
 #include "calib/batch_factors.hpp"
+#include "calib/batch_point.hpp"
 #include "calib/batch_problem.hpp"
-#include "omnivert/calib/batch_point.hpp"
 #include "omnivert/calib/flow_yaw.hpp"
 #include "omnivert/calib/model.hpp"
 #include "omnivert/calib/track_ids.hpp"
@@ -74,7 +74,7 @@ CalibrationRun split_at_gaps(const CalibrationRun& window_in,
                              const CalibrationOptions& options,
                              std::map<int, int>* gap_origin) {
   std::map<int, int> last;
-  std::vector<std::pair<int, int>> gaps;
+  std::vector<TrackSplit> gaps;
   for (int k = 0; k < static_cast<int>(window_in.frames.size()); ++k)
     for (const BearingObservation& o : window_in.frames[k].observations) {
       const auto it = last.find(o.track_id);
@@ -192,7 +192,7 @@ struct WindowProblem {
 // from the prior's, the same starts are solved at the flow's yaw as well. The flow's own
 // error from pixels is 0.03-0.10 rad on average, 0.21 at most, over 60 runs of the paper's
 // mounting: those runs keep their five starts (test: WindowStarts.CameraYawFromTheBearingsFlow
-// and the rendered window starts of calibrate_cases.cmake).
+// and the rendered runs of CalibrationRegression, tests/pipeline).
 std::vector<Extrinsics> window_starts(const CalibrationOptions& options,
                                       const CalibrationRun& window) {
   constexpr double kFlowYawGap = 0.35;  // rad

@@ -12,8 +12,8 @@
 
 #include "calib/association.hpp"
 #include "calib/batch_problem.hpp"
+#include "calib/filter_state.hpp"
 #include "omnivert/calib/calibration_filter.hpp"
-#include "omnivert/calib/filter_state.hpp"
 #include "omnivert/calib/types.hpp"
 
 namespace omnivert::calib {
@@ -38,18 +38,18 @@ struct BootstrapDetails {
   // never enter the state, and the refinement starts from these. A split track: its latest
   // part.
   std::map<int, TrackEstimate> tracks;
-  std::vector<std::pair<int, int>> splits;  // (tracker's track id, window frame of the new part)
-  std::vector<std::pair<int, int>>
+  std::vector<TrackSplit> splits;  // (tracker's track id, window frame of the new part)
+  std::vector<BearingKey>
       guarded;  // (tracker's track id, window frame) left out
                 // where lines cross (CalibrationOptions::association.crossing_guard)
   // (tracker's track id, window frame) removed as outliers (the gate) or with a feature left
   // without bearings: with `guarded`, what the window's solution did not use.
-  std::vector<std::pair<int, int>> rejected;
+  std::vector<BearingKey> rejected;
   // Pieces of one line joined in the window (find_merges,
   // CalibrationOptions::association.join_pieces): (tracker's id of an earlier piece, of the piece
   // joined to it). The line's feature is in the state under its first piece's id; the filter takes
   // later bearings of any of its pieces for it.
-  std::vector<std::pair<int, int>> joins;
+  std::vector<TrackJoin> joins;
 };
 
 bool bootstrap_filter_state(const CalibrationRun& window,
@@ -78,8 +78,8 @@ struct WindowTracks {
 
 // The tracker's ids of the solved window's tracks and bearings.
 struct WindowIds {
-  std::map<int, int> renamed;                   // every renamed id -> the tracker's
-  std::map<std::pair<int, int>, int> bearings;  // (id, window frame) -> the tracker's id
+  std::map<int, int> renamed;          // every renamed id -> the tracker's
+  std::map<BearingKey, int> bearings;  // (id, window frame) -> the tracker's id
   int tracker_id(int id) const;
   // A joined piece's bearings carry its line's first id in the window, their own in the
   // tracker's run.

@@ -13,7 +13,7 @@
 #include "omnivert/core/error.hpp"
 #include "omnivert/eval/panorama.hpp"
 
-namespace omnivert {
+namespace omnivert::eval {
 
 namespace {
 
@@ -501,4 +501,4 @@ PrPoint rules_operating_point(const std::vector<MatchRecord>& records,
   return p;
 }
 
-}  // namespace omnivert
+}  // namespace omnivert::eval

@@ -7,7 +7,7 @@
 
 #include "omnivert/core/angles.hpp"
 
-namespace omnivert {
+namespace omnivert::eval {
 
 cv::Mat rotate_about(const cv::Mat& image, const Eigen::Vector2d& center, double angle_rad) {
   // getRotationMatrix2D(+t) maps an offset at image angle a to a - t (v points down), so
@@ -71,4 +71,4 @@ std::vector<LinePairing> pair_lines(const FrameFeatures& a,
   return out;
 }
 
-}  // namespace omnivert
+}  // namespace omnivert::eval

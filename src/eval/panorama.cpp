@@ -8,7 +8,7 @@
 
 #include "omnivert/core/angles.hpp"
 
-namespace omnivert {
+namespace omnivert::eval {
 
 double Panorama::column_of_bearing(double bearing) const {
   return wrap_positive(bearing) / kTwoPi * width();
@@ -133,4 +133,4 @@ double zncc(const cv::Mat1f& a, const cv::Mat1f& b) {
   return std::clamp((sab - sa * sb / n) / std::sqrt(va * vb), -1.0, 1.0);
 }
 
-}  // namespace omnivert
+}  // namespace omnivert::eval

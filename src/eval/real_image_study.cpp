@@ -9,7 +9,7 @@
 #include "omnivert/core/angles.hpp"
 #include "omnivert/eval/invariance.hpp"
 
-namespace omnivert {
+namespace omnivert::eval {
 
 bool RealImageStudyOptions::IsValid(std::string* why) const {
   auto fail = [&](const char* m) {
@@ -248,4 +248,4 @@ std::string real_image_csv(const std::vector<RealImageResult>& results) {
   return s.str();
 }
 
-}  // namespace omnivert
+}  // namespace omnivert::eval

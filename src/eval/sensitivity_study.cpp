@@ -10,7 +10,7 @@
 #include "omnivert/match/matcher.hpp"
 #include "omnivert/viz/plot.hpp"
 
-namespace omnivert {
+namespace omnivert::eval {
 
 namespace {
 
@@ -39,16 +39,16 @@ struct StudyOutput {
     write_text_atomic(path(name), s);
   }
   void plot(const std::string& name,
-            const std::vector<PlotSeries>& series,
-            const PlotOptions& o) const {
-    write_image_atomic(path(name), draw_plot(series, o));
+            const std::vector<viz::PlotSeries>& series,
+            const viz::PlotOptions& o) const {
+    write_image_atomic(path(name), viz::draw_plot(series, o));
   }
 };
 
-PlotOptions plot_options(const std::string& title,
-                         const std::string& x_label,
-                         const std::string& y_label) {
-  PlotOptions o;
+viz::PlotOptions plot_options(const std::string& title,
+                              const std::string& x_label,
+                              const std::string& y_label) {
+  viz::PlotOptions o;
   o.title = title;
   o.x_label = x_label;
   o.y_label = y_label;
@@ -90,13 +90,14 @@ void write_score_row(std::ostringstream& o, const Scores& s) {
 }
 
 // The three scores' plot series, and a point of each.
-std::vector<PlotSeries> score_series(const std::string& suffix) {
-  return std::vector<PlotSeries>{{"database NN" + suffix, {}, {}, plot_color(0)},
-                                 {"frame-pair NN" + suffix, {}, {}, plot_color(1)},
-                                 {"frame-pair NN, 1-2 m" + suffix, {}, {}, plot_color(2)}};
+std::vector<viz::PlotSeries> score_series(const std::string& suffix) {
+  return std::vector<viz::PlotSeries>{
+      {"database NN" + suffix, {}, {}, viz::plot_color(0)},
+      {"frame-pair NN" + suffix, {}, {}, viz::plot_color(1)},
+      {"frame-pair NN, 1-2 m" + suffix, {}, {}, viz::plot_color(2)}};
 }
 
-void add_scores(std::vector<PlotSeries>& v, std::size_t at, double x, const Scores& s) {
+void add_scores(std::vector<viz::PlotSeries>& v, std::size_t at, double x, const Scores& s) {
   v[at].x.push_back(x), v[at].y.push_back(s.db.percent());
   v[at + 1].x.push_back(x), v[at + 1].y.push_back(s.pair.percent());
   v[at + 2].x.push_back(x), v[at + 2].y.push_back(s.far.percent());
@@ -130,7 +131,7 @@ void clip_study(const StudySet& set,
         s.ap);
   }
   out.text("sensitivity_clip.csv", cs.str());
-  PlotOptions pc = plot_options(
+  viz::PlotOptions pc = plot_options(
       "Fig. 13: influence of clipping", "clipping threshold", "% correct nearest neighbour");
   pc.vertical_lines = {base.clip};
   pc.vertical_labels = {"default"};
@@ -162,7 +163,7 @@ void noise_study(const StudySet& set,
         s.ap);
   }
   out.text("sensitivity_noise.csv", ns.str());
-  PlotOptions pn = plot_options(
+  viz::PlotOptions pn = plot_options(
       "Fig. 14: influence of image noise", "noise sigma [% of 255]", "% correct nearest neighbour");
   pn.legend_bottom = true;
   out.plot("sensitivity_noise.png", sn, pn);
@@ -176,7 +177,7 @@ void bins_study(const StudySet& set,
   std::ostringstream bs;
   bs << "#bins,areas,size,";
   write_score_header(bs);
-  std::vector<PlotSeries> sb;
+  std::vector<viz::PlotSeries> sb;
   say(report, "Fig. 15, orientation bins x areas\n");
   for (int areas : {3, 5}) {
     auto s3 = score_series(areas == 3 ? ", 3 areas" : ", 5 areas");
@@ -201,7 +202,7 @@ void bins_study(const StudySet& set,
     sb.insert(sb.end(), s3.begin(), s3.end());
   }
   out.text("sensitivity_bins.csv", bs.str());
-  PlotOptions pb = plot_options(
+  viz::PlotOptions pb = plot_options(
       "Fig. 15: orientation bins and areas", "orientation bins", "% correct nearest neighbour");
   pb.legend_bottom = true;
   pb.x_lo = 4, pb.x_hi = 52;  // room on the right for the legend
@@ -263,7 +264,7 @@ void rule_study(const std::vector<MatchRecord>& records,
                 fig[rule - 1],
                 100 * sh.false_removed,
                 100 * sh.correct_lost);
-  PlotOptions po = plot_options(t, names[rule - 1], "probability density");
+  viz::PlotOptions po = plot_options(t, names[rule - 1], "probability density");
   po.x_lo = 0, po.x_hi = hi;
   po.y_lo = 0;
   for (std::size_t i = 0; i < x.size(); ++i)
@@ -274,8 +275,8 @@ void rule_study(const std::vector<MatchRecord>& records,
   label += std::to_string(rule) + " = " + f6(threshold);
   po.vertical_labels = {label};
   out.plot("rule" + std::to_string(rule) + "_pdf.png",
-           {{"correct matches", x, yc, plot_color(2), false},
-            {"incorrect matches", x, yi, plot_color(3), false}},
+           {{"correct matches", x, yc, viz::plot_color(2), false},
+            {"incorrect matches", x, yi, viz::plot_color(3), false}},
            po);
   say(report,
       "  rule %d (F = %.2f): removes %5.1f%% of false matches, loses %5.1f%% of correct ones\n",
@@ -330,4 +331,4 @@ void run_sensitivity_study(const StudySet& set,
   rules_study(set, options, out, report);
 }
 
-}  // namespace omnivert
+}  // namespace omnivert::eval

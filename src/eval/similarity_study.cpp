@@ -5,7 +5,7 @@
 
 #include "omnivert/core/angles.hpp"
 
-namespace omnivert {
+namespace omnivert::eval {
 
 cv::Mat1f descriptor_distance_matrix(const DescriptorMatrix& d) {
   const int n = static_cast<int>(d.rows());
@@ -109,4 +109,4 @@ SimilarityResult similarity_study(const cv::Mat& gray,
   return r;
 }
 
-}  // namespace omnivert
+}  // namespace omnivert::eval

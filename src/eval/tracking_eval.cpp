@@ -10,7 +10,7 @@
 
 #include "omnivert/core/error.hpp"
 
-namespace omnivert {
+namespace omnivert::eval {
 
 bool TrackingEvalOptions::IsValid(std::string* error) const {
   auto fail = [&](const std::string& why) {
@@ -390,4 +390,4 @@ std::string format_tracking_table(const TrackingEvaluation& ev, const std::strin
   return s;
 }
 
-}  // namespace omnivert
+}  // namespace omnivert::eval

@@ -90,8 +90,8 @@ void apply_time_offset(dataset::Dataset& data,
                          std::to_string(offset_s * 1e3) + " ms); their bearings are not used");
 }
 
-calib::ReportInputs::TimeOffset time_offset_report(const CalibrateDatasetResult& r) {
-  calib::ReportInputs::TimeOffset t;
+ReportInputs::TimeOffset time_offset_report(const CalibrateDatasetResult& r) {
+  ReportInputs::TimeOffset t;
   const TimeOffsetEstimate& e = r.time_offset;
   t.given = r.time_offset_given;
   t.determined = e.determined;
@@ -113,12 +113,33 @@ void prepare_out_dir(const std::string& out_dir) {
 
 }  // namespace
 
+bool CalibrateDatasetOptions::IsValid(std::string* why) const {
+  std::string w;
+  const auto fail = [&](const char* group) {
+    if (why) *why = std::string(group) + " options: " + w;
+    return false;
+  };
+  if (!features.IsValid(&w)) return fail("extraction");
+  if (!frames.IsValid(&w)) return fail("frame");
+  TrackerOptions t = tracker;
+  if (t.gate.enabled && t.gate.wheel_base == 0.0) t.gate.wheel_base = 1.0;  // from wheel0/
+  if (!t.IsValid(&w)) return fail("tracker");
+  if (!tilt.IsValid(&w)) return fail("tilt");
+  if (!calibration.IsValid(&w)) return fail("calibration");
+  if (!input.IsValid(&w)) return fail("input");
+  if (!time_offset.IsValid(&w)) return fail("time offset");
+  if (time_offset_s && !std::isfinite(*time_offset_s)) {
+    w = "time_offset_s must be finite [s]";
+    return fail("time offset");
+  }
+  return true;
+}
+
 CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
                                          const std::string& out_dir,
                                          const CalibrateDatasetOptions& o) {
   std::string why;
-  if (!o.features.IsValid(&why)) throw InputError("invalid extraction options: " + why);
-  if (!o.frames.IsValid(&why)) throw InputError("invalid frame options: " + why);
+  if (!o.IsValid(&why)) throw InputError("invalid " + why);
   dataset::LoadOptions lo;
   lo.require_wheel = true;
   lo.allow_missing_images = true;
@@ -128,7 +149,7 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
   // warning, not a reason to refuse the calibration.
   if (!data.ground_truth_error().empty())
     spdlog::warn("ground truth not used: {}", data.ground_truth_error());
-  const calib::CalibrationOptions opt = calib::options_from_dataset(data, o.calibration);
+  const calib::CalibrationOptions opt = options_from_dataset(data, o.calibration);
   if (!opt.IsValid(&why)) throw InputError("invalid calibration options: " + why);
 
   // Read before the output folder is cleared: the tracks file may be out_dir/tracks.csv.
@@ -147,7 +168,7 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
   r.tilt = tracked.tilt;
   r.tilt_corrected = tracked.tilt_corrected;
   write_tracks_csv(out / "tracks.csv", tracked.rows);
-  write_tracks_png(out / "tracks.png", tracked.rows);
+  viz::write_tracks_png(out / "tracks.png", tracked.rows);
   const auto t1 = Clock::now();
   r.frames = tracked.frames;
   r.frames_skipped = tracked.frames_skipped;
@@ -161,7 +182,7 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
     if (r.time_offset.significant(o.time_offset))
       apply_time_offset(data, r.time_offset.offset_s, false, r);
   }
-  r.input = calib::calibration_run_from_tracks(data, tracked.rows, o.input);
+  r.input = calibration_run_from_tracks(data, tracked.rows, o.input);
   r.warnings.insert(r.warnings.end(), r.input.warnings.begin(), r.input.warnings.end());
   if (r.input.tracks < kFewTracks)
     r.warnings.push_back(few_tracks_warning(r.input.tracks, o.features));
@@ -188,10 +209,10 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
   // Step 4: the outputs, each written to a temporary name and renamed.
   calib::write_states_csv((out / "states.csv").string(), result.filter.history);
   std::optional<calib::Extrinsics> refined;
-  if (result.refined && result.refinement.covariance_ok) refined = result.refinement.extrinsics;
+  if (result.source == calib::Estimator::kRefinement) refined = result.refinement.extrinsics;
   write_image_atomic((out / "convergence.png").string(),
-                     calib::draw_convergence(result.filter.history, r.truth, refined));
-  calib::ReportInputs ri;
+                     viz::draw_convergence(result.filter.history, r.truth, refined));
+  ReportInputs ri;
   ri.dataset = dataset_dir;
   ri.command = o.command;
   ri.frames = tracked.frames;
@@ -215,8 +236,8 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
     calib::write_extrinsics_yaml((out / "extrinsics.yaml").string(), result);
     calib::write_robot_formats(out.string(), result.extrinsics, result.covariance, o.frames);
   }
-  write_text_atomic((out / "summary.json").string(), calib::summary_json(result, ri));
-  write_text_atomic((out / "report.html").string(), calib::report_html(result, ri));
+  write_text_atomic((out / "summary.json").string(), summary_json(result, ri));
+  write_text_atomic((out / "report.html").string(), report_html(result, ri));
   return r;
 }
 
@@ -231,7 +252,7 @@ std::string format(const char* fmt, auto... args) {
 std::string truth_lines(const CalibrateDatasetResult& r, bool refined) {
   std::string s;
   auto show = [&](const char* name, const calib::Extrinsics& est, const Eigen::Matrix3d& cov) {
-    const auto er = calib::errors_vs_truth(est, cov, *r.truth);
+    const auto er = errors_vs_truth(est, cov, *r.truth);
     s += format(
         "error vs ground truth (%s): phi %.3f deg, rho %.2f mm, psi %.3f deg, "
         "position %.2f mm, yaw %.3f deg, NEES %.2f\n",
@@ -253,7 +274,7 @@ std::string truth_lines(const CalibrateDatasetResult& r, bool refined) {
 
 std::string CalibrateDatasetResult::BriefReport() const {
   const calib::CalibrationResult& c = calibration;
-  const bool refined = c.refined && c.refinement.covariance_ok;
+  const bool refined = c.source == calib::Estimator::kRefinement;
   const auto& e = c.extrinsics;
   const auto& C = c.covariance;
   const auto& o = c.observability;
@@ -283,11 +304,11 @@ std::string CalibrateDatasetResult::BriefReport() const {
   const std::string noise =
       calib::bearing_noise_text(c.model.bearing_sigma, c.model.track_bias_sigma);
   if (c.noise_check.checked)
-    s += "bearing sigma " + noise + "; " + calib::noise_check_line(c) + "\n";
+    s += "bearing sigma " + noise + "; " + noise_check_line(c) + "\n";
   else
     s += "bearing sigma " + noise + " (no noise check" +
          (noise_check_requested ? ": the run does not determine the extrinsics" : "") + ")\n";
-  if (const std::string w = calib::wheel_check_line(c); !w.empty()) s += w + "\n";
+  if (const std::string w = wheel_check_line(c); !w.empty()) s += w + "\n";
   if (c.refined && c.refinement.num_splits > 0)
     s += format("refinement: %d tracks split where they changed line (summary.json lists them)\n",
                 c.refinement.num_splits);

@@ -8,7 +8,23 @@
 #include "omnivert/calib/model.hpp"
 #include "omnivert/core/error.hpp"
 
-namespace omnivert::calib {
+namespace omnivert::pipeline {
+
+bool DatasetRunOptions::IsValid(std::string* why) const {
+  const auto fail = [&](const char* m) {
+    if (why) *why = m;
+    return false;
+  };
+  if (!(std::isfinite(max_wheel_gap_s) && max_wheel_gap_s > 0.0))
+    return fail("max_wheel_gap_s must be > 0 [s]");
+  if (min_lines < 1) return fail("min_lines must be >= 1");
+  if (!(std::isfinite(max_starved_s) && max_starved_s > 0.0))
+    return fail("max_starved_s must be > 0 [s]");
+  if (min_track_length < 2) return fail("min_track_length must be >= 2");
+  if (!(std::isfinite(crowded_sigma_scale) && crowded_sigma_scale > 0.0))
+    return fail("crowded_sigma_scale must be > 0");
+  return true;
+}
 
 namespace {
 
@@ -43,7 +59,7 @@ void add_frame_motion(const dataset::Dataset& data, DatasetRun& out) {
   const double e = data.wheel_sensor().wheel_base;
   std::vector<Eigen::Vector2d> steps;
   for (std::size_t i = 1; i < n; ++i) {
-    FrameInput& f = out.run.frames[i];
+    calib::FrameInput& f = out.run.frames[i];
     // On the odometry clock: the stamps shifted by the camera-odometry time offset.
     const std::int64_t t0 = data.odometry_time(i - 1), t1 = data.odometry_time(i);
     steps.assign(1, Eigen::Vector2d(travel[i - 1].left, travel[i - 1].right));
@@ -54,7 +70,7 @@ void add_frame_motion(const dataset::Dataset& data, DatasetRun& out) {
         steps.emplace_back(wheel[k].travel.left, wheel[k].travel.right);
     steps.emplace_back(travel[i].left, travel[i].right);
     if (e > 0) {
-      const Eigen::Vector3d m = compose_wheel_steps(steps, e, &f.covariance_per_K);
+      const Eigen::Vector3d m = calib::compose_wheel_steps(steps, e, &f.covariance_per_K);
       f.d_right = m(0);
       f.d_left = m(1);
       f.lateral = m(2);
@@ -240,7 +256,8 @@ DatasetRun calibration_run_from_tracks(const dataset::Dataset& data,
   return out;
 }
 
-CalibrationOptions options_from_dataset(const dataset::Dataset& data, CalibrationOptions base) {
+calib::CalibrationOptions options_from_dataset(const dataset::Dataset& data,
+                                               calib::CalibrationOptions base) {
   if (data.has_wheel()) {
     base.robot.wheel_base = data.wheel_sensor().wheel_base;
     if (data.wheel_sensor().odometry_k) base.robot.odometry_K = *data.wheel_sensor().odometry_k;
@@ -248,4 +265,4 @@ CalibrationOptions options_from_dataset(const dataset::Dataset& data, Calibratio
   return base;
 }
 
-}  // namespace omnivert::calib
+}  // namespace omnivert::pipeline

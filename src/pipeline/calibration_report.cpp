@@ -8,13 +8,14 @@
 #include <Eigen/Cholesky>
 #include <nlohmann/json.hpp>
 
+#include "calib/updater.hpp"  // chi2_quantile
 #include "omnivert/core/angles.hpp"
 
-namespace omnivert::calib {
+namespace omnivert::pipeline {
 
-ErrorsVsTruth errors_vs_truth(const Extrinsics& est,
+ErrorsVsTruth errors_vs_truth(const calib::Extrinsics& est,
                               const Eigen::Matrix3d& C,
-                              const Extrinsics& truth) {
+                              const calib::Extrinsics& truth) {
   ErrorsVsTruth e;
   e.phi = wrap_angle(est.phi - truth.phi);
   e.rho = est.rho - truth.rho;
@@ -42,7 +43,7 @@ using nlohmann::json;
 // A JSON number, or null when it is not finite (JSON has no NaN; we never write one).
 json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
-json extrinsics_json(const Extrinsics& e, const Eigen::Matrix3d& C) {
+json extrinsics_json(const calib::Extrinsics& e, const Eigen::Matrix3d& C) {
   json j;
   j["phi"] = num(e.phi), j["rho"] = num(e.rho), j["psi"] = num(e.psi);
   j["sigma_phi"] = num(std::sqrt(C(0, 0))), j["sigma_rho"] = num(std::sqrt(C(1, 1)));
@@ -67,7 +68,7 @@ json errors_json(const ErrorsVsTruth& e) {
           {"nees", num(e.nees)}};
 }
 
-json verdict_json(const ParameterVerdict& v) {
+json verdict_json(const calib::ParameterVerdict& v) {
   return {{"determined", v.determined}, {"crlb", num(v.crlb)}};
 }
 
@@ -101,13 +102,13 @@ std::string f(const char* format, double v) {
   return b;
 }
 
-const char* verdict_name(NoiseVerdict v) {
+const char* verdict_name(calib::NoiseVerdict v) {
   switch (v) {
-    case NoiseVerdict::kMoreNoise:
+    case calib::NoiseVerdict::kMoreNoise:
       return "more noise";
-    case NoiseVerdict::kLessNoise:
+    case calib::NoiseVerdict::kLessNoise:
       return "less noise";
-    case NoiseVerdict::kAgrees:
+    case calib::NoiseVerdict::kAgrees:
       break;
   }
   return "agrees";
@@ -116,7 +117,7 @@ const char* verdict_name(NoiseVerdict v) {
 }  // namespace
 
 // Track splits as [{"track_id", "frame"}]: the tracker's id and the first frame of the new part.
-nlohmann::json splits_json(const std::vector<std::pair<int, int>>& splits) {
+nlohmann::json splits_json(const std::vector<calib::TrackSplit>& splits) {
   nlohmann::json a = nlohmann::json::array();
   for (const auto& [track, frame] : splits) a.push_back({{"track_id", track}, {"frame", frame}});
   return a;
@@ -124,64 +125,67 @@ nlohmann::json splits_json(const std::vector<std::pair<int, int>>& splits) {
 
 // Pieces of one line joined as [{"track_id", "joined"}]: the earlier piece's id and the joined
 // piece's.
-nlohmann::json joins_json(const std::vector<std::pair<int, int>>& joins) {
+nlohmann::json joins_json(const std::vector<calib::TrackJoin>& joins) {
   nlohmann::json a = nlohmann::json::array();
   for (const auto& [track, joined] : joins) a.push_back({{"track_id", track}, {"joined", joined}});
   return a;
 }
 
-std::string noise_check_line(const CalibrationResult& r) {
+std::string noise_check_line(const calib::CalibrationResult& r) {
   if (!r.noise_check.checked) return {};
   const int g = r.noise_check.check.clusters;
   char verdict[320] = "as the model allows: sigmas kept";
-  if (r.noise_check.verdict == NoiseVerdict::kMoreNoise)
+  if (r.noise_check.verdict == calib::NoiseVerdict::kMoreNoise)
+    std::snprintf(verdict,
+                  sizeof verdict,
+                  "more than the model allows (%s): sigmas scaled by %.2f",
+                  calib::noise_check_chance(
+                      calib::noise_check_limit(g, r.noise_check.level), "more", r.noise_check.level)
+                      .c_str(),
+                  std::sqrt(r.noise_check.ratio));
+  else if (r.noise_check.verdict == calib::NoiseVerdict::kLessNoise && r.noise_check.applied)
     std::snprintf(
         verdict,
         sizeof verdict,
-        "more than the model allows (%s): sigmas scaled by %.2f",
-        noise_check_chance(noise_check_limit(g, r.noise_check.level), "more", r.noise_check.level)
+        "less than the model assumes (%s): sigmas scaled by %.2f; %s would weight the "
+        "bearings so from the start",
+        calib::noise_check_chance(calib::noise_check_lower_limit(g, r.noise_check.lower_level),
+                                  "less",
+                                  r.noise_check.lower_level)
             .c_str(),
-        std::sqrt(r.noise_check.ratio));
-  else if (r.noise_check.verdict == NoiseVerdict::kLessNoise && r.noise_check.applied)
-    std::snprintf(verdict,
-                  sizeof verdict,
-                  "less than the model assumes (%s): sigmas scaled by %.2f; %s would weight the "
-                  "bearings so from the start",
-                  noise_check_chance(noise_check_lower_limit(g, r.noise_check.lower_level),
-                                     "less",
-                                     r.noise_check.lower_level)
-                      .c_str(),
-                  std::sqrt(r.noise_check.ratio),
-                  noise_check_flags(r).c_str());
-  else if (r.noise_check.verdict == NoiseVerdict::kLessNoise)
-    std::snprintf(verdict,
-                  sizeof verdict,
-                  "less than the model assumes (%s): sigmas kept, on the safe side, as %zu pieces "
-                  "of lines were joined (pieces left apart hide noise from this check); %s would "
-                  "weight the bearings as the data say",
-                  noise_check_chance(noise_check_lower_limit(g, r.noise_check.lower_level),
-                                     "less",
-                                     r.noise_check.lower_level)
-                      .c_str(),
-                  r.refined && r.refinement.covariance_ok ? r.refinement.merges.size()
-                                                          : r.filter.joins.size(),
-                  noise_check_flags(r).c_str());
+        std::sqrt(r.noise_check.ratio),
+        calib::noise_check_flags(r).c_str());
+  else if (r.noise_check.verdict == calib::NoiseVerdict::kLessNoise)
+    std::snprintf(
+        verdict,
+        sizeof verdict,
+        "less than the model assumes (%s): sigmas kept, on the safe side, as %zu pieces "
+        "of lines were joined (pieces left apart hide noise from this check); %s would "
+        "weight the bearings as the data say",
+        calib::noise_check_chance(calib::noise_check_lower_limit(g, r.noise_check.lower_level),
+                                  "less",
+                                  r.noise_check.lower_level)
+            .c_str(),
+        r.source == calib::Estimator::kRefinement ? r.refinement.merges.size()
+                                                  : r.filter.joins.size(),
+        calib::noise_check_flags(r).c_str());
   char buf[640];
-  std::snprintf(
-      buf,
-      sizeof(buf),
-      "noise check over %d tracks: the errors along the tracks act as %s of "
-      "%s (variance x%.2f; %s)",
-      r.noise_check.check.clusters,
-      bearing_noise_text(effective_bearing_sigma(r), effective_track_bias_sigma(r)).c_str(),
-      r.model.track_bias_sigma > 0.0 ? "noise" : "independent noise",
-      r.noise_check.check.scale,
-      verdict);
+  std::snprintf(buf,
+                sizeof(buf),
+                "noise check over %d tracks: the errors along the tracks act as %s of "
+                "%s (variance x%.2f; %s)",
+                r.noise_check.check.clusters,
+                calib::bearing_noise_text(calib::effective_bearing_sigma(r),
+                                          calib::effective_track_bias_sigma(r))
+                    .c_str(),
+                r.model.track_bias_sigma > 0.0 ? "noise" : "independent noise",
+                r.noise_check.check.scale,
+                verdict);
   return buf;
 }
 
-std::string wheel_check_line(const CalibrationResult& r) {
-  const WheelCheck& w = wheel_check_of(r);
+std::string wheel_check_line(const calib::CalibrationResult& r) {
+  const calib::WheelCheck& w = calib::wheel_check_of(r);
   if (!w.ok) return {};
   char buf[320];
   std::snprintf(buf,
@@ -194,15 +198,15 @@ std::string wheel_check_line(const CalibrationResult& r) {
                 rad2deg(w.drift_per_m),
                 rad2deg(w.sigma_drift_per_m),
                 w.chi2,
-                chi2_quantile(0.999, 2),
-                wheel_check_rejects_model(w) ? "a systematic wheel error (see the warning)"
-                                             : "as the odometry model allows");
+                calib::chi2_quantile(0.999, 2),
+                calib::wheel_check_rejects_model(w) ? "a systematic wheel error (see the warning)"
+                                                    : "as the odometry model allows");
   return buf;
 }
 
 namespace {
 
-json inputs_json(const CalibrationResult& r, const ReportInputs& in) {
+json inputs_json(const calib::CalibrationResult& r, const ReportInputs& in) {
   json inputs;
   inputs["frames"] = in.frames;
   inputs["frames_skipped"] = in.frames_skipped;
@@ -233,7 +237,7 @@ json inputs_json(const CalibrationResult& r, const ReportInputs& in) {
   return inputs;
 }
 
-json observability_json(const ObservabilityReport& o) {
+json observability_json(const calib::ObservabilityReport& o) {
   return {{"observable", o.all_determined()},
           {"phi", verdict_json(o.phi)},
           {"rho", verdict_json(o.rho)},
@@ -248,7 +252,7 @@ json observability_json(const ObservabilityReport& o) {
           {"message", o.message}};
 }
 
-json filter_json(const FilterResult& f) {
+json filter_json(const calib::FilterResult& f) {
   json j = extrinsics_json(f.extrinsics, f.covariance);
   // Tracks split in the filter's bootstrap window (they slipped onto a neighbouring line).
   j["tracks_split"] = f.splits.size();
@@ -266,7 +270,7 @@ json filter_json(const FilterResult& f) {
   return j;
 }
 
-json refinement_json(const CalibrationResult& r) {
+json refinement_json(const calib::CalibrationResult& r) {
   json ref = extrinsics_json(r.refinement.extrinsics, r.refinement.covariance);
   ref["converged"] = r.refinement.converged;
   ref["covariance_ok"] = r.refinement.covariance_ok;
@@ -286,8 +290,8 @@ json refinement_json(const CalibrationResult& r) {
   return ref;
 }
 
-json noise_check_json(const CalibrationResult& r) {
-  const BatchNoiseCheck& n = r.noise_check.check;
+json noise_check_json(const calib::CalibrationResult& r) {
+  const calib::BatchNoiseCheck& n = r.noise_check.check;
   json nc;
   nc["checked"] = r.noise_check.checked;
   nc["applied"] = r.noise_check.applied;  // the reported covariance is the checked one
@@ -297,11 +301,11 @@ json noise_check_json(const CalibrationResult& r) {
   nc["level_less_noise"] = r.noise_check.lower_level;
   nc["scale"] = num(n.ok ? n.scale : NAN);
   nc["tracks"] = n.clusters;
-  nc["effective_bearing_sigma_deg"] = num(rad2deg(effective_bearing_sigma(r)));
-  nc["effective_track_bias_sigma_deg"] = num(rad2deg(effective_track_bias_sigma(r)));
+  nc["effective_bearing_sigma_deg"] = num(rad2deg(calib::effective_bearing_sigma(r)));
+  nc["effective_track_bias_sigma_deg"] = num(rad2deg(calib::effective_track_bias_sigma(r)));
   nc["variance_ratio"] =
       num(r.noise_check.checked ? r.noise_check.ratio : NAN);  // 1 when not applied
-  nc["of"] = r.refined && r.refinement.covariance_ok ? "refinement" : "filter";
+  nc["of"] = calib::estimator_name(r.source);
   nc["filter_scale"] = num(r.noise_check.filter_check.ok ? r.noise_check.filter_check.scale : NAN);
   nc["filter_variance_ratio"] =
       num(r.noise_check.filter_check.ok ? r.noise_check.filter_ratio : NAN);
@@ -324,7 +328,7 @@ json noise_check_json(const CalibrationResult& r) {
                    : NAN);
   };
   {
-    const WheelCheck& w = wheel_check_of(r);
+    const calib::WheelCheck& w = calib::wheel_check_of(r);
     nc["wheels"] = {{"checked", w.ok},
                     {"frames", w.frames},
                     {"rotation_scale", num(w.ok ? w.rotation_scale : NAN)},
@@ -332,7 +336,7 @@ json noise_check_json(const CalibrationResult& r) {
                     {"drift_deg_per_m", num(w.ok ? rad2deg(w.drift_per_m) : NAN)},
                     {"sigma_drift_deg_per_m", num(w.ok ? rad2deg(w.sigma_drift_per_m) : NAN)},
                     {"chi2", num(w.ok ? w.chi2 : NAN)},
-                    {"rejects_model", wheel_check_rejects_model(w)}};
+                    {"rejects_model", calib::wheel_check_rejects_model(w)}};
   }
   nc["crlb_checked"] = {{"phi", checked(r.observability.phi.crlb, 0)},
                         {"rho", checked(r.observability.rho.crlb, 1)},
@@ -342,7 +346,7 @@ json noise_check_json(const CalibrationResult& r) {
 
 }  // namespace
 
-std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
+std::string summary_json(const calib::CalibrationResult& r, const ReportInputs& in) {
   json j;
   j["tool"] = "omnivert calibrate";
   j["dataset"] = in.dataset;
@@ -356,14 +360,14 @@ std::string summary_json(const CalibrationResult& r, const ReportInputs& in) {
   if (r.refined) j["refinement"] = refinement_json(r);
   j["noise_check"] = noise_check_json(r);
   j["result"] = extrinsics_json(r.extrinsics, r.covariance);
-  j["result"]["source"] = r.refined && r.refinement.covariance_ok ? "refinement" : "filter";
+  j["result"]["source"] = calib::estimator_name(r.source);
   if (in.truth) {
     j["ground_truth"] = {
         {"phi", num(in.truth->phi)}, {"rho", num(in.truth->rho)}, {"psi", num(in.truth->psi)}};
     json err;
     err["filter"] =
         errors_json(errors_vs_truth(r.filter.extrinsics, r.filter.covariance, *in.truth));
-    if (r.refined && r.refinement.covariance_ok)
+    if (r.source == calib::Estimator::kRefinement)
       err["refinement"] =
           errors_json(errors_vs_truth(r.refinement.extrinsics, r.refinement.covariance, *in.truth));
     j["errors_vs_ground_truth"] = err;
@@ -389,12 +393,14 @@ namespace {
 
 // The estimates (prior, filter, refinement, truth), the run's Cramer-Rao bounds, and the
 // errors against the truth when known.
-void html_estimates(std::ostringstream& h, const CalibrationResult& r, const ReportInputs& in) {
-  const ObservabilityReport& o = r.observability;
+void html_estimates(std::ostringstream& h,
+                    const calib::CalibrationResult& r,
+                    const ReportInputs& in) {
+  const calib::ObservabilityReport& o = r.observability;
   h << "<h2>Estimates</h2>\n<table><tr><th></th><th>phi [deg]</th><th>rho [mm]</th><th>psi "
        "[deg]</th>"
        "<th>camera x [mm]</th><th>camera y [mm]</th><th>camera yaw [deg]</th></tr>\n";
-  auto row = [&](const std::string& name, const Extrinsics& e, const Eigen::Matrix3d* C) {
+  auto row = [&](const std::string& name, const calib::Extrinsics& e, const Eigen::Matrix3d* C) {
     const Eigen::Vector2d p = e.position();
     h << "<tr><td>" << name << "</td><td>" << f("%.3f", rad2deg(e.phi));
     if (C) h << " &plusmn; " << f("%.3f", rad2deg(std::sqrt((*C)(0, 0))));
@@ -407,7 +413,7 @@ void html_estimates(std::ostringstream& h, const CalibrationResult& r, const Rep
   };
   row("prior (hand measurement)", in.options.prior.mean, nullptr);
   row("filter (Sec. 8.2)", r.filter.extrinsics, &r.filter.covariance);
-  if (r.refined && r.refinement.covariance_ok)
+  if (r.source == calib::Estimator::kRefinement)
     row("batch refinement (--refine)", r.refinement.extrinsics, &r.refinement.covariance);
   if (in.truth) row("ground truth", *in.truth, nullptr);
   h << "</table>\n";
@@ -429,7 +435,7 @@ void html_estimates(std::ostringstream& h, const CalibrationResult& r, const Rep
         << f("%.2f", e.nees) << "</td></tr>\n";
     };
     erow("filter", errors_vs_truth(r.filter.extrinsics, r.filter.covariance, *in.truth));
-    if (r.refined && r.refinement.covariance_ok)
+    if (r.source == calib::Estimator::kRefinement)
       erow("refinement",
            errors_vs_truth(r.refinement.extrinsics, r.refinement.covariance, *in.truth));
     h << "</table>\n";
@@ -437,7 +443,7 @@ void html_estimates(std::ostringstream& h, const CalibrationResult& r, const Rep
 }
 
 // The run's inputs and what each stage did with them.
-void html_inputs(std::ostringstream& h, const CalibrationResult& r, const ReportInputs& in) {
+void html_inputs(std::ostringstream& h, const calib::CalibrationResult& r, const ReportInputs& in) {
   h << "<h2>Inputs</h2>\n<table>\n";
   auto kv = [&](const std::string& k, const std::string& v) {
     h << "<tr><td>" << k << "</td><td>" << html_escape(v) << "</td></tr>\n";
@@ -460,7 +466,7 @@ void html_inputs(std::ostringstream& h, const CalibrationResult& r, const Report
   kv("wheel base e / Chong-Kleeman K (x inflation)",
      f("%.4f m", in.options.robot.wheel_base) + " / " + f("%.3g m", in.options.robot.odometry_K) +
          " (x" + f("%g", in.options.filter.odometry_inflation) + ")");
-  kv("bearing sigma", bearing_noise_text(r.model.bearing_sigma, r.model.track_bias_sigma));
+  kv("bearing sigma", calib::bearing_noise_text(r.model.bearing_sigma, r.model.track_bias_sigma));
   kv("noise check", r.noise_check.checked ? noise_check_line(r) : std::string("not made"));
   {
     const std::string w = wheel_check_line(r);
@@ -496,9 +502,9 @@ void html_inputs(std::ostringstream& h, const CalibrationResult& r, const Report
 
 }  // namespace
 
-std::string report_html(const CalibrationResult& r, const ReportInputs& in) {
+std::string report_html(const calib::CalibrationResult& r, const ReportInputs& in) {
   std::ostringstream h;
-  const ObservabilityReport& o = r.observability;
+  const calib::ObservabilityReport& o = r.observability;
   h << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>omnivert calibrate: "
     << html_escape(in.dataset)
     << "</title>\n<style>body{font-family:sans-serif;max-width:1700px;"
@@ -533,4 +539,4 @@ std::string report_html(const CalibrationResult& r, const ReportInputs& in) {
   return h.str();
 }
 
-}  // namespace omnivert::calib
+}  // namespace omnivert::pipeline

@@ -6,7 +6,7 @@
 #include "core/parallel.hpp"
 #include "omnivert/core/error.hpp"
 
-namespace omnivert {
+namespace omnivert::pipeline {
 
 namespace {
 // Frames per thread in a block: enough to keep the threads busy between the serial steps,
@@ -81,4 +81,4 @@ void FrameSource::fill() {
   });
 }
 
-}  // namespace omnivert
+}  // namespace omnivert::pipeline

@@ -14,7 +14,7 @@
 #include "omnivert/dataset/dataset.hpp"
 #include "omnivert/describe/feature_pipeline.hpp"
 
-namespace omnivert {
+namespace omnivert::pipeline {
 
 class FrameSource {
  public:
@@ -47,4 +47,4 @@ class FrameSource {
   std::size_t pos_ = 0;    // next frame of the block to hand out
 };
 
-}  // namespace omnivert
+}  // namespace omnivert::pipeline

@@ -4,7 +4,7 @@
 
 #include "omnivert/core/error.hpp"
 
-namespace omnivert {
+namespace omnivert::pipeline {
 
 bool TiltCheckOptions::IsValid(std::string* why) const {
   if (frames < 1 || !(correct_deg >= 0.0) || !(lateral_tolerance_px > 0.0)) {
@@ -49,4 +49,4 @@ std::string tilt_warning(const TiltEstimate& tilt,
          " (docs/extraction.md, \"Tilt\")";
 }
 
-}  // namespace omnivert
+}  // namespace omnivert::pipeline

@@ -11,6 +11,23 @@
 
 namespace omnivert::pipeline {
 
+bool TimeOffsetOptions::IsValid(std::string* why) const {
+  const auto fail = [&](const char* m) {
+    if (why) *why = m;
+    return false;
+  };
+  const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  const auto non_negative = [](double v) { return std::isfinite(v) && v >= 0.0; };
+  if (!positive(max_offset_s) || !positive(step_s) || step_s > max_offset_s)
+    return fail("max_offset_s and step_s must be > 0 [s], step_s at most max_offset_s");
+  if (min_common_tracks < 1 || min_pairs < 1)
+    return fail("min_common_tracks and min_pairs must be >= 1");
+  if (!positive(max_sigma_s)) return fail("max_sigma_s must be > 0 [s]");
+  if (!non_negative(min_rise) || !non_negative(significance) || !non_negative(min_applied_s))
+    return fail("min_rise, significance and min_applied_s must be >= 0");
+  return true;
+}
+
 namespace {
 
 // theta_w(t): the wheels' heading, linear between samples, held beyond the ends.

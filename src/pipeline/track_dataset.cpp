@@ -6,7 +6,7 @@
 #include "omnivert/core/error.hpp"
 #include "pipeline/frame_source.hpp"
 
-namespace omnivert {
+namespace omnivert::pipeline {
 
 TrackDatasetResult track_dataset(const dataset::Dataset& data,
                                  const TrackDatasetOptions& options,
@@ -106,4 +106,4 @@ TrackDatasetResult read_tracks_for_dataset(const std::string& file, const datase
   return t;
 }
 
-}  // namespace omnivert
+}  // namespace omnivert::pipeline

@@ -7,11 +7,11 @@
 #include "omnivert/core/angles.hpp"
 #include "omnivert/viz/plot.hpp"
 
-namespace omnivert::calib {
+namespace omnivert::viz {
 
-cv::Mat draw_convergence(const std::vector<FrameEstimate>& history,
-                         const std::optional<Extrinsics>& truth,
-                         const std::optional<Extrinsics>& refined) {
+cv::Mat draw_convergence(const std::vector<calib::FrameEstimate>& history,
+                         const std::optional<calib::Extrinsics>& truth,
+                         const std::optional<calib::Extrinsics>& refined) {
   // Units shown: degrees for the angles, millimetres for rho.
   const double scale[3] = {rad2deg(1.0), 1000.0, rad2deg(1.0)};
   const char* names[3] = {"phi [deg]", "rho [mm]", "psi [deg]"};
@@ -20,7 +20,7 @@ cv::Mat draw_convergence(const std::vector<FrameEstimate>& history,
   // The first frame with an estimate of its own: while the delayed initialisation's window is
   // open (Options::bootstrap_rotation) the filter holds the prior.
   int start_frame = -1;
-  for (const FrameEstimate& h : history)
+  for (const calib::FrameEstimate& h : history)
     if (!history.empty() && h.covariance(0, 0) < 0.99 * history.front().covariance(0, 0)) {
       start_frame = h.frame;
       break;
@@ -31,7 +31,7 @@ cv::Mat draw_convergence(const std::vector<FrameEstimate>& history,
     PlotSeries lo{"-3 sigma", {}, {}, plot_color(0), false, true};
     PlotSeries sig{"sigma", {}, {}, plot_color(1), false, false};
     double vmin = std::numeric_limits<double>::infinity(), vmax = -vmin;
-    for (const FrameEstimate& h : history) {
+    for (const calib::FrameEstimate& h : history) {
       const double v = h.extrinsics.vec()(k) * scale[k];
       const double s = std::sqrt(std::max(h.covariance(k, k), 0.0)) * scale[k];
       if (!std::isfinite(v) || !std::isfinite(s)) continue;
@@ -89,4 +89,4 @@ cv::Mat draw_convergence(const std::vector<FrameEstimate>& history,
   return out;
 }
 
-}  // namespace omnivert::calib
+}  // namespace omnivert::viz

@@ -7,7 +7,7 @@
 
 #include "omnivert/describe/feature_pipeline.hpp"
 
-namespace omnivert {
+namespace omnivert::viz {
 
 cv::Mat draw_overlay(const cv::Mat& image,
                      const FrameFeatures& f,
@@ -155,4 +155,4 @@ cv::Mat draw_camera_overlay(const cv::Mat& image, const CameraEstimate& e) {
   return bgr;
 }
 
-}  // namespace omnivert
+}  // namespace omnivert::viz

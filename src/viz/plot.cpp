@@ -7,7 +7,7 @@
 
 #include <opencv2/imgproc.hpp>
 
-namespace omnivert {
+namespace omnivert::viz {
 
 namespace {
 
@@ -321,4 +321,4 @@ cv::Mat draw_plot(const std::vector<PlotSeries>& series_in, const PlotOptions& o
   return img;
 }
 
-}  // namespace omnivert
+}  // namespace omnivert::viz

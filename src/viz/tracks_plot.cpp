@@ -12,7 +12,7 @@
 #include "omnivert/core/error.hpp"
 #include "omnivert/image/image_io.hpp"
 
-namespace omnivert {
+namespace omnivert::viz {
 
 namespace fs = std::filesystem;
 
@@ -240,4 +240,4 @@ void write_tracks_png(const fs::path& path,
   write_image_atomic(path.string(), draw_tracks(rows, options));
 }
 
-}  // namespace omnivert
+}  // namespace omnivert::viz

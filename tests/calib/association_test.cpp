@@ -14,8 +14,8 @@
 
 #include <Eigen/Dense>
 
+#include "calib/batch_point.hpp"
 #include "calib/synthetic_run.hpp"
-#include "omnivert/calib/batch_point.hpp"
 #include "omnivert/calib/calibrate.hpp"
 #include "omnivert/calib/calibration_filter.hpp"
 #include "omnivert/calib/model.hpp"
@@ -193,7 +193,7 @@ TEST(CrossingGuard, MergedDetectionsAreLeftOutAndDoNotMoveTheEstimate) {
         it->second.second = static_cast<int>(k);
       }
     const double guard = AssociationOptions{}.crossing_guard, tol = deg2rad(0.2);
-    const std::set<std::pair<int, int>> left_out(on.guarded.begin(), on.guarded.end());
+    const std::set<BearingKey> left_out(on.guarded.begin(), on.guarded.end());
     int wrong = 0;
     for (std::size_t k = 0; k < run.run.frames.size(); ++k)
       for (const BearingObservation& ob : run.run.frames[k].observations) {
@@ -288,7 +288,7 @@ TEST(CrossingGuard, BeforeATrackStartsBesideAnother) {
   }
   CalibrationOptions o;
   ASSERT_NEAR(o.association.crossing_guard, deg2rad(0.75), 1e-12);
-  std::map<std::pair<int, int>, int> expected;  // (track, frame) -> where the other starts
+  std::map<BearingKey, int> expected;  // (track, frame) -> where the other starts
   for (int k = 10; k <= 19; ++k) expected[{1, k}] = 20;
   EXPECT_EQ(guard_before_starts(run, o), expected);
   o.association.crossing_guard = 0.0;  // the guard off: nothing

@@ -11,8 +11,8 @@
 #include <Eigen/Dense>
 #include <string>
 
+#include "calib/batch_point.hpp"
 #include "calib/synthetic_run.hpp"
-#include "omnivert/calib/batch_point.hpp"
 #include "omnivert/calib/calibrate.hpp"
 #include "omnivert/calib/diagnostics.hpp"
 #include "omnivert/calib/refinement.hpp"
@@ -334,9 +334,10 @@ TEST(NoiseCheck, FindsBearingsLessNoisyThanAssumed) {
       EXPECT_LT(r.noise_check.check.scale,
                 noise_check_lower_limit(r.noise_check.check.clusters, r.noise_check.lower_level));
       EXPECT_TRUE(r.noise_check.applied);
-      EXPECT_NE(noise_check_line(r).find("less than the model assumes"), std::string::npos);
-      EXPECT_NE(noise_check_line(r).find("sigmas scaled by"), std::string::npos);
-      EXPECT_NE(noise_check_line(r).find("--bearing-sigma"), std::string::npos);
+      EXPECT_NE(pipeline::noise_check_line(r).find("less than the model assumes"),
+                std::string::npos);
+      EXPECT_NE(pipeline::noise_check_line(r).find("sigmas scaled by"), std::string::npos);
+      EXPECT_NE(pipeline::noise_check_line(r).find("--bearing-sigma"), std::string::npos);
       // The bearings' share only: the yaw's variance shrinks, and the whole stays positive
       // definite.
       EXPECT_LT(r.refinement.covariance(0, 0) + r.refinement.covariance(2, 2) +
@@ -367,7 +368,8 @@ TEST(NoiseCheck, FindsBearingsLessNoisyThanAssumed) {
                 0.5 * b.noise_check.check.clusters);
       kept_broken += !b.noise_check.applied &&
                      b.refinement.covariance == b.noise_check.refinement_model_covariance;
-      EXPECT_NE(noise_check_line(b).find("pieces of lines were joined"), std::string::npos);
+      EXPECT_NE(pipeline::noise_check_line(b).find("pieces of lines were joined"),
+                std::string::npos);
     }
   }
   scale /= runs;

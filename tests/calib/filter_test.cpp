@@ -10,16 +10,16 @@
 #include <map>
 #include <set>
 
+#include "calib/batch_point.hpp"
+#include "calib/feature_initializer.hpp"
 #include "calib/synthetic_run.hpp"
-#include "omnivert/calib/batch_point.hpp"
+#include "calib/updater.hpp"
 #include "omnivert/calib/calibrate.hpp"
 #include "omnivert/calib/calibration_filter.hpp"
-#include "omnivert/calib/feature_initializer.hpp"
 #include "omnivert/calib/model.hpp"
 #include "omnivert/calib/observability.hpp"
 #include "omnivert/calib/refinement.hpp"
 #include "omnivert/calib/track_ids.hpp"
-#include "omnivert/calib/updater.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
 #include "synthetic_support.hpp"
@@ -264,7 +264,7 @@ TEST(CalibrationFilter, TracksEnterAndLeave) {
   }
   f.finish();
   EXPECT_LE(max_features, so.num_features);  // ended tracks were marginalised
-  EXPECT_LE(f.state().num_features(), so.num_features);
+  EXPECT_LE(f.num_features(), so.num_features);
   const Eigen::Vector3d e = error(f.extrinsics(), run.truth);
   const Eigen::Matrix3d C = f.covariance();
   for (int i = 0; i < 3; ++i) EXPECT_LT(std::abs(e(i)), 4.0 * std::sqrt(C(i, i))) << i;
@@ -316,20 +316,20 @@ TEST(CalibrationFilter, RefusedBearingsAreListedAndLeftOutOfTheBound) {
   so.seed = 2;
   SyntheticRun run = make_synthetic_run(so);
   const CalibrationOptions o = options_for(so);
-  std::set<std::pair<int, int>> planted;
+  std::set<BearingKey> planted;
   for (std::size_t k = 5; k < run.run.frames.size(); k += 11) {
     auto& obs = run.run.frames[k].observations;
     if (obs.size() < 2) continue;
     obs[1].beta += deg2rad(3.0);
-    planted.emplace(obs[1].track_id, static_cast<int>(k));
+    planted.insert({obs[1].track_id, static_cast<int>(k)});
   }
   const CalibrationResult r = calibrate(run.run, o);
   ASSERT_GT(r.filter.window_frames, 0);
-  const std::set<std::pair<int, int>> refused(r.filter.rejected.begin(), r.filter.rejected.end());
+  const std::set<BearingKey> refused(r.filter.rejected.begin(), r.filter.rejected.end());
   int in_window = 0, after = 0;
   for (const auto& key : planted) {
-    EXPECT_TRUE(refused.count(key)) << "track " << key.first << ", frame " << key.second;
-    ++(key.second < r.filter.window_frames ? in_window : after);
+    EXPECT_TRUE(refused.count(key)) << "track " << key.track << ", frame " << key.frame;
+    ++(key.frame < r.filter.window_frames ? in_window : after);
   }
   EXPECT_GE(in_window, 3);
   EXPECT_GE(after, 1);
@@ -339,7 +339,7 @@ TEST(CalibrationFilter, RefusedBearingsAreListedAndLeftOutOfTheBound) {
   EXPECT_EQ(counted, static_cast<int>(r.filter.rejected.size()));
   // The bound: that of the run without the refused and guarded bearings.
   CalibrationRun used = run.run;
-  std::set<std::pair<int, int>> out = refused;
+  std::set<BearingKey> out = refused;
   out.insert(r.filter.guarded.begin(), r.filter.guarded.end());
   for (std::size_t k = 0; k < used.frames.size(); ++k) {
     auto& obs = used.frames[k].observations;
@@ -415,7 +415,7 @@ TEST(CalibrationFilter, ATrackFoundAgainUnderANewIdContinuesItsFeature) {
   // (Of the 10 lines seen at `from`, 8 are joined. Tracks 7 and 9 are two lines within the
   // crossing guard of each other from there to the end: each new id has both features as
   // candidates, so neither is joined, and their 14 bearings each are guarded either way.)
-  std::set<std::pair<int, int>> got(joined.joins.begin(), joined.joins.end());
+  std::set<TrackJoin> got(joined.joins.begin(), joined.joins.end());
   for (const auto& [a, c] : got) EXPECT_EQ(new_id.at(a), c);
   EXPECT_GE(got.size(), new_id.size() - 2);
   EXPECT_EQ(joined.extrinsics.phi, whole.extrinsics.phi);
@@ -465,7 +465,7 @@ TEST(CalibrationFilter, AJoinedTrackThatComesBackAfterItsFeatureLeftIsOneFeature
     for (int j = std::max(0, k - o.association.max_missed_frames); j <= k; ++j)
       for (const BearingObservation& b : renamed.frames[static_cast<std::size_t>(j)].observations)
         live.insert(b.track_id);
-    ASSERT_LE(filter.state().num_features(), static_cast<int>(live.size())) << "frame " << k;
+    ASSERT_LE(filter.num_features(), static_cast<int>(live.size())) << "frame " << k;
   }
   filter.finish();
   EXPECT_GE(filter.joins().size(), 5u);  // the renamed tracks were joined at `from`

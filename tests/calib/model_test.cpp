@@ -8,8 +8,8 @@
 #include <random>
 #include <set>
 
+#include "calib/propagator.hpp"
 #include "omnivert/calib/model.hpp"
-#include "omnivert/calib/propagator.hpp"
 #include "omnivert/core/angles.hpp"
 
 namespace omnivert::calib {

@@ -4,8 +4,8 @@
 
 #include <cmath>
 
+#include "calib/batch_point.hpp"
 #include "calib/synthetic_run.hpp"
-#include "omnivert/calib/batch_point.hpp"
 #include "omnivert/calib/calibrate.hpp"
 #include "omnivert/calib/observability.hpp"
 #include "omnivert/calib/refinement.hpp"

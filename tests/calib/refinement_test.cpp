@@ -11,8 +11,8 @@
 
 #include <Eigen/Dense>
 
+#include "calib/batch_point.hpp"
 #include "calib/synthetic_run.hpp"
-#include "omnivert/calib/batch_point.hpp"
 #include "omnivert/calib/calibrate.hpp"
 #include "omnivert/calib/refinement.hpp"
 #include "omnivert/core/angles.hpp"

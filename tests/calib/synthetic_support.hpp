@@ -4,8 +4,8 @@
 #include <Eigen/Cholesky>
 #include <cmath>
 
+#include "calib/batch_point.hpp"
 #include "calib/synthetic_run.hpp"
-#include "omnivert/calib/batch_point.hpp"
 #include "omnivert/calib/model.hpp"
 #include "omnivert/calib/refinement.hpp"
 #include "omnivert/core/angles.hpp"

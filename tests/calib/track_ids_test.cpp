@@ -10,8 +10,8 @@
 
 #include <Eigen/Dense>
 
+#include "calib/batch_point.hpp"
 #include "calib/synthetic_run.hpp"
-#include "omnivert/calib/batch_point.hpp"
 #include "omnivert/calib/refinement.hpp"
 #include "omnivert/calib/track_ids.hpp"
 #include "omnivert/core/angles.hpp"

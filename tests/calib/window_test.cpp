@@ -12,15 +12,15 @@
 #include <Eigen/Dense>
 #include <string>
 
+#include "calib/batch_point.hpp"
 #include "calib/synthetic_run.hpp"
+#include "calib/updater.hpp"
 #include "calib/window.hpp"
-#include "omnivert/calib/batch_point.hpp"
 #include "omnivert/calib/calibrate.hpp"
 #include "omnivert/calib/calibration_filter.hpp"
 #include "omnivert/calib/flow_yaw.hpp"
 #include "omnivert/calib/model.hpp"
 #include "omnivert/calib/refinement.hpp"
-#include "omnivert/calib/updater.hpp"
 #include "omnivert/core/angles.hpp"
 #include "synthetic_support.hpp"
 

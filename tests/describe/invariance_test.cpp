@@ -52,7 +52,7 @@ TEST(Invariance, RotatedSceneGivesTheSameLinesShiftedAndTheSameDescriptors) {
       orot.noise_seed = 77 + seed;
       const FrameFeatures f1 = features_of(sim::draw_radial_pattern(orot).image, g);
       EXPECT_EQ(f1.lines.size(), f0.lines.size()) << "seed " << seed << " rotation " << deg;
-      const auto pr = pair_lines(f0, f1, deg2rad(deg), deg2rad(0.5));
+      const auto pr = eval::pair_lines(f0, f1, deg2rad(deg), deg2rad(0.5));
       EXPECT_EQ(pr.size(), f0.lines.size());
       for (const auto& p : pr) {
         ++pairs;
@@ -85,8 +85,8 @@ TEST(Invariance, GainAndGammaChangeDescriptorsLittle) {
     const FrameFeatures f0 = features_of(img, g);
     for (double gain : {0.6, 0.8, 1.25, 1.5}) {
       for (double gamma : {0.7, 1.0, 1.4}) {
-        const FrameFeatures f1 = features_of(relight(img, gain, gamma), g);
-        for (const auto& pr : pair_lines(f0, f1, 0.0, deg2rad(0.3))) {
+        const FrameFeatures f1 = features_of(eval::relight(img, gain, gamma), g);
+        for (const auto& pr : eval::pair_lines(f0, f1, 0.0, deg2rad(0.3))) {
           ++pairs;
           worst = std::max(worst, pr.descriptor_distance);
         }
@@ -127,9 +127,9 @@ TEST_P(RealImages, CentreLinesAndInvariances) {
   CameraGeometry geo;
   geo.center = probe.circle.center;
   geo.r_min = probe.circle.r_min;
-  geo.r_max =
-      std::min(probe.circle.r_max,
-               rotation_safe_r_max(probe.circle.center, gray.cols, gray.rows, probe.circle.r_min));
+  geo.r_max = std::min(
+      probe.circle.r_max,
+      eval::rotation_safe_r_max(probe.circle.center, gray.cols, gray.rows, probe.circle.r_min));
   const FrameFeatures f0 = features_of(img, geo, po);
   ASSERT_GE(f0.lines.size(), 2u);
 
@@ -137,8 +137,8 @@ TEST_P(RealImages, CentreLinesAndInvariances) {
   int found = 0, expected = 0;
   for (double deg : {17.0, 71.0, 199.0}) {
     const FrameFeatures f1 =
-        features_of(rotate_about(img, f0.circle.center, deg2rad(deg)), geo, po);
-    const auto pr = pair_lines(f0, f1, deg2rad(deg), deg2rad(0.3));
+        features_of(eval::rotate_about(img, f0.circle.center, deg2rad(deg)), geo, po);
+    const auto pr = eval::pair_lines(f0, f1, deg2rad(deg), deg2rad(0.3));
     expected += static_cast<int>(f0.lines.size());
     found += static_cast<int>(pr.size());
     for (const auto& p : pr) {
@@ -148,8 +148,8 @@ TEST_P(RealImages, CentreLinesAndInvariances) {
   }
   for (double gain : {0.6, 0.8}) {
     for (double gamma : {0.7, 1.4}) {
-      const FrameFeatures f1 = features_of(relight(img, gain, gamma), geo, po);
-      for (const auto& p : pair_lines(f0, f1, 0.0, deg2rad(0.3)))
+      const FrameFeatures f1 = features_of(eval::relight(img, gain, gamma), geo, po);
+      for (const auto& p : eval::pair_lines(f0, f1, 0.0, deg2rad(0.3)))
         light_dist.push_back(p.descriptor_distance);
     }
   }

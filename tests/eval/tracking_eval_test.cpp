@@ -18,8 +18,8 @@ TrackRow det(std::int64_t frame, std::int64_t id, double bearing, std::int64_t m
   return r;
 }
 
-GroundTruthLine gt(std::int64_t frame, std::int64_t id, double bearing, double len = 90.0) {
-  GroundTruthLine g;
+eval::GroundTruthLine gt(std::int64_t frame, std::int64_t id, double bearing, double len = 90.0) {
+  eval::GroundTruthLine g;
   g.frame = frame;
   g.line_id = id;
   g.bearing = bearing;
@@ -28,8 +28,8 @@ GroundTruthLine gt(std::int64_t frame, std::int64_t id, double bearing, double l
   return g;
 }
 
-TrackingEvalOptions options() {
-  TrackingEvalOptions o;
+eval::TrackingEvalOptions options() {
+  eval::TrackingEvalOptions o;
   o.annulus_r_min = 0.0;
   o.annulus_r_max = 100.0;
   return o;
@@ -39,7 +39,7 @@ TrackingEvalOptions options() {
 // match (track 0 jumps from A to B), one false new entry (track 2 restarts A two frames after
 // its last detection), and a clutter track (unverified link).
 struct Case {
-  std::vector<GroundTruthLine> truth;
+  std::vector<eval::GroundTruthLine> truth;
   std::vector<TrackRow> tracks;
 };
 
@@ -66,18 +66,18 @@ Case hand_built() {
 
 TEST(TrackingEval, OptionsValidation) {
   std::string error;
-  EXPECT_FALSE(TrackingEvalOptions{}.IsValid(&error));  // the annulus is required
+  EXPECT_FALSE(eval::TrackingEvalOptions{}.IsValid(&error));  // the annulus is required
   EXPECT_NE(error.find("annulus"), std::string::npos);
   EXPECT_TRUE(options().IsValid(&error));
-  TrackingEvalOptions o = options();
+  eval::TrackingEvalOptions o = options();
   o.association_tolerance = 0.0;
   EXPECT_FALSE(o.IsValid(&error));
 }
 
 TEST(TrackingEval, HandBuiltCounts) {
   const Case c = hand_built();
-  TrackingEvalOptions o = options();
-  const TrackingEvaluation ev = evaluate_tracking(c.tracks, c.truth, o);
+  eval::TrackingEvalOptions o = options();
+  const eval::TrackingEvaluation ev = eval::evaluate_tracking(c.tracks, c.truth, o);
   EXPECT_EQ(ev.total.matches, 6);
   EXPECT_EQ(ev.total.correct, 4);
   EXPECT_EQ(ev.total.false_matches, 1);
@@ -108,7 +108,7 @@ TEST(TrackingEval, HandBuiltCounts) {
 // lines are within the tolerance either could be the one followed), but its three detections
 // on A are off its majority line (B: five detections).
 TEST(TrackingEval, SlipOntoACloseLineCountsEveryDetectionAfterIt) {
-  std::vector<GroundTruthLine> truth;
+  std::vector<eval::GroundTruthLine> truth;
   std::vector<TrackRow> tracks;
   for (int f = 0; f < 8; ++f) {
     const double b = 0.002 + 0.004 * f;  // B drifts away from A at 0
@@ -116,19 +116,19 @@ TEST(TrackingEval, SlipOntoACloseLineCountsEveryDetectionAfterIt) {
     truth.push_back(gt(f, 2, b));
     tracks.push_back(det(f, 7, f < 3 ? 0.0 : b, f > 0 ? f - 1 : -1));
   }
-  const TrackingEvaluation ev = evaluate_tracking(tracks, truth, options());
+  const eval::TrackingEvaluation ev = eval::evaluate_tracking(tracks, truth, options());
   EXPECT_EQ(ev.total.matches, 7);
   EXPECT_EQ(ev.total.false_matches, 0);
   EXPECT_EQ(ev.total.correct, 7);
   EXPECT_EQ(ev.off_majority_detections, 3);
-  EXPECT_NE(format_tracking_table(ev).find("majority world line: 3"), std::string::npos);
+  EXPECT_NE(eval::format_tracking_table(ev).find("majority world line: 3"), std::string::npos);
 }
 
 TEST(TrackingEval, PerIntervalRows) {
   const Case c = hand_built();
-  TrackingEvalOptions o = options();
+  eval::TrackingEvalOptions o = options();
   o.interval = 2;
-  const TrackingEvaluation ev = evaluate_tracking(c.tracks, c.truth, o);
+  const eval::TrackingEvaluation ev = eval::evaluate_tracking(c.tracks, c.truth, o);
   ASSERT_EQ(ev.intervals.size(), 3u);
   EXPECT_EQ(ev.intervals[0].first_frame, 0);
   EXPECT_EQ(ev.intervals[2].end_frame, 5);
@@ -141,7 +141,7 @@ TEST(TrackingEval, PerIntervalRows) {
   EXPECT_EQ(ev.intervals[2].matches, 0);
   EXPECT_EQ(ev.intervals[2].false_new_entries, 1);
   EXPECT_NEAR(ev.intervals[2].percent_false_new_entries(), 100.0, 1e-9);
-  const std::string table = format_tracking_table(ev);
+  const std::string table = eval::format_tracking_table(ev);
   EXPECT_NE(table.find("0-2"), std::string::npos);
   EXPECT_NE(table.find("4-5"), std::string::npos);
   EXPECT_NE(table.find("Total"), std::string::npos);
@@ -150,18 +150,18 @@ TEST(TrackingEval, PerIntervalRows) {
 
 TEST(TrackingEval, FalseNewEntryNeedsRecentDetection) {
   const Case c = hand_built();
-  TrackingEvalOptions o = options();
+  eval::TrackingEvalOptions o = options();
   o.look_back = 1;  // A was last detected 2 frames before track 2 starts
-  EXPECT_EQ(evaluate_tracking(c.tracks, c.truth, o).total.false_new_entries, 0);
+  EXPECT_EQ(eval::evaluate_tracking(c.tracks, c.truth, o).total.false_new_entries, 0);
   o.look_back = 2;
-  EXPECT_EQ(evaluate_tracking(c.tracks, c.truth, o).total.false_new_entries, 1);
+  EXPECT_EQ(eval::evaluate_tracking(c.tracks, c.truth, o).total.false_new_entries, 1);
 }
 
 TEST(TrackingEval, AssociationToleranceAndWrap) {
-  std::vector<GroundTruthLine> truth = {gt(0, 1, 3.14), gt(0, 2, 1.0)};
+  std::vector<eval::GroundTruthLine> truth = {gt(0, 1, 3.14), gt(0, 2, 1.0)};
   // -3.14 is 0.0032 rad from 3.14 across the wrap: associated. 1.0 + 1.1 deg: not.
   std::vector<TrackRow> tracks = {det(0, 0, -3.14), det(0, 1, 1.0 + deg2rad(1.1))};
-  const TrackingEvaluation ev = evaluate_tracking(tracks, truth, options());
+  const eval::TrackingEvaluation ev = eval::evaluate_tracking(tracks, truth, options());
   EXPECT_EQ(ev.associated_detections, 1);
   EXPECT_NEAR(ev.bearing_rms, 2 * kPi - 6.28, 1e-9);
   EXPECT_EQ(ev.long_lines_detected, 1);
@@ -170,26 +170,26 @@ TEST(TrackingEval, AssociationToleranceAndWrap) {
 // A link is to the observation the tracker matched (matched_frame), not simply the previous
 // detection of the id; without matched_frame the previous detection is used.
 TEST(TrackingEval, LinksFollowMatchedFrame) {
-  std::vector<GroundTruthLine> truth;
+  std::vector<eval::GroundTruthLine> truth;
   for (int f = 0; f < 3; ++f) {
     truth.push_back(gt(f, 1, 0.0));
     truth.push_back(gt(f, 2, 1.0));
   }
   std::vector<TrackRow> tracks = {det(0, 7, 0.0), det(1, 7, 1.0, 0), det(2, 7, 0.0, 0)};
-  TrackingEvaluation ev = evaluate_tracking(tracks, truth, options());
+  eval::TrackingEvaluation ev = eval::evaluate_tracking(tracks, truth, options());
   EXPECT_EQ(ev.total.matches, 2);
   EXPECT_EQ(ev.total.correct, 1);        // 2 -> 0
   EXPECT_EQ(ev.total.false_matches, 1);  // 1 -> 0
   for (auto& r : tracks) r.matched_frame = -1;
-  ev = evaluate_tracking(tracks, truth, options());
+  ev = eval::evaluate_tracking(tracks, truth, options());
   EXPECT_EQ(ev.total.false_matches, 2);  // 1 -> 0 and 2 -> 1
 }
 
 // Two detections of one frame under one id (a double claim): one of them is a false match.
 TEST(TrackingEval, DoubleClaimCountsAsFalseMatch) {
-  std::vector<GroundTruthLine> truth = {gt(0, 1, 0.0), gt(1, 1, 0.0), gt(1, 2, 0.2)};
+  std::vector<eval::GroundTruthLine> truth = {gt(0, 1, 0.0), gt(1, 1, 0.0), gt(1, 2, 0.2)};
   std::vector<TrackRow> tracks = {det(0, 3, 0.0), det(1, 3, 0.0, 0), det(1, 3, 0.2, 0)};
-  const TrackingEvaluation ev = evaluate_tracking(tracks, truth, options());
+  const eval::TrackingEvaluation ev = eval::evaluate_tracking(tracks, truth, options());
   EXPECT_EQ(ev.duplicate_ids, 1);
   EXPECT_EQ(ev.total.matches, 2);
   EXPECT_EQ(ev.total.correct, 1);
@@ -201,7 +201,7 @@ TEST(TrackingEval, DoubleClaimCountsAsFalseMatch) {
 // 1 (two false matches); with the matched line named (line, matched_line) both are correct.
 TEST(TrackingEval, DoubleClaimDuringTurnUsesMatchedLine) {
   const double deg = kPi / 180.0;
-  std::vector<GroundTruthLine> truth;
+  std::vector<eval::GroundTruthLine> truth;
   for (int f = 0; f < 3; ++f) {
     truth.push_back(gt(f, 1, -3.0 * f * deg));
     truth.push_back(gt(f, 2, (2.0 - 3.0 * f) * deg));
@@ -219,12 +219,12 @@ TEST(TrackingEval, DoubleClaimDuringTurnUsesMatchedLine) {
                                   row(1, 1, -1.0 * deg, 0, 1),
                                   row(2, 0, -6.0 * deg, 1, 0),
                                   row(2, 1, -4.0 * deg, 1, 1)};
-  TrackingEvaluation ev = evaluate_tracking(tracks, truth, options());
+  eval::TrackingEvaluation ev = eval::evaluate_tracking(tracks, truth, options());
   EXPECT_EQ(ev.total.matches, 4);
   EXPECT_EQ(ev.total.correct, 4);
   EXPECT_EQ(ev.total.false_matches, 0);
   for (auto& r : tracks) r.matched_line = -1;  // the old file format: nearest bearing
-  ev = evaluate_tracking(tracks, truth, options());
+  ev = eval::evaluate_tracking(tracks, truth, options());
   EXPECT_EQ(ev.total.false_matches, 2);
 }
 
@@ -233,7 +233,7 @@ TEST(TrackingEval, DoubleClaimDuringTurnUsesMatchedLine) {
 // indistinguishable, and none for tracks that follow their line through the crossing.
 TEST(TrackingEval, SwapAtCrossingCountsOnceAndAmbiguityIsNotAnError) {
   const double a_deg[] = {-2, -1, 0, 1, 2}, b_deg[] = {2, 1, 0.05, -1, -2};
-  std::vector<GroundTruthLine> truth;
+  std::vector<eval::GroundTruthLine> truth;
   for (int f = 0; f < 5; ++f) {
     truth.push_back(gt(f, 1, deg2rad(a_deg[f])));
     truth.push_back(gt(f, 2, deg2rad(b_deg[f])));
@@ -247,23 +247,23 @@ TEST(TrackingEval, SwapAtCrossingCountsOnceAndAmbiguityIsNotAnError) {
     follow.push_back(det(f, 0, deg2rad(a_deg[f]), m));
     follow.push_back(det(f, 1, deg2rad(b_deg[f]), m));
   }
-  TrackingEvaluation ev = evaluate_tracking(swap, truth, options());
+  eval::TrackingEvaluation ev = eval::evaluate_tracking(swap, truth, options());
   EXPECT_EQ(ev.ambiguous_detections, 2);
   EXPECT_EQ(ev.total.matches, 8);
   EXPECT_EQ(ev.total.false_matches, 2);
   EXPECT_EQ(ev.total.correct, 6);
-  ev = evaluate_tracking(follow, truth, options());
+  ev = eval::evaluate_tracking(follow, truth, options());
   EXPECT_EQ(ev.total.false_matches, 0);
   EXPECT_EQ(ev.total.correct, 8);
 }
 
 TEST(TrackingEval, EmptyInputs) {
-  const TrackingEvaluation ev = evaluate_tracking({}, {}, options());
+  const eval::TrackingEvaluation ev = eval::evaluate_tracking({}, {}, options());
   EXPECT_EQ(ev.total.matches, 0);
   EXPECT_EQ(ev.total.percent_correct(), 0.0);
   EXPECT_EQ(ev.long_line_recall(), 0.0);
   EXPECT_FALSE(std::isnan(ev.bearing_rms));
-  EXPECT_NE(format_tracking_table(ev).find("Total"), std::string::npos);
+  EXPECT_NE(eval::format_tracking_table(ev).find("Total"), std::string::npos);
 }
 
 }  // namespace
@@ -273,7 +273,7 @@ namespace omnivert {
 namespace {
 
 TEST(TrackingEval, InvalidOptionsThrowInputError) {
-  EXPECT_THROW(evaluate_tracking({}, {}, TrackingEvalOptions{}), InputError);
+  EXPECT_THROW(eval::evaluate_tracking({}, {}, eval::TrackingEvalOptions{}), InputError);
 }
 
 }  // namespace

@@ -25,7 +25,7 @@ struct WorldLine {
 struct SyntheticRun {
   std::vector<FrameFeatures> frames;
   std::vector<WheelIncrement> increments;  // since the previous frame
-  std::vector<GroundTruthLine> truth;
+  std::vector<eval::GroundTruthLine> truth;
 };
 
 Eigen::RowVectorXf clip_normalise(Eigen::RowVectorXf d) {
@@ -93,7 +93,7 @@ SyntheticRun make_run(unsigned seed, int lookalikes, float spread) {
       if (dist < 0.6 || dist > 7.0) continue;
       const double beta =
           wrap_angle(std::atan2(world[w].y - cy, world[w].x - cx) - (th + phi + psi));  // (16)
-      GroundTruthLine g;
+      eval::GroundTruthLine g;
       g.frame = static_cast<std::int64_t>(f);
       g.line_id = w;
       g.bearing = beta;
@@ -118,7 +118,7 @@ SyntheticRun make_run(unsigned seed, int lookalikes, float spread) {
   return run;
 }
 
-TrackingEvaluation track_and_evaluate(const SyntheticRun& run, const TrackerOptions& o) {
+eval::TrackingEvaluation track_and_evaluate(const SyntheticRun& run, const TrackerOptions& o) {
   Tracker tracker(o);
   std::vector<TrackRow> rows;
   std::vector<TrackAssignment> out;
@@ -126,10 +126,10 @@ TrackingEvaluation track_and_evaluate(const SyntheticRun& run, const TrackerOpti
     tracker.add_frame(run.frames[f], run.increments[f], &out);
     append_track_rows(static_cast<std::int64_t>(f), 0, run.frames[f], out, &rows);
   }
-  TrackingEvalOptions eo;
+  eval::TrackingEvalOptions eo;
   eo.annulus_r_min = 30;
   eo.annulus_r_max = 230;
-  return evaluate_tracking(rows, run.truth, eo);
+  return eval::evaluate_tracking(rows, run.truth, eo);
 }
 
 TEST(TrackingPipeline, EachConstraintIsMeasuredOnASyntheticRun) {
@@ -144,18 +144,18 @@ TEST(TrackingPipeline, EachConstraintIsMeasuredOnASyntheticRun) {
   gated.gate.min_feature_distance = 0.5;
   gated.gate.max_camera_offset = 0.3;
 
-  const TrackingEvaluation a = track_and_evaluate(run, paper);
-  const TrackingEvaluation b = track_and_evaluate(run, mutual);
-  const TrackingEvaluation c = track_and_evaluate(run, gated);
+  const eval::TrackingEvaluation a = track_and_evaluate(run, paper);
+  const eval::TrackingEvaluation b = track_and_evaluate(run, mutual);
+  const eval::TrackingEvaluation c = track_and_evaluate(run, gated);
   TrackerOptions gate_only = gated;
   gate_only.mutual = false;
-  const TrackingEvaluation g = track_and_evaluate(run, gate_only);
+  const eval::TrackingEvaluation g = track_and_evaluate(run, gate_only);
   if (std::getenv("OMNIVERT_VERBOSE")) {
     std::printf("%s\n%s\n%s\n%s\n",
-                format_tracking_table(a, "Paper's three rules").c_str(),
-                format_tracking_table(g, "+ odometry gate").c_str(),
-                format_tracking_table(b, "+ mutual").c_str(),
-                format_tracking_table(c, "+ mutual + odometry gate").c_str());
+                eval::format_tracking_table(a, "Paper's three rules").c_str(),
+                eval::format_tracking_table(g, "+ odometry gate").c_str(),
+                eval::format_tracking_table(b, "+ mutual").c_str(),
+                eval::format_tracking_table(c, "+ mutual + odometry gate").c_str());
   }
   // The ground truth and association are the same for all three.
   EXPECT_EQ(a.associated_detections, a.detections);  // noise 0.2 deg << 1 deg

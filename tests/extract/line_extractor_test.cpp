@@ -1,4 +1,6 @@
-// Radial-line extraction on images drawn with edges at known angles (Sec. 2).
+// Radial-line extraction on drawn bars and noise (Sec. 2): edges close to another, crowded
+// edges, the significance threshold on noise. The drawn patterns through the frame pipeline:
+// line_extractor_patterns_test.cpp.
 
 #include <cmath>
 #include <random>
@@ -13,121 +15,6 @@
 
 namespace omnivert {
 namespace {
-
-struct Score {
-  int long_edges = 0, long_found = 0, invented = 0;
-  std::vector<double> errors_deg;
-  std::vector<double> center_errors;
-};
-
-// Matches detections to truth within 0.3 degree.
-void score_frame(const sim::RadialPattern& p, const FrameFeatures& f, Score& s) {
-  const double L = p.circle.r_max - p.circle.r_min;
-  s.center_errors.push_back((f.circle.center - p.circle.center).norm());
-  for (const auto& e : p.edges) {
-    if (e.r_to - e.r_from < 0.6 * L) continue;
-    ++s.long_edges;
-    double best = 1e9;
-    for (const auto& l : f.lines)
-      best = std::min(best, std::abs(angle_diff(l.image_angle, e.image_angle)));
-    if (best <= deg2rad(0.3)) {
-      ++s.long_found;
-      s.errors_deg.push_back(rad2deg(best));
-    }
-  }
-  for (const auto& l : f.lines) {
-    double best = 1e9;
-    for (const auto& e : p.edges)
-      best = std::min(best, std::abs(angle_diff(l.image_angle, e.image_angle)));
-    if (best > deg2rad(0.3)) ++s.invented;
-  }
-}
-
-double rms(const std::vector<double>& v) {
-  double s = 0;
-  for (double x : v) s += x * x;
-  return v.empty() ? 0 : std::sqrt(s / v.size());
-}
-
-TEST(LineExtractor, FindsEveryLongEdgeAtItsAngleAndInventsNone) {
-  Score s;
-  for (int seed = 1; seed <= 20; ++seed) {
-    sim::RadialPatternOptions o;
-    o.seed = seed;
-    o.noise_sigma = 2.0 + (seed % 3);
-    const auto p = sim::draw_radial_pattern(o);
-    CameraGeometry g;
-    g.width = o.width;
-    g.height = o.height;
-    FeaturePipeline pipe(g);
-    FrameFeatures f;
-    std::string why;
-    ASSERT_TRUE(pipe.process(p.image, f, &why)) << why;
-    score_frame(p, f, s);
-  }
-  const double center_rms = rms(s.center_errors);
-  std::printf("long edges %d found %d invented %d bearing RMS %.4f deg centre RMS %.3f px\n",
-              s.long_edges,
-              s.long_found,
-              s.invented,
-              rms(s.errors_deg),
-              center_rms);
-  EXPECT_EQ(s.long_found, s.long_edges);
-  EXPECT_EQ(s.invented, 0);
-  EXPECT_LE(rms(s.errors_deg), 0.05);
-  for (double e : s.center_errors) EXPECT_LE(e, 0.3);
-}
-
-// Angular resolution (docs/extraction.md): patterns crowded with edges, some pairs 1.2-1.5
-// degrees apart. The default peaks (one sector's votes, non-maximum suppression over one
-// sector each side) find every long edge and invent none; the coarser peaks used before
-// (3-sector score, 2 sectors each side) lose one edge of such close pairs.
-TEST(LineExtractor, ResolvesEdgesLittleMoreThanADegreeApart) {
-  auto run = [](int peak_window, int nms_radius, Score* s, int* close_pairs) {
-    for (int seed = 1; seed <= 10; ++seed) {
-      sim::RadialPatternOptions o;
-      o.seed = seed;
-      o.full_edges = 60;
-      o.patches = 0;
-      o.min_separation_deg = 0.4;  // full edges at least 3 x 0.4 = 1.2 degrees apart
-      const auto p = sim::draw_radial_pattern(o);
-      for (std::size_t i = 0; close_pairs && i < p.edges.size(); ++i)
-        for (std::size_t j = i + 1; j < p.edges.size(); ++j)
-          if (std::abs(angle_diff(p.edges[i].image_angle, p.edges[j].image_angle)) < deg2rad(1.5))
-            ++*close_pairs;
-      CameraGeometry g;
-      g.width = o.width;
-      g.height = o.height;
-      FeaturePipelineOptions po;
-      po.lines.peak_window = peak_window;
-      po.lines.nms_radius = nms_radius;
-      FeaturePipeline pipe(g, po);
-      FrameFeatures f;
-      std::string why;
-      ASSERT_TRUE(pipe.process(p.image, f, &why)) << why;
-      score_frame(p, f, *s);
-    }
-  };
-  Score fine, coarse;
-  int pairs = 0;
-  run(0, 1, &fine, &pairs);
-  run(1, 2, &coarse, nullptr);  // the same patterns
-  std::printf(
-      "close pairs %d; default: %d of %d long edges, %d invented, RMS %.4f deg; coarse: %d, %d "
-      "invented\n",
-      pairs,
-      fine.long_found,
-      fine.long_edges,
-      fine.invented,
-      rms(fine.errors_deg),
-      coarse.long_found,
-      coarse.invented);
-  ASSERT_GE(pairs, 10);  // the patterns do hold close pairs
-  EXPECT_EQ(fine.long_found, fine.long_edges);
-  EXPECT_EQ(fine.invented, 0);
-  EXPECT_LE(rms(fine.errors_deg), 0.05);
-  EXPECT_LT(coarse.long_found, coarse.long_edges);
-}
 
 // A dark radial bar `width` wide (angle) on a bright annulus, anti-aliased by supersampling
 // the pixels within 1.5 px of its edges; mirror rim outside r = 228, dark disc inside 30.
@@ -274,52 +161,6 @@ TEST(LineExtractor, SignificanceKeepsNoLineInNoise) {
   std::printf("noise, 10 images: %d significant lines, %d with topk\n", kept, topk);
   EXPECT_LE(kept, 2);
   EXPECT_EQ(topk, 200);
-}
-
-// Partial-height edges (a wall half hidden by furniture): the paper's rule drops those
-// shorter than half the annulus; the significance keeps every edge at least a fifth of the
-// annulus long, and invents none.
-TEST(LineExtractor, SignificanceKeepsPartialEdges) {
-  Score s_def, s_paper;
-  int partial = 0, partial_def = 0, partial_paper = 0;
-  for (int seed = 1; seed <= 10; ++seed) {
-    sim::RadialPatternOptions o;
-    o.seed = seed;
-    const auto p = sim::draw_radial_pattern(o);
-    const double L = p.circle.r_max - p.circle.r_min;
-    for (int paper = 0; paper < 2; ++paper) {
-      LineExtractorOptions lo;
-      lo.threshold = paper ? LineThreshold::kFractionOfAnnulus : LineThreshold::kSignificance;
-      LineExtractor ex(lo);
-      std::vector<VerticalLine> lines;
-      ex.extract(p.image, p.circle, lines);
-      FrameFeatures f;
-      f.circle = p.circle;
-      f.lines = lines;
-      score_frame(p, f, paper ? s_paper : s_def);
-      for (const auto& e : p.edges) {
-        if (e.full || e.r_to - e.r_from < 0.2 * L) continue;
-        partial += paper ? 0 : 1;
-        for (const auto& l : lines)
-          if (std::abs(angle_diff(l.image_angle, e.image_angle)) <= deg2rad(0.3)) {
-            ++(paper ? partial_paper : partial_def);
-            break;
-          }
-      }
-    }
-  }
-  std::printf(
-      "partial edges >= 20%% of the annulus: %d; found %d (significance), %d (50%% rule); "
-      "invented %d, %d\n",
-      partial,
-      partial_def,
-      partial_paper,
-      s_def.invented,
-      s_paper.invented);
-  EXPECT_EQ(partial_def, partial);
-  EXPECT_LT(partial_paper, partial);
-  EXPECT_EQ(s_def.invented, 0);
-  EXPECT_EQ(s_def.long_found, s_def.long_edges);
 }
 
 }  // namespace

@@ -153,9 +153,9 @@ TEST(TracksPlot, WrapIsBrokenAndTracksAreDrawn) {
   add(100, 0, -170);  // crosses +180 -> -180 between the two frames
   add(0, 1, -90);
   add(100, 1, -60);
-  TrackPlotOptions o;
+  viz::TrackPlotOptions o;
   o.draw_ids = false;
-  const cv::Mat img = draw_tracks(rows, o);
+  const cv::Mat img = viz::draw_tracks(rows, o);
   ASSERT_EQ(img.cols, o.width);
   ASSERT_EQ(img.rows, o.height);
   // Plot area as in draw_tracks: left 80, right 30, top 50, bottom 60.
@@ -206,7 +206,7 @@ TEST(TracksPlot, WritesPng) {
   const char* env = std::getenv("OMNIVERT_PLOT_DIR");
   const ScratchDir scratch;
   const fs::path p = (env ? fs::path(env) : scratch.path()) / "tracks.png";
-  write_tracks_png(p, rows);
+  viz::write_tracks_png(p, rows);
   const cv::Mat back = cv::imread(p.string());
   ASSERT_FALSE(back.empty());
   EXPECT_EQ(back.cols, 1600);

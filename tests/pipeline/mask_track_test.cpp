@@ -46,11 +46,11 @@ TEST_F(MaskTrack, NoTrackAtTheStrutsWithTheMask) {
   dataset::LoadOptions lo;
   lo.require_wheel = false;
   const auto data = dataset::Dataset::load(dir.string(), lo);
-  TrackDatasetOptions plain;
-  const TrackDatasetResult without = track_dataset(data, plain);
-  TrackDatasetOptions masked;
+  pipeline::TrackDatasetOptions plain;
+  const pipeline::TrackDatasetResult without = pipeline::track_dataset(data, plain);
+  pipeline::TrackDatasetOptions masked;
   masked.mask = mask.string();
-  const TrackDatasetResult with = track_dataset(data, masked);
+  const pipeline::TrackDatasetResult with = pipeline::track_dataset(data, masked);
   const int n_without = near_struts(without.rows, cfg.overlay.strut_angles_deg);
   const int n_with = near_struts(with.rows, cfg.overlay.strut_angles_deg);
   std::printf(

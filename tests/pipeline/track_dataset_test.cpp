@@ -38,7 +38,7 @@ dataset::Dataset load_for_tracking(const fs::path& dir) {
 }
 
 // The options `omnivert track` passes without flags (tools/cmd_track.cpp).
-TrackDatasetOptions cli_track_options() { return {}; }
+pipeline::TrackDatasetOptions cli_track_options() { return {}; }
 
 std::set<std::int64_t> frames_of(const std::vector<TrackRow>& rows) {
   std::set<std::int64_t> frames;
@@ -47,17 +47,17 @@ std::set<std::int64_t> frames_of(const std::vector<TrackRow>& rows) {
 }
 
 // `omnivert evaluate`: the tracks against the dataset's ground-truth lines (Table 3).
-TrackingEvaluation evaluate(const dataset::Dataset& data, const std::vector<TrackRow>& rows) {
+eval::TrackingEvaluation evaluate(const dataset::Dataset& data, const std::vector<TrackRow>& rows) {
   const auto& gt = data.ground_truth();
   EXPECT_TRUE(gt && gt->has_lines);
-  std::vector<GroundTruthLine> truth;
+  std::vector<eval::GroundTruthLine> truth;
   for (const auto& l : gt->lines)
     truth.push_back({l.frame, l.line_id, l.bearing, l.r_inner, l.r_outer});
-  TrackingEvalOptions o;
+  eval::TrackingEvalOptions o;
   o.annulus_r_min = data.camera().r_min.value_or(0.0);
   o.annulus_r_max = data.camera().r_max.value_or(0.0);
   o.num_frames = static_cast<std::int64_t>(data.size());
-  return evaluate_tracking(rows, truth, o);
+  return eval::evaluate_tracking(rows, truth, o);
 }
 
 class TrackDataset : public SimulatedDatasets {
@@ -71,7 +71,8 @@ class TrackDataset : public SimulatedDatasets {
   }
   // Frame 5 of 12 damaged: tracking goes on to frame 11, frame 5 has no lines, and the
   // look-back bridges the gap (some line of frame 6 continues a track from frame 4).
-  static void expect_frame_5_skipped_and_bridged(const fs::path& dir, const TrackDatasetResult& r) {
+  static void expect_frame_5_skipped_and_bridged(const fs::path& dir,
+                                                 const pipeline::TrackDatasetResult& r) {
     EXPECT_EQ(r.frames, 12);
     const std::set<std::int64_t> frames = frames_of(r.rows);
     for (std::int64_t f : {0, 1, 2, 3, 4, 6, 7, 8, 9, 10, 11})
@@ -90,7 +91,7 @@ class TrackDataset : public SimulatedDatasets {
 // falsely matched, bearings to better than 0.05 degree RMS.
 TEST_F(TrackDataset, TinyRunIsTrackedInEveryFrameAndMatchesTheGroundTruth) {
   const auto data = load_for_tracking(tiny());
-  const TrackDatasetResult r = track_dataset(data, cli_track_options());
+  const pipeline::TrackDatasetResult r = pipeline::track_dataset(data, cli_track_options());
   EXPECT_EQ(r.frames, 12);
   EXPECT_EQ(r.frames_skipped, 0);
   EXPECT_EQ(frames_of(r.rows).size(), 12u);
@@ -98,25 +99,25 @@ TEST_F(TrackDataset, TinyRunIsTrackedInEveryFrameAndMatchesTheGroundTruth) {
   const fs::path out = scratch("tiny-out");
   fs::create_directories(out);
   write_tracks_csv(out / "tracks.csv", r.rows);
-  write_tracks_png(out / "tracks.png", r.rows);
+  viz::write_tracks_png(out / "tracks.png", r.rows);
   EXPECT_THAT(read_lines(out / "tracks.csv").front(),
               ::testing::StartsWith("frame,timestamp_ns,track_id,bearing_rad"));
   EXPECT_GE(fs::file_size(out / "tracks.png"), 1000u);
 
-  const TrackingEvaluation ev = evaluate(data, r.rows);
+  const eval::TrackingEvaluation ev = evaluate(data, r.rows);
   EXPECT_GE(ev.total.matches, 40);
   EXPECT_GE(ev.total.percent_correct(), 95.0);
   EXPECT_EQ(ev.total.false_matches, 0);
   EXPECT_LT(rad2deg(ev.bearing_rms), 0.05);
-  EXPECT_THAT(format_tracking_table(ev), HasSubstr("Total"));
+  EXPECT_THAT(eval::format_tracking_table(ev), HasSubstr("Total"));
 }
 
 TEST_F(TrackDataset, TracksReadBackForTheSameDatasetAreTheTrackedOnes) {
   const auto data = load_for_tracking(tiny());
-  const TrackDatasetResult r = track_dataset(data, cli_track_options());
+  const pipeline::TrackDatasetResult r = pipeline::track_dataset(data, cli_track_options());
   const fs::path file = scratch("read-back.csv");
   write_tracks_csv(file, r.rows);
-  const TrackDatasetResult back = read_tracks_for_dataset(file.string(), data);
+  const pipeline::TrackDatasetResult back = pipeline::read_tracks_for_dataset(file.string(), data);
   ASSERT_EQ(back.rows.size(), r.rows.size());
   for (std::size_t i = 0; i < r.rows.size(); ++i) {
     EXPECT_EQ(back.rows[i].frame, r.rows[i].frame);
@@ -131,7 +132,8 @@ TEST_F(TrackDataset, CorruptImageIsWarnedAboutAndSkipped) {
   const fs::path dir = tiny_copy("corrupt");
   const std::string victim = image_names(dir)[5];
   write_text(dir / "cam0/data" / victim, "this is not a PNG file\n");
-  const TrackDatasetResult r = track_dataset(load_for_tracking(dir), cli_track_options());
+  const pipeline::TrackDatasetResult r =
+      pipeline::track_dataset(load_for_tracking(dir), cli_track_options());
   EXPECT_EQ(r.frames_skipped, 1);
   EXPECT_THAT(joined(r.warnings),
               HasSubstr(victim + ": cannot be read as an image; frame 5 skipped"));
@@ -142,7 +144,8 @@ TEST_F(TrackDataset, MissingImageIsWarnedAboutAndSkipped) {
   const fs::path dir = tiny_copy("missing");
   const std::string victim = image_names(dir)[5];
   fs::remove(dir / "cam0/data" / victim);
-  const TrackDatasetResult r = track_dataset(load_for_tracking(dir), cli_track_options());
+  const pipeline::TrackDatasetResult r =
+      pipeline::track_dataset(load_for_tracking(dir), cli_track_options());
   EXPECT_EQ(r.frames_skipped, 1);
   EXPECT_THAT(joined(r.warnings),
               HasSubstr("image file '" + victim + "' not found in cam0/data/; frame 5 skipped"));
@@ -154,7 +157,8 @@ TEST_F(TrackDataset, MissingImageIsWarnedAboutAndSkipped) {
 TEST_F(TrackDataset, FrameWithoutLinesIsNotReportedUnreadable) {
   const fs::path dir = tiny_copy("grey");
   write_grey_frame(dir / "cam0/data" / image_names(dir)[5]);
-  const TrackDatasetResult r = track_dataset(load_for_tracking(dir), cli_track_options());
+  const pipeline::TrackDatasetResult r =
+      pipeline::track_dataset(load_for_tracking(dir), cli_track_options());
   EXPECT_THAT(joined(r.warnings), Not(HasSubstr("cannot be read")));
   expect_frame_5_skipped_and_bridged(dir, r);
 }
@@ -191,14 +195,14 @@ TEST_F(TrackDataset, TracksAreIdenticalForEveryThreadCount) {
   write_text(damaged / "cam0/data" / image_names(damaged)[5], "not an image\n");
   for (const fs::path& dir : {tiny(), searched, damaged}) {
     const auto data = load_for_tracking(dir);
-    TrackDatasetOptions o = cli_track_options();
+    pipeline::TrackDatasetOptions o = cli_track_options();
     o.threads = 1;
-    const TrackDatasetResult one = track_dataset(data, o, {}, true);
+    const pipeline::TrackDatasetResult one = pipeline::track_dataset(data, o, {}, true);
     ASSERT_EQ(one.frames, 12);
     EXPECT_GE(one.rows.size(), 40u) << dir;
     for (int threads : {2, 3, 7}) {
       o.threads = threads;
-      const TrackDatasetResult r = track_dataset(data, o, {}, true);
+      const pipeline::TrackDatasetResult r = pipeline::track_dataset(data, o, {}, true);
       const std::string what =
           dir.filename().string() + ", " + std::to_string(threads) + " threads";
       expect_identical_rows(one.rows, r.rows, what);
@@ -229,7 +233,7 @@ TEST_F(TrackDataset, DatasetWhoseImageFilesAreAllMissingIsAnInputError) {
   const fs::path dir = tiny_copy("all-missing");
   for (const std::string& name : image_names(dir)) fs::remove(dir / "cam0/data" / name);
   try {
-    track_dataset(load_for_tracking(dir), cli_track_options());
+    pipeline::track_dataset(load_for_tracking(dir), cli_track_options());
     ADD_FAILURE() << "a dataset without image files was tracked";
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), HasSubstr("cam0/data.csv: none of the 12 listed image files exists"));

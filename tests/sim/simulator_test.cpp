@@ -16,7 +16,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "omnivert/calib/batch_point.hpp"
+#include "calib/batch_point.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
 #include "omnivert/dataset/dataset.hpp"
@@ -133,7 +133,7 @@ TEST_F(SimulatorTest, WheelTravelIntegratesToTheGroundTruthPoses) {
 
   expect_lines_follow_edges(fs::path(out), gt, cfg);
 
-  // What the calibration sees (calib::calibration_run_from_tracks, the ground truth's lines as
+  // What the calibration sees (pipeline::calibration_run_from_tracks, the ground truth's lines as
   // tracks): one step per frame, composed from the wheel samples between the images, with its
   // sideways displacement (FrameInput::lateral). Dead-reckoned, it gives the ground-truth
   // poses; eq. (14) once per frame does not (frame 61 ends the straight and starts the turn).
@@ -146,7 +146,7 @@ TEST_F(SimulatorTest, WheelTravelIntegratesToTheGroundTruthPoses) {
     r.bearing = r.image_angle = l.bearing;
     rows.push_back(r);
   }
-  const calib::DatasetRun run = calib::calibration_run_from_tracks(d, rows);
+  const pipeline::DatasetRun run = pipeline::calibration_run_from_tracks(d, rows);
   const std::vector<Eigen::Vector3d> dr = calib::dead_reckoning(run.run, e);
   calib::CalibrationRun one_step = run.run;
   for (calib::FrameInput& f : one_step.frames) f.lateral = 0.0;

@@ -53,10 +53,20 @@ struct CalibrationTiming {
   double filter = 0.0, refinement = 0.0, observability = 0.0, noise_check = 0.0;
 };
 
+// Which estimator produced the answer of a CalibrationResult.
+enum class Estimator {
+  kFilter,      // the EKF of Sec. 8.2 (with its start-up window)
+  kRefinement,  // the batch maximum-likelihood refinement (CalibrationOptions::refinement)
+};
+// "filter" or "refinement": the `source` of extrinsics.yaml and summary.json.
+const char* estimator_name(Estimator e);
+
 struct CalibrationResult {
-  // The answer: the refinement's when refined and its covariance exists, else the filter's.
+  // The answer: the refinement's when refined and its covariance exists, else the filter's;
+  // `source` says which.
   Extrinsics extrinsics;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  Estimator source = Estimator::kFilter;
   // Refinement only: its covariance came from the Fisher information of the observability
   // analysis (the inverse of the same information) because ceres::Covariance failed.
   bool covariance_from_information = false;

@@ -11,15 +11,14 @@
 //   Extrinsics ex = filter.extrinsics();  Eigen::Matrix3d C = filter.covariance();
 
 #include <map>
+#include <memory>
 #include <string>
-#include <utility>
 #include <vector>
 
-#include "omnivert/calib/feature_initializer.hpp"
-#include "omnivert/calib/filter_state.hpp"
+#include <Eigen/Core>
+
 #include "omnivert/calib/options.hpp"
-#include "omnivert/calib/propagator.hpp"
-#include "omnivert/calib/updater.hpp"
+#include "omnivert/calib/types.hpp"
 
 namespace omnivert::calib {
 
@@ -50,6 +49,11 @@ class CalibrationFilter {
  public:
   // Throws omnivert::InputError when !options.IsValid().
   explicit CalibrationFilter(const CalibrationOptions& options);
+  ~CalibrationFilter();
+  CalibrationFilter(const CalibrationFilter& other);
+  CalibrationFilter& operator=(const CalibrationFilter& other);
+  CalibrationFilter(CalibrationFilter&& other) noexcept;
+  CalibrationFilter& operator=(CalibrationFilter&& other) noexcept;
 
   // One image frame. Throws InputError on non-finite wheel travel or bearings, or a track id
   // repeated within the frame.
@@ -57,94 +61,43 @@ class CalibrationFilter {
   // Bearings (track id, frame) -> the frame where the track of the line beside them starts,
   // to leave out as guarded (guard_before_starts; a filter fed frame by frame does not know
   // them, run_filter does).
-  void guard_ahead(std::map<std::pair<int, int>, int> keys) { ahead_ = std::move(keys); }
+  void guard_ahead(std::map<BearingKey, int> keys);
   // End of the run: solves a pending bootstrap window (a run that never turned). Call once
   // after the last frame before reading the estimate.
   void finish();
 
-  Extrinsics extrinsics() const { return state_.extrinsics(); }
-  Eigen::Matrix3d covariance() const { return state_.extrinsics_covariance(); }
-  const FilterState& state() const { return state_; }
-  const std::vector<FrameEstimate>& history() const { return history_; }
-  const std::map<int, TrackEstimate>& tracks() const { return tracks_; }
+  Extrinsics extrinsics() const;
+  Eigen::Matrix3d covariance() const;
+  // Features in the state now (eq. 28's Z).
+  int num_features() const;
+  const std::vector<FrameEstimate>& history() const;
+  const std::map<int, TrackEstimate>& tracks() const;
   // Tracks split in the bootstrap window (a track that slipped onto a neighbouring line):
   // (tracker's track id, first frame of the new part); see split_tracks (track_ids.hpp).
-  const std::vector<std::pair<int, int>>& splits() const { return splits_; }
+  const std::vector<TrackSplit>& splits() const;
   // The bootstrap window: how many frames it held (0: none), and, when it could not be
   // solved, why (the filter then ran over it from the prior, undelayed).
-  int window_frames() const { return window_frames_; }
-  const std::string& window_failure() const { return window_failure_; }
+  int window_frames() const;
+  const std::string& window_failure() const;
   // Bearings left out where lines cross (CalibrationOptions::association.crossing_guard), in the
   // window and after: (tracker's track id, frame).
-  const std::vector<std::pair<int, int>>& guarded() const { return guarded_; }
+  const std::vector<BearingKey>& guarded() const;
   // Bearings refused by the chi-square gate, in the window and after (tracker's track id,
   // frame). The bound of Sec. 8.1 for the filter's estimate is computed without these and
   // the guarded ones (calibrate()).
-  const std::vector<std::pair<int, int>>& rejected() const { return rejected_; }
+  const std::vector<BearingKey>& rejected() const;
   // New tracks taken for the continuation of a feature in the state
   // (CalibrationOptions::association.join_pieces): (the feature's track id, the new track's id).
   // The new track's bearings update that feature, and tracks() lists it with the feature's
   // estimate.
-  const std::vector<std::pair<int, int>>& joins() const { return joins_; }
-  int frames_processed() const { return frame_; }
-  const CalibrationOptions& options() const { return options_; }
+  const std::vector<TrackJoin>& joins() const;
+  int frames_processed() const;
+  const CalibrationOptions& options() const;
 
  private:
-  void admit(const FrameInput& frame);
-  // One frame of the EKF (after the window): prediction, updates, new tracks, conversions,
-  // marginalisation.
-  void step(const FrameInput& frame);
-  // The crossing guard in this frame: per entry (the state's features, then the frame's new
-  // tracks at n + their index in the frame) whether it is left out.
-  std::vector<char> crossing_entries(const FrameInput& frame) const;
-  // The frame's bearings sorted: guarded (counted in rec), new tracks (*fresh), updates of
-  // features of the state (*z, their own track ids *z_ids), a feature's second bearing
-  // refused.
-  void sort_bearings(const FrameInput& frame,
-                     const std::vector<char>& crossing,
-                     FrameEstimate* rec,
-                     std::vector<const BearingObservation*>* fresh,
-                     std::vector<BearingMeasurement>* z,
-                     std::vector<int>* z_ids);
-  // Inverse-depth blocks whose depth is now well known change parametrisation.
-  void convert_known_depths();
-  // Removes from obs (frame `frame`) the bearings guard_ahead marked before a track that
-  // starts after frame `started_after`, records them as guarded; returns how many.
-  int leave_out_ahead(std::vector<BearingObservation>* obs, int frame, int started_after);
-  // Bearings left out ahead in a frame.
-  int guarded_ahead(int frame) const;
-  void end_bootstrap(FrameEstimate rec);
-  void record_tracks();
-  // The slot of a track (a joined track's feature while that is in the state), -1 when not
-  // in the state.
-  int slot_of(int track_id) const;
-  // Joins the new tracks in `fresh` that continue a feature of the state
-  // (CalibrationOptions::association.join_pieces) and appends their bearings to z / z_ids; returns
-  // the new tracks left.
-  std::vector<const BearingObservation*> join_pieces(std::vector<const BearingObservation*> fresh,
-                                                     std::vector<BearingMeasurement>* z,
-                                                     std::vector<int>* z_ids);
-  CalibrationOptions options_;
-  FilterState state_;
-  Propagator propagator_;
-  Updater updater_;
-  FeatureInitializer initializer_;
-  int frame_ = 0;
-  std::vector<FrameEstimate> history_;
-  std::map<int, TrackEstimate> tracks_;
-  std::vector<std::pair<int, int>> splits_;
-  std::vector<std::pair<int, int>> guarded_;
-  std::vector<std::pair<int, int>> rejected_;
-  std::vector<std::pair<int, int>> joins_;
-  std::map<int, int> joined_to_;  // new track id -> the feature's track id
-  int window_frames_ = 0;
-  std::string window_failure_;
-  bool bootstrapping_ = false;
-  CalibrationRun window_;
-  double window_heading_ = 0.0;
-  double window_max_turn_ = 0.0;
-  std::map<std::pair<int, int>, int> ahead_;  // guard_ahead
-  std::map<int, int> ahead_count_;            // frame -> bearings left out ahead
+  // The EKF's state, models and bookkeeping (src/calib/filter_impl.hpp).
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
 };
 
 // The crossing guard ahead of a track's start (CalibrationOptions::association.crossing_guard): a
@@ -158,8 +111,8 @@ class CalibrationFilter {
 // (the earliest, where several lines start beside it).
 // (A line beside another before its track starts pushes that one's bearings off, and the
 // filter ends off by several of its sigmas: CrossingGuard.BeforeATrackStartsBesideAnother.)
-std::map<std::pair<int, int>, int> guard_before_starts(const CalibrationRun& run,
-                                                       const CalibrationOptions& options);
+std::map<BearingKey, int> guard_before_starts(const CalibrationRun& run,
+                                              const CalibrationOptions& options);
 
 // Runs the filter over a whole run.
 struct FilterResult {
@@ -167,12 +120,12 @@ struct FilterResult {
   Eigen::Matrix3d covariance;
   std::vector<FrameEstimate> history;
   std::map<int, TrackEstimate> tracks;
-  std::vector<std::pair<int, int>> splits;    // CalibrationFilter::splits
-  int window_frames = 0;                      // CalibrationFilter::window_frames
-  std::string window_failure;                 // CalibrationFilter::window_failure
-  std::vector<std::pair<int, int>> guarded;   // CalibrationFilter::guarded
-  std::vector<std::pair<int, int>> rejected;  // CalibrationFilter::rejected
-  std::vector<std::pair<int, int>> joins;     // CalibrationFilter::joins
+  std::vector<TrackSplit> splits;    // CalibrationFilter::splits
+  int window_frames = 0;             // CalibrationFilter::window_frames
+  std::string window_failure;        // CalibrationFilter::window_failure
+  std::vector<BearingKey> guarded;   // CalibrationFilter::guarded
+  std::vector<BearingKey> rejected;  // CalibrationFilter::rejected
+  std::vector<TrackJoin> joins;      // CalibrationFilter::joins
 };
 FilterResult run_filter(const CalibrationRun& run, const CalibrationOptions& options);
 

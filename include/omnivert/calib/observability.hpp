@@ -6,8 +6,8 @@
 
 #include <Eigen/Core>
 
-#include "omnivert/calib/batch_point.hpp"
 #include "omnivert/calib/options.hpp"
+#include "omnivert/calib/types.hpp"
 
 namespace omnivert::calib {
 

@@ -1,6 +1,6 @@
 #pragma once
 // Batch maximum-likelihood refinement of a whole run (Ceres), on the batch formulation of
-// batch_point.hpp.
+// docs/theory/refinement.md (unknowns: the BatchPoint of types.hpp).
 
 #include <limits>
 #include <string>
@@ -9,9 +9,9 @@
 
 #include <Eigen/Core>
 
-#include "omnivert/calib/batch_point.hpp"
 #include "omnivert/calib/diagnostics.hpp"
 #include "omnivert/calib/options.hpp"
+#include "omnivert/calib/types.hpp"
 
 namespace omnivert::calib {
 
@@ -30,17 +30,17 @@ struct RefinementResult {
   int num_splits = 0;    // tracks split in two (CalibrationOptions::association.split_chi2)
   // (track id, first frame of the new part): the tracker's id, or with merges the id of the
   // line's first piece.
-  std::vector<std::pair<int, int>> splits;
+  std::vector<TrackSplit> splits;
   // Pieces of one line joined (CalibrationOptions::association.join_pieces): (earlier track id,
   // later track id), the later piece's bearings renamed to the line's first piece.
-  std::vector<std::pair<int, int>> merges;
+  std::vector<TrackJoin> merges;
   // Bearings left out where lines cross (CalibrationOptions::association.crossing_guard): (track id
   // of the solved run, i.e. of solved_run when tracks were split or merged, frame).
-  std::vector<std::pair<int, int>> guarded;
+  std::vector<BearingKey> guarded;
   // Bearings removed as outliers (the gate) or with a feature left with too few bearings:
   // (track id of the solved run, frame). With `guarded`, what the solution did not use; the
   // bound of Sec. 8.1 for this run is computed without them (calibrate()).
-  std::vector<std::pair<int, int>> rejected;
+  std::vector<BearingKey> rejected;
   // With splits or merges (renamed()): the run `solution` refers to (split parts and merged
   // pieces renamed); otherwise empty, and `solution` refers to the run given.
   CalibrationRun solved_run;

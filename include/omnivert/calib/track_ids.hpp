@@ -15,7 +15,7 @@ namespace omnivert::calib {
 // frames of a track gets a new id, from one above the largest id of the run. `origin`
 // (optional) receives new id -> tracker's id.
 CalibrationRun split_tracks(const CalibrationRun& run,
-                            const std::vector<std::pair<int, int>>& splits,
+                            const std::vector<TrackSplit>& splits,
                             std::map<int, int>* origin = nullptr);
 
 // The run with pieces of one line under one id (RefinementResult::merges,
@@ -23,12 +23,12 @@ CalibrationRun split_tracks(const CalibrationRun& run,
 // the id of its line's first piece (chains followed). `renamed` (optional) receives each
 // renamed id -> its new id.
 CalibrationRun join_tracks(const CalibrationRun& run,
-                           const std::vector<std::pair<int, int>>& joins,
+                           const std::vector<TrackJoin>& joins,
                            std::map<int, int>* renamed = nullptr);
 // Each joined piece's line: joined piece's id -> the id of its line's first piece (chains of
 // (earlier, later) pairs followed to their start). What join_tracks renames by. Of several
 // pairs for one piece the last counts; a pair that joins a piece to itself or would close a
 // loop is left out: every chain ends.
-std::map<int, int> join_roots(const std::vector<std::pair<int, int>>& joins);
+std::map<int, int> join_roots(const std::vector<TrackJoin>& joins);
 
 }  // namespace omnivert::calib

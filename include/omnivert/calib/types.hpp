@@ -7,8 +7,11 @@
 // from the robot x-axis, so T_base_cam = [Rz(phi + psi) | (rho cos phi, rho sin phi, 0)].
 // A bearing beta is counter-clockwise from the camera x-axis, in radians.
 
-#include <Eigen/Core>
+#include <compare>
+#include <map>
 #include <vector>
+
+#include <Eigen/Core>
 
 namespace omnivert::calib {
 
@@ -59,6 +62,39 @@ struct FrameInput {
 // A whole recorded run (what the batch refinement and the observability analysis need).
 struct CalibrationRun {
   std::vector<FrameInput> frames;
+};
+
+// A point of the batch (whole-run) problem of the refinement and the observability analysis
+// (docs/theory/refinement.md): robot poses (x, y, theta) of every frame, poses[0] = (0, 0, 0)
+// the gauge; features as world points (x_f, y_f) by track id; the extrinsics.
+struct BatchPoint {
+  std::vector<Eigen::Vector3d> poses;
+  std::map<int, Eigen::Vector2d> features;
+  Extrinsics extrinsics;
+};
+
+// One bearing of a run: its track id and its frame (index into CalibrationRun::frames).
+// Ordered by track, then frame.
+struct BearingKey {
+  int track = 0;
+  int frame = 0;
+  friend auto operator<=>(const BearingKey&, const BearingKey&) = default;
+};
+
+// A track split in two where it slipped onto a neighbouring line: the track's id and the
+// first frame of the new part (split_tracks, track_ids.hpp).
+struct TrackSplit {
+  int track = 0;
+  int frame = 0;
+  friend auto operator<=>(const TrackSplit&, const TrackSplit&) = default;
+};
+
+// Two pieces of one line joined: the earlier piece's track id and the later piece's, whose
+// bearings become the line's (join_tracks, track_ids.hpp).
+struct TrackJoin {
+  int earlier = 0;
+  int later = 0;
+  friend auto operator<=>(const TrackJoin&, const TrackJoin&) = default;
 };
 
 }  // namespace omnivert::calib

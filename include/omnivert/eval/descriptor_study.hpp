@@ -30,7 +30,7 @@
 #include "omnivert/dataset/dataset.hpp"
 #include "omnivert/describe/feature_pipeline.hpp"
 
-namespace omnivert {
+namespace omnivert::eval {
 
 struct StudyOptions {
   double max_baseline = 2.0;                    // metres between robot positions
@@ -172,4 +172,4 @@ PrPoint rules_operating_point(const std::vector<MatchRecord>& records,
                               double f2,
                               double f3);
 
-}  // namespace omnivert
+}  // namespace omnivert::eval

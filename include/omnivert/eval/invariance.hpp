@@ -10,7 +10,7 @@
 
 #include "omnivert/describe/frame_features.hpp"
 
-namespace omnivert {
+namespace omnivert::eval {
 
 // Rotates `image` about `center` so that image angles change by +angle_rad (bilinear).
 cv::Mat rotate_about(const cv::Mat& image, const Eigen::Vector2d& center, double angle_rad);
@@ -41,4 +41,4 @@ std::vector<LinePairing> pair_lines(const FrameFeatures& original,
                                     double shift_rad,
                                     double tolerance_rad);
 
-}  // namespace omnivert
+}  // namespace omnivert::eval

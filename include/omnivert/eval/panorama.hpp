@@ -12,7 +12,7 @@
 
 #include "omnivert/core/mirror_circle.hpp"
 
-namespace omnivert {
+namespace omnivert::eval {
 
 struct PanoramaOptions {
   // Columns for 360 degrees. 0: a multiple of 360 close to the circumference at the middle
@@ -65,4 +65,4 @@ double ssd_per_pixel(const cv::Mat1f& a, const cv::Mat1f& b);
 // identical (or affinely brighter) patterns. 0 when either pattern is flat (no variance).
 double zncc(const cv::Mat1f& a, const cv::Mat1f& b);
 
-}  // namespace omnivert
+}  // namespace omnivert::eval

@@ -16,7 +16,7 @@
 #include "omnivert/core/camera_geometry.hpp"
 #include "omnivert/describe/feature_pipeline.hpp"
 
-namespace omnivert {
+namespace omnivert::eval {
 
 struct RealImageStudyOptions {
   FeaturePipelineOptions pipeline;
@@ -68,4 +68,4 @@ RealImageResult study_real_image(const std::string& label,
 std::string real_image_table(const std::vector<RealImageResult>& results);
 std::string real_image_csv(const std::vector<RealImageResult>& results);
 
-}  // namespace omnivert
+}  // namespace omnivert::eval

@@ -18,7 +18,7 @@
 #include "omnivert/describe/descriptor.hpp"
 #include "omnivert/eval/descriptor_study.hpp"
 
-namespace omnivert {
+namespace omnivert::eval {
 
 struct SensitivityStudyOptions {
   DescriptorOptions descriptor;  // the defaults each figure varies one setting of
@@ -34,4 +34,4 @@ void run_sensitivity_study(const StudySet& set,
                            const std::string& out_dir,
                            std::FILE* report);
 
-}  // namespace omnivert
+}  // namespace omnivert::eval

@@ -27,7 +27,7 @@
 #include "omnivert/describe/descriptor.hpp"
 #include "omnivert/eval/panorama.hpp"
 
-namespace omnivert {
+namespace omnivert::eval {
 
 struct Distinctiveness {
   double gap = 0.0;         // mean nearest off-band distance / median distance
@@ -63,4 +63,4 @@ SimilarityResult similarity_study(const cv::Mat& gray,
                                   const MirrorCircle& circle,
                                   const SimilarityOptions& options = {});
 
-}  // namespace omnivert
+}  // namespace omnivert::eval

@@ -43,7 +43,7 @@
 #include "omnivert/core/angles.hpp"
 #include "omnivert/match/tracks_io.hpp"
 
-namespace omnivert {
+namespace omnivert::eval {
 
 // One ground-truth vertical line visible in one frame.
 struct GroundTruthLine {
@@ -115,4 +115,4 @@ TrackingEvaluation evaluate_tracking(const std::vector<TrackRow>& tracks,
 std::string format_tracking_table(const TrackingEvaluation& evaluation,
                                   const std::string& title = "Recognition rate (Table 3)");
 
-}  // namespace omnivert
+}  // namespace omnivert::eval

@@ -40,10 +40,10 @@ struct CalibrateDatasetOptions {
   // The tracker; its odometry gate takes the wheel base of wheel0/sensor.yaml.
   TrackerOptions tracker = recommended_dataset_tracker_options();
   // The estimator's options: prior, models, filter, refinement, noise check. The wheel base and
-  // Chong-Kleeman K come from wheel0/sensor.yaml (calib::options_from_dataset); everything else
+  // Chong-Kleeman K come from wheel0/sensor.yaml (options_from_dataset); everything else
   // from here.
   calib::CalibrationOptions calibration = calib::recommended_options();
-  calib::DatasetRunOptions input;  // wheel gaps, crowded lines
+  DatasetRunOptions input;         // wheel gaps, crowded lines
   std::string tracks_file;         // non-empty: calibrate from this earlier tracks.csv
   bool force = false;              // write extrinsics.yaml even when undetermined
   std::string command;             // the command line, recorded in the report
@@ -61,11 +61,17 @@ struct CalibrateDatasetOptions {
   // Called while tracking (stage "track", frames done, frames in all) and once before the
   // calibration (stage "calibrate", 0, 0).
   std::function<void(const std::string& stage, std::size_t done, std::size_t total)> progress;
+
+  // The whole tree at once: features, tracker, calibration, input, tilt, frames, time offset.
+  // False with the reason in *why (may be null), which names the group first, e.g.
+  // "calibration options: noise.bearing_sigma must be > 0 [rad]". calibrate_dataset throws
+  // InputError("invalid " + why) when it is false.
+  bool IsValid(std::string* why) const;
 };
 
 struct CalibrateDatasetResult {
   calib::CalibrationResult calibration;
-  calib::DatasetRun input;  // what the estimator was given
+  DatasetRun input;  // what the estimator was given
   std::int64_t frames = 0, frames_skipped = 0, detections = 0;
   std::optional<calib::Extrinsics> truth;  // ground_truth/extrinsics.yaml, when present
   std::vector<std::string> warnings;       // tracking's, the input's and the estimate's

@@ -22,20 +22,26 @@
 #include "omnivert/dataset/dataset.hpp"
 #include "omnivert/match/tracks_io.hpp"
 
-namespace omnivert::calib {
+namespace omnivert::pipeline {
 
 struct DatasetRunOptions {
   double max_wheel_gap_s = 0.5;  // a wheel sample interval longer than this is a gap [s]
   int min_lines = 2;             // fewer tracked lines than this in a frame: starved
   double max_starved_s = 10.0;   // a starved stretch longer than this is warned about [s]
-  int min_track_length = 2;      // shorter tracks carry no parallax: left out
+  // Shorter tracks carry no parallax: left out of the input (the batch problems have their
+  // own, larger, calib::AssociationOptions::min_track_length).
+  int min_track_length = 2;
   // A crowded line's bearing (TrackRow::crowded: another edge within a few pixels all along
   // it) has its sigma multiplied by this (BearingObservation::sigma_scale).
   double crowded_sigma_scale = 1.0;
+
+  // True when every field is usable; otherwise false with the reason in *why (may be null),
+  // naming the field, e.g. "max_wheel_gap_s must be > 0 [s]".
+  bool IsValid(std::string* why) const;
 };
 
 struct DatasetRun {
-  CalibrationRun run;
+  calib::CalibrationRun run;
   std::vector<std::string> warnings;
   int frames_dropped_for_gaps = 0;   // frames whose bearings were dropped (wheel gap)
   int double_claims = 0;             // (frame, track) pairs dropped
@@ -56,6 +62,7 @@ DatasetRun calibration_run_from_tracks(const dataset::Dataset& data,
 
 // CalibrationOptions filled from the dataset: wheel base from wheel0/sensor.yaml, Chong-Kleeman K
 // from its odometry_k when given (else the default of CalibrationOptions), the rest from `base`.
-CalibrationOptions options_from_dataset(const dataset::Dataset& data, CalibrationOptions base = {});
+calib::CalibrationOptions options_from_dataset(const dataset::Dataset& data,
+                                               calib::CalibrationOptions base = {});
 
-}  // namespace omnivert::calib
+}  // namespace omnivert::pipeline

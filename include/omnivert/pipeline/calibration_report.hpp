@@ -15,7 +15,7 @@
 #include "omnivert/calib/calibrate.hpp"
 #include "omnivert/pipeline/calibration_input.hpp"
 
-namespace omnivert::calib {
+namespace omnivert::pipeline {
 
 // Errors of an estimate against the truth (angles wrapped).
 struct ErrorsVsTruth {
@@ -25,9 +25,9 @@ struct ErrorsVsTruth {
   double yaw = 0;                    // phi + psi [rad]
   double nees = 0;                   // e^T C^-1 e over (phi, rho, psi); inf if C is singular
 };
-ErrorsVsTruth errors_vs_truth(const Extrinsics& estimate,
+ErrorsVsTruth errors_vs_truth(const calib::Extrinsics& estimate,
                               const Eigen::Matrix3d& covariance,
-                              const Extrinsics& truth);
+                              const calib::Extrinsics& truth);
 
 // Everything the report shows, gathered by the caller.
 struct ReportInputs {
@@ -38,8 +38,8 @@ struct ReportInputs {
   std::int64_t detections = 0;
   std::int64_t tracks_total = 0;  // tracks found by the tracker
   const DatasetRun* run = nullptr;
-  CalibrationOptions options;
-  std::optional<Extrinsics> truth;  // ground_truth/extrinsics.yaml
+  calib::CalibrationOptions options;
+  std::optional<calib::Extrinsics> truth;  // ground_truth/extrinsics.yaml
   bool force = false;
   int exit_code = 0;
   double seconds_tracking = 0, seconds_calibration = 0;
@@ -60,14 +60,14 @@ struct ReportInputs {
 // One line on the noise check (docs/theory/noise-check.md), for the terminal and the
 // report: over how many tracks, the independent noise the errors act as, and what was done;
 // empty when no check was made.
-std::string noise_check_line(const CalibrationResult& result);
+std::string noise_check_line(const calib::CalibrationResult& result);
 // One line on the wheel check (WheelCheck): the wheels' turn scale and drift against the
 // robot's, and the verdict; empty when no check was made.
-std::string wheel_check_line(const CalibrationResult& result);
+std::string wheel_check_line(const calib::CalibrationResult& result);
 
 // summary.json's text (pretty-printed JSON).
-std::string summary_json(const CalibrationResult& result, const ReportInputs& inputs);
+std::string summary_json(const calib::CalibrationResult& result, const ReportInputs& inputs);
 // report.html's text: refers to convergence.png and tracks.png next to it.
-std::string report_html(const CalibrationResult& result, const ReportInputs& inputs);
+std::string report_html(const calib::CalibrationResult& result, const ReportInputs& inputs);
 
-}  // namespace omnivert::calib
+}  // namespace omnivert::pipeline

@@ -10,7 +10,7 @@
 #include "omnivert/describe/feature_pipeline.hpp"
 #include "omnivert/extract/tilt_estimator.hpp"
 
-namespace omnivert {
+namespace omnivert::pipeline {
 
 struct TiltCheckOptions {
   bool enabled = true;  // measure when the camera's xi and gamma are known
@@ -35,4 +35,4 @@ TiltEstimate measure_tilt(const dataset::Dataset& data,
 // The warning for an estimate above options.estimator.warn_deg, else an empty string.
 std::string tilt_warning(const TiltEstimate& tilt, const TiltCheckOptions& options, bool corrected);
 
-}  // namespace omnivert
+}  // namespace omnivert::pipeline

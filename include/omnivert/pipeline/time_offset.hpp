@@ -49,6 +49,9 @@ struct TimeOffsetOptions {
   // synchronised recording keeps its stamps (and its results) unchanged.
   double significance = 3.0;
   double min_applied_s = 0.02;
+
+  // True when every field is usable; otherwise false with the reason in *why (may be null).
+  bool IsValid(std::string* why) const;
 };
 
 struct TimeOffsetEstimate {

@@ -19,7 +19,7 @@
 #include "omnivert/match/tracks_io.hpp"
 #include "omnivert/pipeline/tilt_check.hpp"
 
-namespace omnivert {
+namespace omnivert::pipeline {
 
 struct TrackDatasetOptions {
   FeaturePipelineOptions pipeline;
@@ -62,4 +62,4 @@ TrackDatasetResult track_dataset(const dataset::Dataset& data,
 // and line.
 TrackDatasetResult read_tracks_for_dataset(const std::string& file, const dataset::Dataset& data);
 
-}  // namespace omnivert
+}  // namespace omnivert::pipeline

@@ -8,13 +8,13 @@
 
 #include "omnivert/calib/calibration_filter.hpp"
 
-namespace omnivert::calib {
+namespace omnivert::viz {
 
 // Fig. 25: two rows of three plots (phi [deg], rho [mm], psi [deg]; their sigmas), against
 // the frame number, with +-3 sigma dashed around the estimate, the truth and the refined
 // value (when given) as horizontal lines.
-cv::Mat draw_convergence(const std::vector<FrameEstimate>& history,
-                         const std::optional<Extrinsics>& truth = std::nullopt,
-                         const std::optional<Extrinsics>& refined = std::nullopt);
+cv::Mat draw_convergence(const std::vector<calib::FrameEstimate>& history,
+                         const std::optional<calib::Extrinsics>& truth = std::nullopt,
+                         const std::optional<calib::Extrinsics>& refined = std::nullopt);
 
-}  // namespace omnivert::calib
+}  // namespace omnivert::viz

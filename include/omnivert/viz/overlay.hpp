@@ -9,7 +9,7 @@
 #include "omnivert/describe/frame_features.hpp"
 #include "omnivert/extract/camera_estimate.hpp"
 
-namespace omnivert {
+namespace omnivert::viz {
 
 // Returns a BGR picture. `highlight` is the index of the line whose circular areas are drawn
 // (-1: the longest line).
@@ -24,4 +24,4 @@ cv::Mat draw_overlay(const cv::Mat& image,
 // the proposed mask excludes inside the annulus, tinted red.
 cv::Mat draw_camera_overlay(const cv::Mat& image, const CameraEstimate& estimate);
 
-}  // namespace omnivert
+}  // namespace omnivert::viz

@@ -8,7 +8,7 @@
 
 #include <opencv2/core.hpp>
 
-namespace omnivert {
+namespace omnivert::viz {
 
 struct HeatmapOptions {
   std::string title;
@@ -48,4 +48,4 @@ cv::Mat draw_plot(const std::vector<PlotSeries>& series, const PlotOptions& opti
 // A distinct colour for series i.
 cv::Scalar plot_color(int i);
 
-}  // namespace omnivert
+}  // namespace omnivert::viz

@@ -9,7 +9,7 @@
 
 #include "omnivert/match/tracks_io.hpp"
 
-namespace omnivert {
+namespace omnivert::viz {
 
 struct TrackPlotOptions {
   int width = 1600;  // pixels
@@ -30,4 +30,4 @@ void write_tracks_png(const std::filesystem::path& path,
                       const std::vector<TrackRow>& rows,
                       const TrackPlotOptions& options = {});
 
-}  // namespace omnivert
+}  // namespace omnivert::viz

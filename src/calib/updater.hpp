@@ -5,7 +5,7 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "omnivert/calib/filter_state.hpp"
+#include "calib/filter_state.hpp"
 #include "omnivert/calib/options.hpp"
 
 namespace omnivert::calib {

@@ -8,7 +8,7 @@
 
 #include <Eigen/Core>
 
-#include "omnivert/calib/filter_state.hpp"
+#include "calib/filter_state.hpp"
 #include "omnivert/calib/options.hpp"
 
 namespace omnivert::calib {

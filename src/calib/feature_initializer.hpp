@@ -8,7 +8,7 @@
 //     the camera, q_c ~ N(q0, sigma_q^2) spanning [1/max_distance, 1/min_distance] at
 //     two sigma; stored as (q = 1/D, theta) of the robot origin.
 
-#include "omnivert/calib/filter_state.hpp"
+#include "calib/filter_state.hpp"
 #include "omnivert/calib/options.hpp"
 
 namespace omnivert::calib {

@@ -10,22 +10,15 @@
 // (eq. 14-15 inverted) against the encoders, and the lateral slip, which a differential drive
 // cannot do (sigma `lateral_sigma`).
 
-#include <map>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "omnivert/calib/calibration_filter.hpp"
 #include "omnivert/calib/options.hpp"
+#include "omnivert/calib/types.hpp"
 
 namespace omnivert::calib {
-
-// A point of the batch problem.
-struct BatchPoint {
-  std::vector<Eigen::Vector3d> poses;       // one per frame, poses[0] = (0, 0, 0)
-  std::map<int, Eigen::Vector2d> features;  // track id -> world point
-  Extrinsics extrinsics;
-};
 
 // Dead-reckoned poses, eq. (14), from the encoder increments.
 std::vector<Eigen::Vector3d> dead_reckoning(const CalibrationRun& run, double wheel_base);
