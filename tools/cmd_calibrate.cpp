@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "check_options.hpp"
 #include "commands.hpp"
 #include "core/progress.hpp"
 #include "core/yaml_fields.hpp"
@@ -49,6 +50,7 @@ struct CalibrateArgs {
   TrackerFlags tracker;
   calib::RobotFrames frames;             // --base-frame, --camera-frame, --camera-height
   std::string time_offset = "estimate";  // --time-offset: "estimate" or seconds
+  CheckFlags check;                      // --check-reference, --check-frames, ...
 };
 
 // The prior from a YAML file: keys phi, rho, psi, sigma_phi, sigma_rho, sigma_psi [rad, m]
@@ -98,6 +100,9 @@ void run_calibrate(const CalibrateArgs& a) {
   o.tracks_file = a.tracks_file;
   o.force = a.force;
   o.frames = a.frames;
+  o.reprojection = check_options(a.check);
+  o.check_reference = a.check.reference != "auto" && a.check.reference != "none";
+  o.check_off = a.check.reference == "none";
   if (a.time_offset != "estimate") o.time_offset_s = std::stod(a.time_offset);
   if (!a.frames.camera_height && !a.prior_file.empty())
     o.frames.camera_height =
@@ -307,6 +312,7 @@ void add_calibrate_command(CLI::App& app) {
   add_prior_options(cmd, *a);
   add_model_options(cmd, *a);
   add_frame_options(cmd, *a);
+  add_check_options(cmd, a->check, "--check-");
   add_pipeline_options(cmd, a->pipeline);
   add_mask_option(cmd, a->mask);
   add_tilt_options(cmd, a->tilt);
