@@ -180,8 +180,8 @@ std::string LaserData::describe() const {
   char buf[300];
   std::snprintf(buf,
                 sizeof buf,
-                "%zu scans, %zu ranges, %zu of them no return (%zu nan or inf, the others outside "
-                "range_min..range_max)",
+                "%zu scans, %zu ranges, %zu of them no return (%zu not finite, the others "
+                "outside range_min..range_max)",
                 scans.size(),
                 ranges,
                 no_returns,

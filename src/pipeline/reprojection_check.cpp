@@ -381,9 +381,12 @@ std::string ReprojectionResult::json() const {
 }
 
 std::string ReprojectionResult::html(const std::string& png) const {
+  std::string text;  // the description, HTML-escaped (it may hold a file name)
+  for (const char ch : description)
+    text += ch == '<' ? "&lt;" : ch == '>' ? "&gt;" : ch == '&' ? "&amp;" : std::string(1, ch);
   std::string h =
       "<h2>Check by eye: reference corners on the image (the paper's Figs. 23 and 26)</h2>\n<p>" +
-      description +
+      text +
       ". Red ticks: the reference's corners, where vertical edges stand (orange: no extracted "
       "line within " +
       fmt("%g", rad2deg(gate)) +
