@@ -1,6 +1,7 @@
-// sensor_msgs/LaserScan imported into laser0/ from a bag written by python3-rosbag
-// (fixtures/make_laser_bag.py): the scans read back with the fixture's numbers, NaN and inf
-// ranges kept as no returns, and the scanner pose required.
+// sensor_msgs/LaserScan imported into laser0/ from a ROS 1 bag written by python3-rosbag
+// (fixtures/make_laser_bag.py) and a ROS 2 MCAP file written by @mcap/core and
+// @foxglove/rosmsg2-serialization (fixtures/make_laser_mcap.mjs): the scans read back with the
+// fixtures' numbers, NaN and inf ranges kept as no returns, and the scanner pose required.
 
 #include <unistd.h>
 
@@ -37,16 +38,20 @@ class LaserImport : public ::testing::Test {
     o.laser_pose = dataset::LaserSensor{0.12, -0.03, 0.05, 0.0};
   }
   void TearDown() override { fs::remove_all(dir); }
-  ImportSummary run() {
-    auto rec = open_recording(kFx + "/ros1_laser.bag");
+  ImportSummary run(const std::string& fixture = "ros1_laser.bag") {
+    auto rec = open_recording(kFx + "/" + fixture);
     return import_recording(*rec, o);
   }
+  // The fixtures' scans: 11 at 10 Hz from T0 + 30 ms, 8 rays over -90..90 degrees, ray i at
+  // 1 + 0.5 i + 0.01 k m, ray 2 NaN and ray 5 +inf. `stamp_ns`: the stamps' tolerance.
+  void check_scans(const std::string& fixture, double stamp_ns);
   fs::path dir;
   ImportOptions o;
 };
 
-TEST_F(LaserImport, ScansReadBackWithTheFixturesNumbers) {
-  const ImportSummary s = run();
+void LaserImport::check_scans(const std::string& fixture, double stamp_ns) {
+  fs::remove_all(o.out);
+  const ImportSummary s = run(fixture);
   EXPECT_EQ(s.laser_scans, 11u);
   const auto laser = dataset::load_laser(o.out);
   ASSERT_TRUE(laser.has_value());
@@ -77,6 +82,13 @@ TEST_F(LaserImport, ScansReadBackWithTheFixturesNumbers) {
     }
   }
 }
+
+TEST_F(LaserImport, Ros1BagScansReadBack) {
+  // python3-rosbag's stamps are doubles of seconds near 1.7e9: exact to a few hundred ns.
+  check_scans("ros1_laser.bag", 1000.0);
+}
+
+TEST_F(LaserImport, Ros2McapScansReadBack) { check_scans("ros2_laser.mcap", 0.0); }
 
 TEST_F(LaserImport, ScannerPoseIsRequired) {
   o.laser_pose.reset();
