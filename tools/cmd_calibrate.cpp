@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "check_options.hpp"
 #include "commands.hpp"
 #include "core/parallel.hpp"
 #include "core/progress.hpp"
@@ -45,6 +46,7 @@ struct CalibrateArgs {
   double crossing_guard_deg = rad2deg(calib::AssociationOptions{}.crossing_guard);
   TrackerFlags tracker;
   std::string time_offset = "estimate";  // --time-offset: "estimate" or seconds
+  CheckFlags check;                      // --check-reference, --check-frames, ...
 };
 
 // The prior from a YAML file: keys phi, rho, psi, sigma_phi, sigma_rho, sigma_psi [rad, m]
@@ -87,6 +89,9 @@ void run_calibrate(const CalibrateArgs& a) {
   pipeline::CalibrateDatasetOptions o = a.options;
   o.tracker = a.tracker.options();
   o.calibration = calibration_options(a);
+  o.reprojection = check_options(a.check);
+  o.check_reference = a.check.reference != "auto" && a.check.reference != "none";
+  o.check_off = a.check.reference == "none";
   if (a.time_offset != "estimate") o.time_offset_s = std::stod(a.time_offset);
   if (!o.frames.camera_height && !a.prior_file.empty())
     o.frames.camera_height =
@@ -302,6 +307,7 @@ void add_calibrate_command(CLI::App& app) {
   add_prior_options(cmd, *a);
   add_model_options(cmd, *a);
   add_frame_options(cmd, *a);
+  add_check_options(cmd, a->check, "--check-");
   add_pipeline_options(cmd, a->options.features);
   add_mask_option(cmd, a->options.mask);
   add_tilt_options(cmd, a->options.tilt);

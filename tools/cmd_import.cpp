@@ -22,6 +22,7 @@ struct ImportArgs {
   bool list = false;
   std::string wheel_joints;
   double odometry_k = -1;
+  std::vector<double> laser_pose;  // x, y, yaw
   recording::ImportOptions o;
 };
 
@@ -47,6 +48,8 @@ void run_import(ImportArgs& a) {
     a.o.right_joint = a.wheel_joints.substr(comma + 1);
   }
   if (a.odometry_k >= 0) a.o.odometry_k = a.odometry_k;
+  if (a.laser_pose.size() == 3)
+    a.o.laser_pose = dataset::LaserSensor{a.laser_pose[0], a.laser_pose[1], a.laser_pose[2], 0.0};
   std::unique_ptr<Progress> bar;
   a.o.progress = [&bar](std::uint64_t done, std::uint64_t total) {
     if (!bar) bar = std::make_unique<Progress>("import", static_cast<std::size_t>(total));
@@ -67,6 +70,7 @@ void run_import(ImportArgs& a) {
     std::printf(
         ", %zu wheel samples (%.3f to %.3f s)", s.wheel_samples, s.wheel_start_s, s.wheel_end_s);
   }
+  if (s.laser_scans > 0) std::printf(", %zu laser scans", s.laser_scans);
   std::printf("\nwrote %s\n", a.o.out.c_str());
 }
 
@@ -109,6 +113,10 @@ void add_import_command(CLI::App& app) {
                   "A pose or wheel step faster than this is refused as a jump or reset [m/s]")
       ->capture_default_str()
       ->check(kPositive);
+  cmd->add_option("--laser-topic", a->o.laser_topic, "sensor_msgs/LaserScan topic, into laser0/");
+  cmd->add_option(
+         "--laser-pose", a->laser_pose, "The scanner's pose on the robot: X Y [m] YAW [rad]")
+      ->expected(3);
   cmd->callback([a] { run_import(*a); });
 }
 

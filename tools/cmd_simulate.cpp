@@ -24,6 +24,7 @@ struct SimulateArgs {
   std::vector<double> ticks_per_meter;
   std::vector<double> reflection;
   std::vector<double> reflection_radii;
+  std::vector<double> laser_pose;
 };
 
 // World, trajectory, output and frames.
@@ -175,6 +176,33 @@ void add_overlay_options(CLI::App* cmd, SimulateArgs& a) {
       ->group(g);
 }
 
+// The 2D laser scanner (laser0/), off unless --laser.
+void add_laser_options(CLI::App* cmd, SimulateArgs& a) {
+  sim::LaserConfig& l = a.cfg.laser;
+  const std::string g = "Laser scanner (laser0/)";
+  cmd->add_flag("--laser", l.enabled, "Write laser0/: a 2D laser scanner's scans")->group(g);
+  cmd->add_option(
+         "--laser-pose", a.laser_pose, "Scanner pose on the robot: x [m], y [m], yaw [rad]")
+      ->expected(3)
+      ->group(g);
+  cmd->add_option("--laser-height", l.height, "Height of the scan plane [m]")
+      ->capture_default_str()
+      ->check(kPositive)
+      ->group(g);
+  cmd->add_option("--laser-rate", l.rate_hz, "Scans per second [Hz]")
+      ->capture_default_str()
+      ->check(kPositive)
+      ->group(g);
+  cmd->add_option("--laser-noise", l.noise_sigma, "Range noise sigma [m]")
+      ->capture_default_str()
+      ->check(kNonNegative)
+      ->group(g);
+  cmd->add_option("--laser-max-range", l.range_max, "Maximum range [m] (no return beyond)")
+      ->capture_default_str()
+      ->check(kPositive)
+      ->group(g);
+}
+
 void run_simulate(SimulateArgs& a) {
   sim::SimConfig& cfg = a.cfg;
   cfg.wheel.ticks = a.wheel_unit == "ticks";
@@ -193,6 +221,11 @@ void run_simulate(SimulateArgs& a) {
   if (a.reflection_radii.size() == 2) {
     cfg.overlay.reflection_r_inner_px = a.reflection_radii[0];
     cfg.overlay.reflection_r_outer_px = a.reflection_radii[1];
+  }
+  if (a.laser_pose.size() == 3) {
+    cfg.laser.x = a.laser_pose[0];
+    cfg.laser.y = a.laser_pose[1];
+    cfg.laser.yaw = a.laser_pose[2];
   }
   const sim::World world = sim::load_world(a.world);
   const sim::Trajectory trajectory = sim::load_trajectory(a.trajectory);
@@ -227,6 +260,7 @@ void add_simulate_command(CLI::App& app) {
   add_wheel_options(cmd, *args);
   add_image_sensor_options(cmd, *args);
   add_overlay_options(cmd, *args);
+  add_laser_options(cmd, *args);
   cmd->callback([args]() { run_simulate(*args); });
 }
 

@@ -63,6 +63,8 @@ void add_real_images_study(CLI::App* study);
 void add_calibrate_command(CLI::App& app);
 // omnivert import: a ROS 1 or ROS 2 recording into a dataset folder (tools/cmd_import.cpp).
 void add_import_command(CLI::App& app);
+// omnivert reproject: the check by eye of a mounting (tools/cmd_reproject.cpp).
+void add_reproject_command(CLI::App& app);
 
 // The command line as given (for reports), set by main().
 void set_command_line(int argc, char** argv);

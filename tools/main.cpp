@@ -52,6 +52,7 @@ int main(int argc, char** argv) {
   omnivert::cli::add_study_command(app);
   omnivert::cli::add_calibrate_command(app);
   omnivert::cli::add_import_command(app);
+  omnivert::cli::add_reproject_command(app);
   omnivert::cli::set_command_line(argc, argv);
 
   try {

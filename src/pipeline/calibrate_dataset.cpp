@@ -41,7 +41,8 @@ constexpr const char* kOutputs[] = {"extrinsics.yaml",
                                     "tracks.png",
                                     calib::kRobotFormatFiles[0],
                                     calib::kRobotFormatFiles[1],
-                                    calib::kRobotFormatFiles[2]};
+                                    calib::kRobotFormatFiles[2],
+                                    "reprojection.png"};
 
 std::string few_tracks_warning(int tracks, const FeaturePipelineOptions& features) {
   std::string w = "only " + std::to_string(tracks) +
@@ -104,6 +105,43 @@ ReportInputs::TimeOffset time_offset_report(const CalibrateDatasetResult& r) {
   return t;
 }
 
+// The check by eye (pipeline/reprojection.hpp): the reference's corners against the tracked
+// lines, with the prior and with the estimate; reprojection.png and the report's section.
+// A laser0/ found (not asked for) that cannot be used is a warning.
+void reprojection_check(const dataset::Dataset& data,
+                        const std::vector<TrackRow>& rows,
+                        const calib::Extrinsics& before,
+                        const calib::Extrinsics& after,
+                        const CalibrateDatasetOptions& o,
+                        calib::ReportInputs& ri,
+                        CalibrateDatasetResult& r) {
+  ReprojectionOptions ro = o.reprojection;
+  ro.features = o.features;
+  ro.mask = o.mask;
+  if (!o.check_reference) {
+    std::error_code ec;
+    if (o.check_off || !fs::is_directory(fs::path(data.root()) / "laser0", ec)) return;
+    ro.reference.source = ReferenceSource::kLaser;
+  }
+  try {
+    const References refs = load_references(data, ro.reference);
+    std::vector<std::vector<double>> lines(data.size());
+    for (const TrackRow& row : rows)
+      if (row.frame >= 0 && static_cast<std::size_t>(row.frame) < lines.size())
+        lines[static_cast<std::size_t>(row.frame)].push_back(row.bearing);
+    const ReprojectionResult c = check_reprojection(data, refs, lines, before, after, ro);
+    write_image_atomic((fs::path(r.out_dir) / "reprojection.png").string(), c.picture);
+    ri.reprojection_json = c.json();
+    ri.reprojection_html = c.html("reprojection.png");
+    r.reprojection_message = c.message();
+  } catch (const InputError& e) {
+    if (o.check_reference) throw;
+    r.warnings.push_back(std::string("the check by eye against laser0/ was not made: ") + e.what());
+    spdlog::warn("{}", r.warnings.back());
+    ri.warnings = r.warnings;
+  }
+}
+
 void prepare_out_dir(const std::string& out_dir) {
   std::error_code ec;
   fs::create_directories(out_dir, ec);
@@ -151,6 +189,9 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
     spdlog::warn("ground truth not used: {}", data.ground_truth_error());
   const calib::CalibrationOptions opt = options_from_dataset(data, o.calibration);
   if (!opt.IsValid(&why)) throw InputError("invalid calibration options: " + why);
+  if (!o.reprojection.IsValid(&why)) throw InputError("invalid check options: " + why);
+  // A reference asked for is checked before the work (bad input, exit code 2).
+  if (o.check_reference && !o.check_off) (void)load_references(data, o.reprojection.reference);
 
   // Read before the output folder is cleared: the tracks file may be out_dir/tracks.csv.
   std::optional<TrackDatasetResult> given;
@@ -232,6 +273,7 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
   r.time_offset_message =
       time_offset_line(r.time_offset, r.time_offset_given, r.time_offset_applied, o.time_offset);
   ri.time_offset = time_offset_report(r);
+  reprojection_check(data, tracked.rows, opt.prior.mean, result.extrinsics, o, ri, r);
   if (r.wrote_extrinsics) {
     calib::write_extrinsics_yaml((out / "extrinsics.yaml").string(), result);
     calib::write_robot_formats(out.string(), result.extrinsics, result.covariance, o.frames);
@@ -325,13 +367,15 @@ std::string CalibrateDatasetResult::BriefReport() const {
               o.rho.crlb * 1e3,
               rad2deg(o.psi.crlb));
   s += time_offset_message + "\n";
+  if (!reprojection_message.empty()) s += reprojection_message + "\n";
   if (truth) s += truth_lines(*this, refined);
   s += o.message + "\n";
   s += "results in " + out_dir + ": " +
        (wrote_extrinsics ? "extrinsics.yaml (and as camera_joint.urdf, "
                            "static_transform_publisher.sh, extrinsics_kalibr.yaml), "
                          : "") +
-       "report.html, summary.json, states.csv, convergence.png, tracks.csv, tracks.png\n";
+       "report.html, summary.json, states.csv, convergence.png, tracks.csv, tracks.png" +
+       (reprojection_message.empty() ? "" : ", reprojection.png") + "\n";
   return s;
 }
 

@@ -385,6 +385,7 @@ std::string summary_json(const calib::CalibrationResult& r, const ReportInputs& 
                         {"residual_scale", num(t.residual_scale)},
                         {"message", t.line}};
   }
+  if (!in.reprojection_json.empty()) j["reprojection"] = json::parse(in.reprojection_json);
   j["warnings"] = in.warnings;
   return j.dump(2) + "\n";
 }
@@ -535,6 +536,7 @@ std::string report_html(const calib::CalibrationResult& r, const ReportInputs& i
        "alt=\"phi, rho, psi and their sigmas against the frame\">\n";
   h << "<h2>Tracks (the paper's Fig. 22)</h2>\n<img src=\"tracks.png\" alt=\"bearing of every "
        "tracked line against the frame\">\n";
+  h << in.reprojection_html;
   h << "<p>Files: extrinsics.yaml, states.csv, tracks.csv, summary.json.</p>\n</body></html>\n";
   return h.str();
 }

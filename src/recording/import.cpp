@@ -1,4 +1,5 @@
 #include "omnivert/recording/import.hpp"
+#include "omnivert/recording/laser_scan.hpp"
 
 #include <unistd.h>
 
@@ -74,6 +75,11 @@ void check_options(const Recording& rec, const ImportOptions& o) {
   if (!o.joint_states_topic.empty())
     require_topic(rec, o.joint_states_topic, {"sensor_msgs/JointState"});
   if (!o.odometry_topic.empty()) require_topic(rec, o.odometry_topic, {"nav_msgs/Odometry"});
+  if (!o.laser_topic.empty()) {
+    if (!o.laser_pose)
+      throw InputError("--laser-topic needs --laser-pose X Y YAW: the scanner's pose on the robot");
+    require_topic(rec, o.laser_topic, {"sensor_msgs/LaserScan"});
+  }
 }
 
 double seconds(std::int64_t ns) { return static_cast<double>(ns) * 1e-9; }
@@ -132,6 +138,8 @@ ImportSummary import_recording(Recording& rec, const ImportOptions& o) {
   cam.close();
   write_camera_sensor(rec, o, c, tmp.path / "cam0");
   s.images = c.images.size();
+  if (!o.laser_topic.empty())
+    s.laser_scans = import_laser_scans(rec, o.laser_topic, *o.laser_pose, tmp.path);
 
   if (fs::exists(out, ec)) fs::remove_all(out);
   fs::rename(tmp.path, out);

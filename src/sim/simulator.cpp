@@ -385,6 +385,10 @@ void write_dataset(const World& world,
   write_simulation_settings(
       dir / "ground_truth" / "simulation.yaml", world, trajectory, cfg, start, times.count);
   write_frames(dir, renderer, motion, cfg, times, summary, progress);
+  if (cfg.laser.enabled) {
+    std::mt19937_64 laser_rng(cfg.seed * 2 + 3);
+    write_laser(dir.string(), world, motion, t_last, cfg.laser, cfg.start_ns, laser_rng);
+  }
   write_map(dir / "ground_truth" / "map.png", world, motion, cfg, t_last);
   summary.frames = times.count;
 }
@@ -406,6 +410,9 @@ SimSummary simulate(const World& world,
   }
   if (!(cfg.frame_rate > 0) || !(cfg.wheel.rate_hz > 0)) throw InputError("rates must be positive");
   if (std::string why; !cfg.overlay.IsValid(&why)) throw InputError("overlay: " + why);
+  if (cfg.laser.enabled) {
+    if (const std::string p = cfg.laser.validate(); !p.empty()) throw InputError("laser: " + p);
+  }
   if (cfg.wheel.odometry_k < 0) throw InputError("odometry_k must not be negative");
   if (!(cfg.wheel.wheel_base > 0) || !(cfg.wheel.true_wheel_base() > 0)) {
     throw InputError("the wheel base must be positive");

@@ -28,6 +28,7 @@
 #include "omnivert/describe/feature_pipeline.hpp"
 #include "omnivert/match/tracker.hpp"
 #include "omnivert/pipeline/calibration_input.hpp"
+#include "omnivert/pipeline/reprojection.hpp"
 #include "omnivert/pipeline/time_offset.hpp"
 #include "omnivert/pipeline/track_dataset.hpp"
 
@@ -58,6 +59,13 @@ struct CalibrateDatasetOptions {
   // calibration's input when significant (pipeline/time_offset.hpp, docs/calibration.md).
   std::optional<double> time_offset_s;
   TimeOffsetOptions time_offset;
+  // The check by eye (pipeline/reprojection.hpp), written as reprojection.png: against
+  // `reprojection.reference` when check_reference is set (bad references are then bad input),
+  // else against laser0/ when the dataset has it (a bad laser0/ is then a warning); none with
+  // check_off. Its gate and frames are those of `reprojection`; its extraction is `features`.
+  ReprojectionOptions reprojection;
+  bool check_reference = false;
+  bool check_off = false;
   // Called while tracking (stage "track", frames done, frames in all) and once before the
   // calibration (stage "calibrate", 0, 0).
   std::function<void(const std::string& stage, std::size_t done, std::size_t total)> progress;
@@ -82,7 +90,8 @@ struct CalibrateDatasetResult {
   bool tilt_corrected = false;        // the frames were rectified with tilt.vector
   TimeOffsetEstimate time_offset;     // estimated, or the given one (time_offset_given)
   bool time_offset_given = false, time_offset_applied = false;
-  std::string time_offset_message;  // time_offset_line(): the terminal's and the report's line
+  std::string time_offset_message;   // time_offset_line(): the terminal's and the report's line
+  std::string reprojection_message;  // the check by eye's line; empty when not made
 
   // The answer: the refinement's estimate when it ran and its covariance is usable, else the
   // filter's (the same as calibration.extrinsics / calibration.covariance).

@@ -55,6 +55,9 @@ struct ReportInputs {
     double residual_scale = 0;
     std::string line;  // time_offset_line(): the terminal's and the report's words
   } time_offset;
+  // The check by eye (pipeline/reprojection.hpp), when made: summary.json's "reprojection"
+  // object (JSON text) and report.html's section.
+  std::string reprojection_json, reprojection_html;
 };
 
 // One line on the noise check (docs/theory/noise-check.md), for the terminal and the

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "omnivert/dataset/laser.hpp"
 #include "omnivert/recording/recording.hpp"
 
 namespace omnivert::recording {
@@ -34,6 +35,10 @@ struct ImportOptions {
   // A cam0/sensor.yaml to copy (centre, annulus, mask); without it only the resolution and
   // the pixel format are written and `omnivert camera` finds the rest.
   std::string camera_sensor;
+  // sensor_msgs/LaserScan into laser0/ (recording/laser_scan.hpp), with the scanner's pose on
+  // the robot (required with the topic: the message does not hold it).
+  std::string laser_topic;
+  std::optional<dataset::LaserSensor> laser_pose;
   // A pose step faster than this is an odometry jump [m/s].
   double max_speed = 5.0;
   ProgressFn progress;
@@ -44,6 +49,7 @@ struct ImportSummary {
   std::size_t images = 0;          // written to cam0/
   std::size_t images_outside = 0;  // dropped: outside the odometry's time span
   std::size_t wheel_samples = 0;
+  std::size_t laser_scans = 0;       // written to laser0/
   std::size_t duplicate_stamps = 0;  // odometry samples dropped for repeating the previous stamp
   std::string image_encoding;        // "mono8", "png", ...
   int width = 0, height = 0;

@@ -3,6 +3,7 @@
 // dataset in the layout every omnivert tool reads (docs/simulator.md, dataset/dataset.hpp):
 //
 //   cam0/data.csv, cam0/data/<timestamp>.png, cam0/sensor.yaml (cam0/mask.png when asked)
+//   laser0/data.csv, laser0/sensor.yaml (when SimConfig::laser.enabled)
 //   wheel0/data.csv, wheel0/sensor.yaml
 //   ground_truth/extrinsics.yaml, poses.csv, lines.csv, edges.csv, world.yaml,
 //   ground_truth/simulation.yaml (every setting used, for reproduction)
@@ -15,6 +16,7 @@
 #include <string>
 
 #include "omnivert/sim/camera_model.hpp"
+#include "omnivert/sim/laser.hpp"
 #include "omnivert/sim/renderer.hpp"
 #include "omnivert/sim/robot_overlay.hpp"
 #include "omnivert/sim/sensors.hpp"
@@ -43,6 +45,7 @@ struct SimConfig {
   WheelConfig wheel;
   ImageSensor image;
   RobotOverlay overlay;        // struts and the robot's reflection in the image; none by default
+  LaserConfig laser;           // a 2D laser scanner (laser0/); off by default
   double min_clearance = 0.2;  // the robot centre keeps this far from every wall [m]
   double min_line_px = 2.0;    // ground-truth lines shorter than this (radially) are left out
 };
