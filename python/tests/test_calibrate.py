@@ -27,8 +27,9 @@ def yaml_values(path):
 
 def test_calibrate_dataset_same_as_cli(demo_run, tmp_path):
     cli("calibrate", demo_run, "--out", tmp_path / "cli", "--refine")
+    calls = []
     r = omnivert.calibrate_dataset(str(demo_run), str(tmp_path / "py"), refine=True,
-                                   progress=False)
+                                   progress=lambda *a: calls.append(a))
     expected = yaml_values(tmp_path / "cli" / "extrinsics.yaml")
     e = r.extrinsics
     printed = {"phi": e.phi, "rho": e.rho, "psi": e.psi, "x": e.position[0],
@@ -47,6 +48,7 @@ def test_calibrate_dataset_same_as_cli(demo_run, tmp_path):
             s.pop(key)
         s.get("inputs", {}).pop("seconds", None)
     assert r.summary == cli_summary
+    assert calls[-1] == ("calibrate", 0, 0) and ("track", 93, 93) in calls
     assert r.observable and r.calibration.source == "refinement"
     assert r.covariance.shape == (3, 3)
     assert r.calibration.observability.phi.determined
