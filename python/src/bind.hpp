@@ -101,7 +101,7 @@ py::dict options_dict(const OptionTable<O>& table, O defaults) {
 // The `progress` keyword of a long call: None prints "stage done/total" on stderr when it is a
 // terminal, False prints nothing, a callable is called as progress(stage, done, total). The
 // returned function may be called without the GIL; it takes it, and raises KeyboardInterrupt
-// (through py::error_already_set) when Ctrl-C was pressed.
+// (through py::error_already_set) when Ctrl-C was pressed, whatever `progress` is.
 std::function<void(const std::string&, std::size_t, std::size_t)> progress_reporter(
     const py::object& progress);
 

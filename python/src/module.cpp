@@ -21,24 +21,21 @@ void reject_unknown(const py::dict& kwargs, const char* call) {
 
 std::function<void(const std::string&, std::size_t, std::size_t)> progress_reporter(
     const py::object& progress) {
-  if (!progress.is_none() && !PyCallable_Check(progress.ptr())) {
-    if (!progress.cast<bool>()) return {};
+  const bool callable = PyCallable_Check(progress.ptr()) != 0;
+  if (!progress.is_none() && !callable && progress.cast<bool>())
     throw py::type_error("progress: expected None, False or a callable");
-  }
-  const bool terminal = progress.is_none() && isatty(STDERR_FILENO) != 0;
-  if (progress.is_none() && !terminal) return {};
-  // Shared with the library's threads only through the GIL.
-  auto callback = std::make_shared<py::object>(progress);
-  return [callback, terminal](const std::string& stage, std::size_t done, std::size_t total) {
+  const bool print = progress.is_none() && isatty(STDERR_FILENO) != 0;
+  // Released with the GIL held: the last reference is the caller's copy of this function.
+  auto callback = callable ? std::make_shared<py::object>(progress) : nullptr;
+  return [callback, print](const std::string& stage, std::size_t done, std::size_t total) {
     py::gil_scoped_acquire gil;
-    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-    if (!terminal) {
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();  // Ctrl-C
+    if (callback) {
       (*callback)(stage, done, total);
-      return;
+    } else if (print && total > 0) {
+      std::fprintf(stderr, "\r%s %zu/%zu%s", stage.c_str(), done, total, done == total ? "\n" : "");
+      std::fflush(stderr);
     }
-    if (total == 0) return;
-    std::fprintf(stderr, "\r%s %zu/%zu%s", stage.c_str(), done, total, done == total ? "\n" : "");
-    std::fflush(stderr);
   };
 }
 

@@ -1,6 +1,7 @@
 """The module's conventions: keyword options with the command-line tool's defaults, the
 InputError class, the simulator, the camera geometry."""
 import re
+import signal
 
 import numpy as np
 import pytest
@@ -65,6 +66,18 @@ def test_simulate_writes_a_dataset(tmp_path):
     with pytest.raises(omnivert.InputError) as e:
         omnivert.simulate(str(tmp_path / "w2"), world="moon")
     assert str(e.value) in err
+
+
+def test_interrupted_simulation_leaves_no_dataset(tmp_path):
+    def interrupt(stage, done, total):
+        assert stage == "simulate" and total == 12
+        if done == 3:
+            signal.raise_signal(signal.SIGINT)
+
+    with pytest.raises(KeyboardInterrupt):
+        omnivert.simulate(str(tmp_path / "run"), frames=12, progress=interrupt)
+    assert not (tmp_path / "run").exists()
+    assert [p.name for p in tmp_path.iterdir()] == []
 
 
 def test_camera_geometry():

@@ -67,6 +67,24 @@ def test_image_layouts_give_the_same_lines(short_run):
             np.testing.assert_array_equal(f.descriptors, ref.descriptors)
 
 
+def test_threads_extract_in_parallel_with_the_same_result(short_run):
+    """process releases the GIL: pipelines of two threads run at once, each its own."""
+    from concurrent.futures import ThreadPoolExecutor
+    ds = omnivert.Dataset(str(short_run))
+    images = [ds.image(i) for i in range(len(ds))]
+
+    def run(_):
+        pipe = omnivert.FeaturePipeline(ds.camera)
+        return [pipe.process(im).bearings for im in images]
+
+    ref = run(0)
+
+    with ThreadPoolExecutor(2) as pool:
+        for got in pool.map(run, range(4)):
+            for g, r in zip(got, ref):
+                np.testing.assert_array_equal(g, r)
+
+
 def test_descriptor_view_is_read_only(short_run):
     f = omnivert.extract(omnivert.read_image(str(first_frame(short_run))))
     with pytest.raises(ValueError):
