@@ -190,7 +190,10 @@ void bind_results(py::module_& m) {
                                d["checked"] = n.checked;
                                d["applied"] = n.applied;
                                d["verdict"] = verdict_name(n.verdict);
-                               d["scale"] = n.check.scale;
+                               // None, not NaN, when the check was not made.
+                               d["scale"] = std::isfinite(n.check.scale)
+                                                ? py::object(py::float_(n.check.scale))
+                                                : py::object(py::none());
                                d["ratio"] = n.ratio;
                                d["line"] = calib::noise_check_line(c.result);
                                return d;

@@ -1,6 +1,7 @@
 """Frame features through Python against `omnivert extract --json` on the same image, the
 image layouts numpy gives, and bad images."""
 import json
+import pathlib
 
 import numpy as np
 import pytest
@@ -100,6 +101,23 @@ def test_descriptor_view_is_read_only(short_run):
 def test_bad_arrays_raise_input_error(image, words):
     with pytest.raises(omnivert.InputError, match=words):
         omnivert.extract(image)
+
+
+@pytest.mark.parametrize("name", ["one-pixel.png", "black.png", "noise.png", "gradient.png"])
+def test_hostile_images_raise_or_give_finite_lines(name):
+    """The CLI's hostile images (tests/tools/data): an InputError with the reason, or lines
+    without a NaN."""
+    path = pathlib.Path(__file__).parents[2] / "tests" / "tools" / "data" / name
+    image = omnivert.read_image(str(path))
+    try:
+        f = omnivert.extract(image)
+    except omnivert.InputError as e:
+        assert str(e).startswith("image: ") and len(str(e)) > 12
+        cli("extract", path, expect=2)
+        return
+    assert np.isfinite(f.bearings).all() and np.isfinite(f.descriptors).all()
+    assert np.isfinite(f.center).all()
+    cli("extract", path)
 
 
 def test_wrong_size_raises_the_cli_message(short_run, tmp_path):
