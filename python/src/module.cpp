@@ -47,9 +47,10 @@ py::dict defaults(const std::string& call) {
   auto add = [&d](const py::dict& part) {
     for (const auto& kv : part) d[kv.first] = kv.second;
   };
-  if (call == "extract" || call == "FeaturePipeline" || call == "calibrate_dataset")
+  const bool job = call == "calibrate_dataset" || call == "track_dataset";
+  if (call == "extract" || call == "FeaturePipeline" || job)
     add(options_dict(extraction_table(), FeaturePipelineOptions{}));
-  if (call == "Tracker" || call == "calibrate_dataset") {
+  if (call == "Tracker" || job) {
     d["rules"] = "recommended";
     add(options_dict(tracker_table(), recommended_dataset_tracker_options()));
   }
@@ -59,6 +60,7 @@ py::dict defaults(const std::string& call) {
     add(options_dict(calibration_table(), calib::recommended_options()));
   if (call == "calibrate_dataset")
     add(options_dict(dataset_job_table(), pipeline::CalibrateDatasetOptions{}));
+  if (call == "track_dataset") add(options_dict(track_job_table(), TrackDatasetOptions{}));
   if (call == "simulate") add(options_dict(simulation_table(), sim::SimConfig{}));
   if (d.empty()) throw py::value_error("defaults(): no call named '" + call + "'");
   return d;
@@ -90,12 +92,13 @@ PYBIND11_MODULE(omnivert, m) {
       PyErr_SetObject(input_error.ptr(), err.ptr());
     }
   });
-  m.def("defaults",
-        &defaults,
-        py::arg("call"),
-        "The keyword options of a call ('extract', 'FeaturePipeline', 'Tracker', 'calibrate', "
-        "'CalibrationFilter', 'calibrate_dataset', 'simulate') with their defaults: the "
-        "command-line tool's.");
+  m.def(
+      "defaults",
+      &defaults,
+      py::arg("call"),
+      "The keyword options of a call ('extract', 'FeaturePipeline', 'Tracker', 'track_dataset', "
+      "'calibrate', 'CalibrationFilter', 'calibrate_dataset', 'simulate') with their defaults: the "
+      "command-line tool's.");
 
   bind_core(m);
   bind_features(m);

@@ -327,6 +327,25 @@ const OptionTable<DO>& dataset_job_table() {
   return t;
 }
 
+const OptionTable<TrackDatasetOptions>& track_job_table() {
+  using TD = TrackDatasetOptions;
+  static const OptionTable<TD> t{
+      field<std::string, TD>(
+          "mask", "image mask file instead of sensor.yaml's mask:", [](TD & o) -> auto& {
+            return o.mask;
+          }),
+      field<bool, TD>(
+          "tilt_check", "measure the tilt of the mirror axis before tracking", [](TD & o) -> auto& {
+            return o.tilt.enabled;
+          }),
+      field<double, TD>(
+          "tilt_correct_above", "rectify the frames above this tilt [deg]", [](TD & o) -> auto& {
+            return o.tilt.correct_deg;
+          }),
+  };
+  return t;
+}
+
 const OptionTable<SC>& simulation_table() {
   static const OptionTable<SC> t{
       field<std::uint64_t, SC>(

@@ -9,6 +9,7 @@
 #include "omnivert/describe/feature_pipeline.hpp"
 #include "omnivert/match/tracker.hpp"
 #include "omnivert/pipeline/calibrate_dataset.hpp"
+#include "omnivert/pipeline/track_dataset.hpp"
 #include "omnivert/sim/simulator.hpp"
 
 namespace omnivert::python {
@@ -25,6 +26,8 @@ const OptionTable<calib::CalibrationOptions>& calibration_table();
 const OptionTable<calib::CalibrationOptions>& robot_table();
 // calibrate_dataset's own: input checks, output files, time offset, tilt, mask.
 const OptionTable<pipeline::CalibrateDatasetOptions>& dataset_job_table();
+// track_dataset's own: mask and tilt.
+const OptionTable<TrackDatasetOptions>& track_job_table();
 // The simulator's settings: `omnivert simulate`'s flags.
 const OptionTable<sim::SimConfig>& simulation_table();
 

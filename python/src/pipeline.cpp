@@ -1,12 +1,16 @@
 // Bindings of the main jobs: calibrate_dataset (pipeline/calibrate_dataset.hpp, what `omnivert
 // calibrate` runs) and simulate (sim/simulator.hpp, what `omnivert simulate` runs).
 
+#include <filesystem>
+
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
 #include "bind.hpp"
 #include "omnivert/pipeline/calibrate_dataset.hpp"
+#include "omnivert/pipeline/track_dataset.hpp"
 #include "omnivert/sim/simulator.hpp"
+#include "omnivert/viz/tracks_plot.hpp"
 #include "options.hpp"
 #include "results.hpp"
 
@@ -59,6 +63,88 @@ DatasetCalibration calibrate_dataset(const std::string& dataset,
   r.summary = py::module_::import("json").attr("loads")(
       py::module_::import("pathlib").attr("Path")(path).attr("read_text")("utf-8"));
   return r;
+}
+
+// tracks.csv's columns as numpy arrays.
+py::dict track_columns(const std::vector<TrackRow>& rows) {
+  const auto n = static_cast<py::ssize_t>(rows.size());
+  py::array_t<std::int64_t> frame(n), stamp(n), id(n), matched_frame(n);
+  py::array_t<double> bearing(n), angle(n), r_inner(n), r_outer(n), distance(n);
+  py::array_t<int> edge_pixels(n), line(n), matched_line(n);
+  py::array_t<bool> crowded(n);
+  for (py::ssize_t i = 0; i < n; ++i) {
+    const TrackRow& r = rows[static_cast<std::size_t>(i)];
+    frame.mutable_at(i) = r.frame;
+    stamp.mutable_at(i) = r.timestamp_ns;
+    id.mutable_at(i) = r.track_id;
+    bearing.mutable_at(i) = r.bearing;
+    angle.mutable_at(i) = r.image_angle;
+    edge_pixels.mutable_at(i) = r.edge_pixels;
+    r_inner.mutable_at(i) = r.r_inner;
+    r_outer.mutable_at(i) = r.r_outer;
+    matched_frame.mutable_at(i) = r.matched_frame;
+    distance.mutable_at(i) = r.distance;
+    line.mutable_at(i) = r.line;
+    matched_line.mutable_at(i) = r.matched_line;
+    crowded.mutable_at(i) = r.crowded;
+  }
+  py::dict d;
+  d["frame"] = frame;
+  d["timestamp_ns"] = stamp;
+  d["track_id"] = id;
+  d["bearing"] = bearing;
+  d["image_angle"] = angle;
+  d["edge_pixels"] = edge_pixels;
+  d["r_inner"] = r_inner;
+  d["r_outer"] = r_outer;
+  d["matched_frame"] = matched_frame;
+  d["distance"] = distance;
+  d["line"] = line;
+  d["matched_line"] = matched_line;
+  d["crowded"] = crowded;
+  return d;
+}
+
+// `omnivert track DATASET [--out OUT]`: tracks.csv's rows as arrays, the counters, the warnings.
+py::dict track_dataset(const std::string& dataset,
+                       const py::object& out,
+                       const py::object& progress,
+                       py::kwargs kw) {
+  const char* call = "track_dataset";
+  py::dict kwargs = kw;
+  TrackDatasetOptions o;
+  apply_options(extraction_table(), o.pipeline, kwargs, call);
+  o.tracker = tracker_from_kwargs(kwargs, 0.0, true, call);
+  apply_options(track_job_table(), o, kwargs, call);
+  reject_unknown(kwargs, call);
+  check_valid(o.pipeline);
+  const auto report = progress_reporter(progress);
+  std::function<void(std::size_t, std::size_t)> each;
+  if (report)
+    each = [&report](std::size_t done, std::size_t total) { report("track", done, total); };
+  const std::string dir = out.is_none() ? std::string() : out.cast<std::string>();
+  TrackDatasetResult r;
+  {
+    py::gil_scoped_release release;
+    dataset::LoadOptions lo;
+    lo.require_wheel = false;
+    lo.allow_missing_images = true;  // a missing frame is warned about and tracked with no lines
+    r = omnivert::track_dataset(dataset::Dataset::load(dataset, lo), o, each);
+    if (!dir.empty()) {
+      std::error_code ec;
+      std::filesystem::create_directories(dir, ec);
+      if (ec) throw InputError(dir, 0, "cannot create the output folder: " + ec.message());
+      write_tracks_csv(std::filesystem::path(dir) / "tracks.csv", r.rows);
+      write_tracks_png(std::filesystem::path(dir) / "tracks.png", r.rows);
+    }
+  }
+  py::dict d;
+  d["tracks"] = track_columns(r.rows);
+  d["stats"] = stats_dict(r.stats);
+  d["frames"] = r.frames;
+  d["frames_skipped"] = r.frames_skipped;
+  d["warnings"] = r.warnings;
+  return d;
 }
 
 py::dict simulate(const std::string& out,
@@ -148,6 +234,15 @@ void bind_pipeline(py::module_& m) {
          "progress(stage, done, total). Keyword options (the CLI's flags and defaults):\n" +
          doc)
             .c_str());
+  m.def("track_dataset",
+        &track_dataset,
+        py::arg("dataset"),
+        py::arg("out") = py::none(),
+        py::arg("progress") = py::none(),
+        "The lines of a dataset tracked, as `omnivert track DATASET --out OUT` (tracks.csv and "
+        "tracks.png written into out when given): a dict with tracks (tracks.csv's columns as "
+        "arrays), stats, frames, frames_skipped, warnings. Keyword options: the extraction's, "
+        "rules and the tracker's, mask, tilt_check, tilt_correct_above (as calibrate_dataset).");
   m.def("simulate",
         &simulate,
         py::arg("out"),

@@ -8,6 +8,7 @@
 
 #include "bind.hpp"
 #include "omnivert/calib/calibrate.hpp"
+#include "omnivert/match/tracker.hpp"
 
 namespace omnivert::python {
 
@@ -20,5 +21,8 @@ struct Calibration {
 // states.csv's columns as numpy arrays (frame, phi, rho, psi, sigma_phi, sigma_rho,
 // sigma_psi, features, updates, rejected, new, guarded).
 py::dict history_dict(const std::vector<calib::FrameEstimate>& history);
+
+// The tracker's counters (TrackerStats) as a dict (tracking.cpp).
+py::dict stats_dict(const TrackerStats& stats);
 
 }  // namespace omnivert::python

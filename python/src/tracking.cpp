@@ -8,6 +8,7 @@
 #include "omnivert/dataset/dataset.hpp"
 #include "omnivert/match/tracker.hpp"
 #include "options.hpp"
+#include "results.hpp"
 
 namespace omnivert::python {
 
@@ -47,6 +48,8 @@ Assignments add_frame(PyTracker& t, const FrameFeatures* frame, double d_right, 
   return a;
 }
 
+}  // namespace
+
 py::dict stats_dict(const TrackerStats& s) {
   py::dict d;
   d["frames"] = s.frames;
@@ -64,6 +67,8 @@ py::dict stats_dict(const TrackerStats& s) {
   d["rejected_fork"] = s.rejected_fork;
   return d;
 }
+
+namespace {
 
 void bind_tracker(py::module_& m) {
   py::class_<Assignments>(

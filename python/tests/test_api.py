@@ -24,7 +24,8 @@ def help_defaults(command):
 
 
 @pytest.mark.parametrize("call,command", [("calibrate_dataset", "calibrate"),
-                                          ("simulate", "simulate"), ("extract", "extract")])
+                                          ("simulate", "simulate"), ("extract", "extract"),
+                                          ("track_dataset", "track")])
 def test_defaults_are_the_cli_defaults(call, command):
     flags = help_defaults(command)
     compared = 0
@@ -33,7 +34,8 @@ def test_defaults_are_the_cli_defaults(call, command):
             continue
         assert float(flags[name]) == pytest.approx(value, rel=1e-9), name
         compared += 1
-    assert compared >= {"calibrate_dataset": 10, "simulate": 15, "extract": 8}[call]
+    assert compared >= {"calibrate_dataset": 10, "simulate": 15, "extract": 8,
+                        "track_dataset": 9}[call]
 
 
 def test_input_error_is_a_value_error():

@@ -51,6 +51,24 @@ def test_frame_by_frame_tracking_same_as_cli(short_run, tmp_path):
     assert len(plain.add_frame(None)) == 0
 
 
+def test_track_dataset_same_as_cli(short_run, tmp_path):
+    cli("track", short_run, "--out", tmp_path / "cli")
+    r = omnivert.track_dataset(str(short_run), str(tmp_path / "py"), progress=False)
+    assert ((tmp_path / "py" / "tracks.csv").read_text()
+            == (tmp_path / "cli" / "tracks.csv").read_text())
+    with open(tmp_path / "cli" / "tracks.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert r["tracks"]["track_id"].tolist() == [int(x["track_id"]) for x in rows]
+    assert r["frames"] == 12 and r["stats"]["lines"] == len(rows)
+    # The paper's rules give other tracks (no gate, F1 1.05), as `track --rules paper`.
+    cli("track", short_run, "--out", tmp_path / "paper", "--rules", "paper")
+    p = omnivert.track_dataset(str(short_run), str(tmp_path / "py-paper"), rules="paper",
+                               progress=False)
+    assert ((tmp_path / "py-paper" / "tracks.csv").read_text()
+            == (tmp_path / "paper" / "tracks.csv").read_text())
+    assert p["stats"]["rejected_gate"] == 0
+
+
 def test_missing_wheel_data_same_message_as_cli(short_run, tmp_path):
     broken = tmp_path / "broken"
     shutil.copytree(short_run, broken)
