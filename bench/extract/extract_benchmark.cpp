@@ -9,6 +9,8 @@
 // Report: median real time per frame (run with --benchmark_repetitions=9
 // --benchmark_report_aggregates_only=true).
 
+#include <cstdlib>
+
 #include <benchmark/benchmark.h>
 #include <opencv2/features2d.hpp>
 #include <opencv2/line_descriptor.hpp>
@@ -17,6 +19,7 @@
 
 #include "omnivert/core/angles.hpp"
 #include "omnivert/describe/feature_pipeline.hpp"
+#include "omnivert/image/image_io.hpp"
 #include "omnivert/sim/radial_pattern.hpp"
 
 namespace {
@@ -148,6 +151,28 @@ void BM_Descriptors_Masked(benchmark::State& state) {
   state.counters["lines"] = static_cast<double>(lines.size());
 }
 BENCHMARK(BM_Descriptors_Masked)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The front end on an image file with its sensor.yaml (environment OMNIVERT_BENCH_IMAGE and
+// OMNIVERT_BENCH_SENSOR; skipped without them): the C++ side of the Python module's overhead
+// (python/bench/extract_overhead.py times FeaturePipeline.process on the same file).
+void BM_FrontEnd_File(benchmark::State& state) {
+  const char* image_path = std::getenv("OMNIVERT_BENCH_IMAGE");
+  const char* sensor_path = std::getenv("OMNIVERT_BENCH_SENSOR");
+  if (image_path == nullptr || sensor_path == nullptr) {
+    state.SkipWithError("OMNIVERT_BENCH_IMAGE and OMNIVERT_BENCH_SENSOR not set");
+    return;
+  }
+  const cv::Mat image = read_image(image_path);
+  FeaturePipeline pipe(load_camera_geometry(sensor_path));
+  FrameFeatures f;
+  pipe.process(image, f);  // first frame: rim estimation
+  for (auto _ : state) {
+    pipe.process(image, f);
+    benchmark::DoNotOptimize(f.descriptors.data());
+  }
+  state.counters["lines"] = static_cast<double>(f.lines.size());
+}
+BENCHMARK(BM_FrontEnd_File)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
 
 void BM_Peer_ORB(benchmark::State& state) {
   auto orb = cv::ORB::create(500);
