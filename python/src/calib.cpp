@@ -106,11 +106,11 @@ calib::CalibrationRun run_of(const py::array_t<double, py::array::forcecast>& in
 }
 
 py::object summary_of(const Calibration& c) {
-  calib::ReportInputs in;
+  pipeline::ReportInputs in;
   in.options = c.options;
   in.truth = c.truth;
   in.exit_code = c.result.observable() ? 0 : 3;
-  return py::module_::import("json").attr("loads")(calib::summary_json(c.result, in));
+  return py::module_::import("json").attr("loads")(pipeline::summary_json(c.result, in));
 }
 
 void bind_results(py::module_& m) {

@@ -327,8 +327,8 @@ const OptionTable<DO>& dataset_job_table() {
   return t;
 }
 
-const OptionTable<TrackDatasetOptions>& track_job_table() {
-  using TD = TrackDatasetOptions;
+const OptionTable<pipeline::TrackDatasetOptions>& track_job_table() {
+  using TD = pipeline::TrackDatasetOptions;
   static const OptionTable<TD> t{
       field<std::string, TD>(
           "mask", "image mask file instead of sensor.yaml's mask:", [](TD & o) -> auto& {

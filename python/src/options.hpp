@@ -27,7 +27,7 @@ const OptionTable<calib::CalibrationOptions>& robot_table();
 // calibrate_dataset's own: input checks, output files, time offset, tilt, mask.
 const OptionTable<pipeline::CalibrateDatasetOptions>& dataset_job_table();
 // track_dataset's own: mask and tilt.
-const OptionTable<TrackDatasetOptions>& track_job_table();
+const OptionTable<pipeline::TrackDatasetOptions>& track_job_table();
 // The simulator's settings: `omnivert simulate`'s flags.
 const OptionTable<sim::SimConfig>& simulation_table();
 

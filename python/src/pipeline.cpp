@@ -112,7 +112,7 @@ py::dict track_dataset(const std::string& dataset,
                        py::kwargs kw) {
   const char* call = "track_dataset";
   py::dict kwargs = kw;
-  TrackDatasetOptions o;
+  pipeline::TrackDatasetOptions o;
   apply_options(extraction_table(), o.pipeline, kwargs, call);
   o.tracker = tracker_from_kwargs(kwargs, 0.0, true, call);
   apply_options(track_job_table(), o, kwargs, call);
@@ -123,19 +123,19 @@ py::dict track_dataset(const std::string& dataset,
   if (report)
     each = [&report](std::size_t done, std::size_t total) { report("track", done, total); };
   const std::string dir = out.is_none() ? std::string() : out.cast<std::string>();
-  TrackDatasetResult r;
+  pipeline::TrackDatasetResult r;
   {
     py::gil_scoped_release release;
     dataset::LoadOptions lo;
     lo.require_wheel = false;
     lo.allow_missing_images = true;  // a missing frame is warned about and tracked with no lines
-    r = omnivert::track_dataset(dataset::Dataset::load(dataset, lo), o, each);
+    r = pipeline::track_dataset(dataset::Dataset::load(dataset, lo), o, each);
     if (!dir.empty()) {
       std::error_code ec;
       std::filesystem::create_directories(dir, ec);
       if (ec) throw InputError(dir, 0, "cannot create the output folder: " + ec.message());
       write_tracks_csv(std::filesystem::path(dir) / "tracks.csv", r.rows);
-      write_tracks_png(std::filesystem::path(dir) / "tracks.png", r.rows);
+      viz::write_tracks_png(std::filesystem::path(dir) / "tracks.png", r.rows);
     }
   }
   py::dict d;

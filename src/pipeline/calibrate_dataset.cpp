@@ -113,7 +113,7 @@ void reprojection_check(const dataset::Dataset& data,
                         const calib::Extrinsics& before,
                         const calib::Extrinsics& after,
                         const CalibrateDatasetOptions& o,
-                        calib::ReportInputs& ri,
+                        ReportInputs& ri,
                         CalibrateDatasetResult& r) {
   ReprojectionOptions ro = o.reprojection;
   ro.features = o.features;
