@@ -31,12 +31,15 @@ struct SimulatedRun {
   std::string world, trajectory;
   std::uint64_t seed = 1;
   int frames = 0;  // 0: the whole trajectory
+  // The camera mount (--phi, --rho, --psi); empty: the simulator's default.
+  std::optional<sim::Extrinsics> extrinsics = std::nullopt;
 };
 
 inline void simulate_into(const SimulatedRun& run, const fs::path& dir) {
   sim::SimConfig cfg;
   cfg.seed = run.seed;
   cfg.max_frames = run.frames;
+  if (run.extrinsics) cfg.extrinsics = *run.extrinsics;
   sim::simulate(
       sim::load_world(run.world), sim::load_trajectory(run.trajectory), cfg, dir.string(), true);
 }
