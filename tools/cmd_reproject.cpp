@@ -5,12 +5,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 #include <spdlog/spdlog.h>
 #include <yaml-cpp/yaml.h>
 
 #include "check_options.hpp"
 #include "commands.hpp"
+#include "core/progress.hpp"
 #include "core/yaml_fields.hpp"
 #include "omnivert/core/error.hpp"
 #include "omnivert/image/image_io.hpp"
@@ -68,8 +70,14 @@ void run_reproject(const ReprojectArgs& a) {
           "a list of vertical corners (docs/calibration.md#checking-the-result-by-eye)");
   }
   const pipeline::References refs = pipeline::load_references(data, o.reference);
+  std::optional<Progress> bar;
+  o.progress = [&bar](std::size_t done, std::size_t total) {
+    if (!bar) bar.emplace("extract", total);
+    bar->update(done);
+  };
   const pipeline::ReprojectionResult r =
       pipeline::check_reprojection(data, refs, {}, before, after, o);
+  if (bar) bar->finish();
   write_image_atomic(a.out, r.picture);
   std::printf("%s\n%s\nwrote %s\n", r.description.c_str(), r.message().c_str(), a.out.c_str());
 }

@@ -333,9 +333,11 @@ ReprojectionResult check_reprojection(const dataset::Dataset& data,
   if (lines.empty()) {
     // Every frame with a reference, each extracted on its own (the picture's frames too).
     lines.resize(data.size());
+    std::size_t done = 0;
     for (const auto& f : refs.frames) {
-      if (data.images()[f.frame].missing) continue;
-      lines[f.frame] = bearings(extract(data, f.frame, o).features);
+      if (!data.images()[f.frame].missing)
+        lines[f.frame] = bearings(extract(data, f.frame, o).features);
+      if (o.progress) o.progress(++done, refs.frames.size());
     }
   }
   r.stats_before = corner_line_offsets(refs, lines, before, r.gate);

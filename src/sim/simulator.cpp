@@ -252,6 +252,14 @@ void write_simulation_settings(const fs::path& path,
     y += "reflection_grey: " + fmt("%.9g", o.reflection_grey) + "\n";
   }
   if (o.write_mask) y += "mask_margin_px: " + fmt("%.9g", o.mask_margin_px) + "\n";
+  if (const LaserConfig& l = cfg.laser; l.enabled) {
+    y += "laser_pose: [" + fmt("%.9g", l.x) + ", " + fmt("%.9g", l.y) + ", " + fmt("%.9g", l.yaw) +
+         "]\n";
+    y += "laser_height: " + fmt("%.9g", l.height) + "\n";
+    y += "laser_rate_hz: " + fmt("%.9g", l.rate_hz) + "\n";
+    y += "laser_noise: " + fmt("%.9g", l.noise_sigma) + "\n";
+    y += "laser_max_range: " + fmt("%.9g", l.range_max) + "\n";
+  }
   if (cfg.camera.tilt_deg != 0.0) {
     y += "tilt_deg: " + fmt("%.9g", cfg.camera.tilt_deg) + "\n";
     y += "tilt_direction_deg: " + fmt("%.9g", cfg.camera.tilt_direction_deg) + "\n";

@@ -17,6 +17,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -134,6 +135,8 @@ struct ReprojectionOptions {
   std::vector<std::size_t> frames;  // frames drawn; empty: the middle frame with a reference
   FeaturePipelineOptions features;  // the extraction of the drawn frames
   std::string mask;                 // image mask file instead of the sensor.yaml's
+  // Called after each frame whose lines are extracted here (done, total).
+  std::function<void(std::size_t, std::size_t)> progress;
   bool IsValid(std::string* why) const;
 };
 
