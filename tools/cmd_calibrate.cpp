@@ -124,7 +124,7 @@ void run_calibrate(const CalibrateArgs& a) {
     std::printf("%s%s\n", r.tilt.describe().c_str(), r.tilt_corrected ? "; frames rectified" : "");
   }
   std::printf("%s", r.BriefReport().c_str());
-  if (a.tracks_file.empty() && tracking_s > 0)
+  if (o.tracks_file.empty() && tracking_s > 0)
     std::printf("tracking: %s\n",
                 throughput(r.frames, tracking_s, resolve_threads(a.options.threads)).c_str());
   if (!r.wrote_extrinsics) {

@@ -195,7 +195,7 @@ void bind_results(py::module_& m) {
                                                 ? py::object(py::float_(n.check.scale))
                                                 : py::object(py::none());
                                d["ratio"] = n.ratio;
-                               d["line"] = calib::noise_check_line(c.result);
+                               d["line"] = pipeline::noise_check_line(c.result);
                                return d;
                              })
       .def_property_readonly("warnings",

@@ -240,13 +240,13 @@ std::string mounting_text(const calib::Extrinsics& x) {
          " mm, psi " + fmt("%.2f", rad2deg(x.psi)) + " deg";
 }
 
-ReprojectionLayer layer_of(const FrameReference* ref,
+viz::ReprojectionLayer layer_of(const FrameReference* ref,
                            const calib::Extrinsics& x,
                            const std::vector<double>& lines,
                            double gate,
                            const std::string& name,
                            std::size_t frame) {
-  ReprojectionLayer layer;
+  viz::ReprojectionLayer layer;
   const Eigen::Vector2d cam = x.position();
   std::vector<double> offsets;
   if (ref) {

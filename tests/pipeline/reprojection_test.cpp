@@ -102,7 +102,7 @@ TEST(Reprojection, MountingOffByAKnownYawShiftsTheDrawnCornerByIt) {
   const Eigen::Vector2d corner(2.0, 1.5);
   for (const int sign : {1, -1}) {
     auto angle_of = [&](const calib::Extrinsics& m) {
-      ReprojectionLayer l;
+      viz::ReprojectionLayer l;
       l.corners.emplace_back(camera_bearing(m, corner), 2.0);
       return drawn_tick_angle(viz::draw_reprojection(black, c, sign, {}, l), c);
     };
