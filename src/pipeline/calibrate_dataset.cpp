@@ -191,7 +191,8 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
   write_image_atomic((out / "convergence.png").string(),
                      calib::draw_convergence(result.filter.history, r.truth, refined));
   calib::ReportInputs ri;
-  ri.dataset = dataset_dir;
+  ri.dataset = o.input_name.empty() ? dataset_dir : o.input_name;
+  ri.prior_source = o.prior_source;
   ri.command = o.command;
   ri.frames = tracked.frames;
   ri.frames_skipped = tracked.frames_skipped;

@@ -47,6 +47,11 @@ struct CalibrateDatasetOptions {
   std::string tracks_file;         // non-empty: calibrate from this earlier tracks.csv
   bool force = false;              // write extrinsics.yaml even when undetermined
   std::string command;             // the command line, recorded in the report
+  // What the report names as the input (a recording and its imported dataset); empty: the
+  // dataset folder.
+  std::string input_name;
+  // Where the prior of `calibration` came from, named in the report; empty: the defaults.
+  std::string prior_source;
   std::vector<std::string> notes;  // extra warnings of the caller, reported with the rest
   TiltCheckOptions tilt;           // the tilt of the mirror axis (pipeline/tilt_check.hpp)
   // Frame names and camera height of the robot-format files written with extrinsics.yaml
