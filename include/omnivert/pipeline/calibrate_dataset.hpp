@@ -58,12 +58,13 @@ struct CalibrateDatasetOptions {
   // (calib/robot_formats.hpp).
   calib::RobotFrames frames;
   // The camera-odometry time offset [s], positive when the image stamps are late: given (the
-  // stamps shifted before tracking), or empty: estimated from the tracks and applied to the
-  // calibration's input when significant (pipeline/time_offset.hpp, docs/calibration.md).
+  // stamps shifted before tracking), or empty: estimated from the tracks and, when significant,
+  // applied and the images tracked again on the corrected stamps (pipeline/time_offset.hpp,
+  // docs/calibration.md).
   std::optional<double> time_offset_s;
   TimeOffsetOptions time_offset;
-  // Called while tracking (stage "track", frames done, frames in all) and once before the
-  // calibration (stage "calibrate", 0, 0).
+  // Called while tracking (stage "track", frames done, frames in all; "track again" when an
+  // estimated time offset is applied) and once before the calibration (stage "calibrate", 0, 0).
   std::function<void(const std::string& stage, std::size_t done, std::size_t total)> progress;
 };
 
