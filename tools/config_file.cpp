@@ -64,7 +64,8 @@ void apply_config(CLI::App* cmd, const std::string& file) {
     }
     try {
       for (const std::string& v : values) {
-        if (op->get_items_expected_max() == 0) {  // a flag: true or false (a negated flag turns it off)
+        // A flag: true or false (a negated flag, !--no-x, turns its setting off).
+        if (op->get_items_expected_max() == 0) {
           const YAML::Node b = YAML::Load(v);
           bool on = false;
           if (!YAML::convert<bool>::decode(b, on))

@@ -41,8 +41,7 @@ void add_import_options(CLI::App* cmd, ImportFlags& f, bool job) {
       ->group(g);
   cmd->add_option("--odometry-topic", o.odometry_topic, "nav_msgs/Odometry topic (poses)")
       ->group(g);
-  cmd->add_option(
-         "--poses-csv", o.poses_csv, "TUM pose file 't x y z qx qy qz qw' (t in seconds)")
+  cmd->add_option("--poses-csv", o.poses_csv, "TUM pose file 't x y z qx qy qz qw' (t in seconds)")
       ->group(g);
   cmd->add_option("--wheel-base",
                   o.wheel_base,

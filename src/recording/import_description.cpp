@@ -38,7 +38,9 @@ void use_urdf(const Recording& rec, const Collected& c, ImportOptions& o, Import
 }
 
 // The mount: base_frame -> camera_frame composed from the static transforms.
-void use_tf_static(const Recording& rec, const Collected& c, const ImportOptions& o,
+void use_tf_static(const Recording& rec,
+                   const Collected& c,
+                   const ImportOptions& o,
                    ImportSummary& s) {
   s.base_frame = o.base_frame;
   s.camera_frame = !o.camera_frame.empty() ? o.camera_frame : c.camera_frame_id;
@@ -64,8 +66,8 @@ void use_tf_static(const Recording& rec, const Collected& c, const ImportOptions
   const auto T = tree.transform(s.base_frame, s.camera_frame, &why);
   const std::string where = std::string(kTfStaticTopic) + " of " + rec.path();
   if (!T) {
-    s.mount_source = where + " has no transform " + s.base_frame + " -> " + s.camera_frame +
-                     ": " + why;
+    s.mount_source =
+        where + " has no transform " + s.base_frame + " -> " + s.camera_frame + ": " + why;
     s.warnings.push_back(s.mount_source + "; the prior is calibrate's default or its flags");
     return;
   }
@@ -84,8 +86,7 @@ void use_tf_static(const Recording& rec, const Collected& c, const ImportOptions
 
 }  // namespace
 
-void use_description(const Recording& rec, const Collected& c, ImportOptions& o,
-                     ImportSummary& s) {
+void use_description(const Recording& rec, const Collected& c, ImportOptions& o, ImportSummary& s) {
   use_urdf(rec, c, o, s);
   use_tf_static(rec, c, o, s);
 }

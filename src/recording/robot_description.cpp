@@ -28,8 +28,9 @@ std::optional<Eigen::Isometry3d> FrameTree::transform(const std::string& from,
                                                       std::string* why) const {
   auto known = [&](const std::string& f) {
     if (parent_of_.count(f)) return true;
-    return std::any_of(
-        parent_of_.begin(), parent_of_.end(), [&](const auto& kv) { return kv.second.parent == f; });
+    return std::any_of(parent_of_.begin(), parent_of_.end(), [&](const auto& kv) {
+      return kv.second.parent == f;
+    });
   };
   for (const std::string& f : {from, to}) {
     if (!known(f)) {
