@@ -1,4 +1,5 @@
-// omnivert calibrate DATASET --out DIR [--refine] [--force]: the main job. Tracks the
+// omnivert calibrate DATASET|RECORDING --out DIR [--refine] [--force]: the main job (a recording
+// is imported first: omnivert/pipeline/recording_job.hpp). Tracks the
 // vertical lines of the dataset (Sec. 4, 9.1), runs the self-calibration EKF (Sec. 8.2),
 // analyses observability (Sec. 8.1), optionally refines the whole run as a batch
 // maximum-likelihood problem, and writes extrinsics.yaml, tracks.csv, tracks.png, states.csv,
@@ -10,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -18,10 +20,13 @@
 #include "check_options.hpp"
 #include "commands.hpp"
 #include "core/parallel.hpp"
+#include "config_file.hpp"
 #include "core/progress.hpp"
 #include "core/yaml_fields.hpp"
+#include "import_options.hpp"
 #include "omnivert/calib/calibrate.hpp"
 #include "omnivert/core/angles.hpp"
+#include "omnivert/core/error.hpp"
 #include "omnivert/pipeline/calibrate_dataset.hpp"
 #include "pipeline_options.hpp"
 #include "tracker_options.hpp"
@@ -47,6 +52,8 @@ struct CalibrateArgs {
   TrackerFlags tracker;
   std::string time_offset = "estimate";  // --time-offset: "estimate" or seconds
   CheckFlags check;                      // --check-reference, --check-frames, ...
+  ImportFlags import;                    // a recording instead of a dataset folder
+  std::string config;
 };
 
 // The prior from a YAML file: keys phi, rho, psi, sigma_phi, sigma_rho, sigma_psi [rad, m]
@@ -66,11 +73,14 @@ void read_prior_file(const std::string& path, calib::CalibrationOptions* o) {
     o->filter.odometry_inflation = *v;
 }
 
-// The calibration's options: the recommended preset with the bound flags, then the prior
-// file, then the flags that override it (the wheel base and K come from wheel0/sensor.yaml in
+// The calibration's options: the recommended preset with the bound flags, then the dataset's
+// prior.yaml (the mount of a recording's /tf_static, written by the import), then the prior
+// file, then the flags that override them (the wheel base and K come from wheel0/sensor.yaml in
 // the pipeline).
-calib::CalibrationOptions calibration_options(const CalibrateArgs& a) {
+calib::CalibrationOptions calibration_options(const CalibrateArgs& a,
+                                              const std::string& dataset_prior) {
   calib::CalibrationOptions opt = a.options.calibration;
+  if (!dataset_prior.empty()) read_prior_file(dataset_prior, &opt);
   if (!a.prior_file.empty()) read_prior_file(a.prior_file, &opt);
   if (a.phi) opt.prior.mean.phi = *a.phi;
   if (a.rho) opt.prior.mean.rho = *a.rho;
@@ -85,17 +95,60 @@ calib::CalibrationOptions calibration_options(const CalibrateArgs& a) {
   return opt;
 }
 
-void run_calibrate(const CalibrateArgs& a) {
+// The prior of the dataset's prior.yaml (a recording's /tf_static), its frames and camera
+// height where the flags do not give them, and the words naming the prior in the report.
+std::string dataset_prior(CLI::App* cmd,
+                          const CalibrateArgs& a,
+                          const std::string& dataset,
+                          pipeline::CalibrateDatasetOptions& o) {
+  namespace fs = std::filesystem;
+  const std::string file = (fs::path(dataset) / recording::kPriorFile).string();
+  std::error_code ec;
+  const bool flags = a.phi || a.rho || a.psi;
+  if (fs::exists(file, ec)) {
+    const YAML::Node y = yaml::load_file(file);
+    const std::string source = yaml::optional_string(y, "source", file).value_or(file);
+    if (!cmd->get_option("--base-frame")->count())
+      o.frames.base = yaml::optional_string(y, "base_frame", file).value_or(o.frames.base);
+    if (!cmd->get_option("--camera-frame")->count())
+      o.frames.camera = yaml::optional_string(y, "camera_frame", file).value_or(o.frames.camera);
+    if (!a.options.frames.camera_height)
+      o.frames.camera_height = yaml::optional_number(y, "camera_height", file);
+    o.prior_source = source + (!a.prior_file.empty() ? ", then " + a.prior_file : "") +
+                     (flags ? ", then the flags" : "");
+    std::printf("prior: the camera's mount of %s%s\n",
+                source.c_str(),
+                flags || !a.prior_file.empty() ? " (overridden by --prior or the flags)" : "");
+    return file;
+  }
+  if (!a.prior_file.empty())
+    o.prior_source = a.prior_file + (flags ? ", then the flags" : "");
+  else if (flags)
+    o.prior_source = "the flags";
+  return {};
+}
+
+void run_calibrate(CLI::App* cmd, const CalibrateArgs& a) {
+  if (a.out.empty()) throw InputError("--out is required");
+  ImportFlags import = a.import;  // the prior's frames are calibrate's --base-frame, --camera-frame
+  import.o.base_frame = a.options.frames.base;
+  if (cmd->get_option("--camera-frame")->count()) import.o.camera_frame = a.options.frames.camera;
+  const auto imported = import_for_job(cmd, a.dataset, a.out, import);
+  const std::string dataset = imported ? imported->path() : a.dataset;
   pipeline::CalibrateDatasetOptions o = a.options;
+  const std::string prior = dataset_prior(cmd, a, dataset, o);
+  if (imported) o.input_name = a.dataset + " (imported into " + dataset + ")";
   o.tracker = a.tracker.options();
-  o.calibration = calibration_options(a);
+  o.calibration = calibration_options(a, prior);
   o.reprojection = check_options(a.check);
   o.check_reference = a.check.reference != "auto" && a.check.reference != "none";
   o.check_off = a.check.reference == "none";
   if (a.time_offset != "estimate") o.time_offset_s = std::stod(a.time_offset);
-  if (!o.frames.camera_height && !a.prior_file.empty())
-    o.frames.camera_height =
-        yaml::optional_number(yaml::load_file(a.prior_file), "camera_height", a.prior_file);
+  if (!a.options.frames.camera_height && !a.prior_file.empty()) {
+    if (auto h =
+            yaml::optional_number(yaml::load_file(a.prior_file), "camera_height", a.prior_file))
+      o.frames.camera_height = h;
+  }
   o.command = command_line();
   if (!o.tracks_file.empty() && !a.unused_with_tracks.empty()) {
     std::string list;
@@ -106,9 +159,11 @@ void run_calibrate(const CalibrateArgs& a) {
   std::optional<Progress> bar;
   const auto start = std::chrono::steady_clock::now();
   double tracking_s = 0;  // from the call to the end of tracking
+  std::string bar_stage;
   o.progress = [&](const std::string& stage, std::size_t done, std::size_t total) {
-    if (stage == "track") {
-      if (!bar) bar.emplace("track", total);
+    if (stage != "calibrate") {  // "track", "track again"
+      if (bar && bar_stage != stage) bar->finish(), bar.reset();
+      if (!bar) bar.emplace(stage, total), bar_stage = stage;
       bar->update(done);
       return;
     }
@@ -119,7 +174,7 @@ void run_calibrate(const CalibrateArgs& a) {
                    "calibrate: filter%s...\n",
                    o.calibration.refinement.enabled ? " and refinement" : "");
   };
-  const pipeline::CalibrateDatasetResult r = pipeline::calibrate_dataset(a.dataset, a.out, o);
+  const pipeline::CalibrateDatasetResult r = pipeline::calibrate_dataset(dataset, a.out, o);
   if (r.tilt.valid) {
     std::printf("%s%s\n", r.tilt.describe().c_str(), r.tilt_corrected ? "; frames rectified" : "");
   }
@@ -257,9 +312,13 @@ void add_calibrate_command(CLI::App& app) {
       "calibrate",
       "Self-calibrate the camera-to-odometry extrinsics (phi, rho, psi) from a dataset: track "
       "lines, EKF (Sec. 8.2), observability (Sec. 8.1), optional batch refinement");
-  cmd->add_option("DATASET", a->dataset, "Dataset folder (cam0/, wheel0/, optional ground_truth/)")
+  cmd->add_option("DATASET",
+                  a->dataset,
+                  "Dataset folder (cam0/, wheel0/, optional ground_truth/), or a recording (ROS 1 "
+                  ".bag, ROS 2 .db3 or .mcap, with the options of `omnivert import`)")
       ->required();
-  cmd->add_option("--out", a->out, "Output folder")->required();
+  cmd->add_option("--out", a->out, "Output folder (required)");
+  add_config_option(cmd, a->config);
   cmd->add_flag(
       "--refine",
       a->options.calibration.refinement.enabled,
@@ -313,7 +372,9 @@ void add_calibrate_command(CLI::App& app) {
   add_tilt_options(cmd, a->options.tilt);
   add_tracker_options(cmd, a->tracker);
   add_threads_option(cmd, a->options.threads);
+  add_import_options(cmd, a->import, true);
   cmd->callback([a, cmd] {
+    apply_config(cmd, a->config);
     // Extraction and tracking flags given with --tracks do nothing: say so.
     a->unused_with_tracks.clear();
     for (const CLI::Option* o : cmd->get_options())
@@ -321,7 +382,7 @@ void add_calibrate_command(CLI::App& app) {
           (o->get_group() == kExtractionGroup || o->get_group() == kDescriptorGroup ||
            o->get_group() == kTrackingGroup))
         a->unused_with_tracks.push_back(o->get_name());
-    run_calibrate(*a);
+    run_calibrate(cmd, *a);
   });
 }
 

@@ -1,4 +1,5 @@
-// omnivert track DATASET --out DIR: lines tracked through a video (Sec. 4, 9.1).
+// omnivert track DATASET|RECORDING --out DIR: lines tracked through a video (Sec. 4, 9.1); a
+// recording is imported first (omnivert/pipeline/recording_job.hpp).
 
 #include <chrono>
 #include <cstdio>
@@ -8,8 +9,10 @@
 #include <spdlog/spdlog.h>
 
 #include "commands.hpp"
+#include "config_file.hpp"
 #include "core/parallel.hpp"
 #include "core/progress.hpp"
+#include "import_options.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
 #include "omnivert/pipeline/track_dataset.hpp"
@@ -29,16 +32,20 @@ struct TrackArgs {
   pipeline::TiltCheckOptions tilt;
   TrackerFlags tracker;
   int threads = 0;
+  ImportFlags import;
+  std::string config;
 };
 
-void run_track(const TrackArgs& a) {
+void run_track(CLI::App* cmd, const TrackArgs& a) {
   namespace fs = std::filesystem;
   std::string why;
+  if (a.out.empty()) throw InputError("--out is required");
   if (!a.pipeline.IsValid(&why)) throw InputError("invalid extraction options: " + why);
+  const auto imported = import_for_job(cmd, a.dataset, a.out, a.import);
   dataset::LoadOptions lo;
   lo.require_wheel = false;
   lo.allow_missing_images = true;  // a missing frame is warned about and skipped (no lines)
-  const auto data = dataset::Dataset::load(a.dataset, lo);
+  const auto data = dataset::Dataset::load(imported ? imported->path() : a.dataset, lo);
   for (const std::string& n : data.notes()) spdlog::debug("{}", n);
   std::error_code ec;
   fs::create_directories(a.out, ec);
@@ -81,14 +88,23 @@ void add_track_command(CLI::App& app) {
   auto a = std::make_shared<TrackArgs>();
   CLI::App* cmd = app.add_subcommand(
       "track", "Track vertical lines through a dataset (tracks.csv, tracks.png)");
-  cmd->add_option("DATASET", a->dataset, "Dataset folder (cam0/, optional wheel0/)")->required();
-  cmd->add_option("--out", a->out, "Output folder")->required();
+  cmd->add_option("DATASET",
+                  a->dataset,
+                  "Dataset folder (cam0/, optional wheel0/), or a recording (ROS 1 .bag, ROS 2 "
+                  ".db3 or .mcap, with the options of `omnivert import`)")
+      ->required();
+  cmd->add_option("--out", a->out, "Output folder (required)");
+  add_config_option(cmd, a->config);
   add_pipeline_options(cmd, a->pipeline);
   add_mask_option(cmd, a->mask);
   add_tilt_options(cmd, a->tilt);
   add_tracker_options(cmd, a->tracker);
   add_threads_option(cmd, a->threads);
-  cmd->callback([a] { run_track(*a); });
+  add_import_options(cmd, a->import, true);
+  cmd->callback([a, cmd] {
+    apply_config(cmd, a->config);
+    run_track(cmd, *a);
+  });
 }
 
 }  // namespace omnivert::cli

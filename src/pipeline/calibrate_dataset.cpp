@@ -58,7 +58,8 @@ std::string few_tracks_warning(int tracks, const FeaturePipelineOptions& feature
 // Step 1: the tracks, of the images or of an earlier tracks.csv.
 TrackDatasetResult tracks_of(const dataset::Dataset& data,
                              const CalibrateDatasetOptions& o,
-                             std::optional<TrackDatasetResult> given) {
+                             std::optional<TrackDatasetResult> given,
+                             const std::string& stage = "track") {
   if (given) return std::move(*given);
   TrackDatasetOptions to;
   to.pipeline = o.features;
@@ -67,7 +68,7 @@ TrackDatasetResult tracks_of(const dataset::Dataset& data,
   to.tilt = o.tilt;
   to.threads = o.threads;
   return track_dataset(data, to, [&](std::size_t done, std::size_t total) {
-    if (o.progress) o.progress("track", done, total);
+    if (o.progress) o.progress(stage, done, total);
   });
 }
 
@@ -204,7 +205,20 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
   r.noise_check_requested = o.calibration.noise_check.enabled;
   const auto t0 = Clock::now();
   if (o.time_offset_s) apply_time_offset(data, *o.time_offset_s, true, r);  // before tracking
-  const TrackDatasetResult tracked = tracks_of(data, o, std::move(given));
+  const bool from_images = !given.has_value();
+  TrackDatasetResult tracked = tracks_of(data, o, std::move(given));
+
+  // The time offset, estimated from the tracks when not given. Applied, it also changes the
+  // wheel travel between frames that the tracker's odometry gate predicts with (Sec. 9.1), so
+  // the images are tracked again on the corrected stamps.
+  if (!o.time_offset_s) {
+    r.time_offset = estimate_time_offset(
+        data, tracked.rows, opt.robot.odometry_K, opt.noise.bearing_sigma, o.time_offset);
+    if (r.time_offset.significant(o.time_offset)) {
+      apply_time_offset(data, r.time_offset.offset_s, false, r);
+      if (from_images) tracked = tracks_of(data, o, std::nullopt, "track again");
+    }
+  }
   r.warnings.insert(r.warnings.begin(), tracked.warnings.begin(), tracked.warnings.end());
   r.tilt = tracked.tilt;
   r.tilt_corrected = tracked.tilt_corrected;
@@ -215,14 +229,7 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
   r.frames_skipped = tracked.frames_skipped;
   r.detections = static_cast<std::int64_t>(tracked.rows.size());
 
-  // The time offset, estimated from the tracks when not given; step 2: the calibration's
-  // input; step 3: filter, observability, refinement (Sec. 8).
-  if (!o.time_offset_s) {
-    r.time_offset = estimate_time_offset(
-        data, tracked.rows, opt.robot.odometry_K, opt.noise.bearing_sigma, o.time_offset);
-    if (r.time_offset.significant(o.time_offset))
-      apply_time_offset(data, r.time_offset.offset_s, false, r);
-  }
+  // Step 2: the calibration's input; step 3: filter, observability, refinement (Sec. 8).
   r.input = calibration_run_from_tracks(data, tracked.rows, o.input);
   r.warnings.insert(r.warnings.end(), r.input.warnings.begin(), r.input.warnings.end());
   if (r.input.tracks < kFewTracks)
@@ -254,7 +261,8 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
   write_image_atomic((out / "convergence.png").string(),
                      viz::draw_convergence(result.filter.history, r.truth, refined));
   ReportInputs ri;
-  ri.dataset = dataset_dir;
+  ri.dataset = o.input_name.empty() ? dataset_dir : o.input_name;
+  ri.prior_source = o.prior_source;
   ri.command = o.command;
   ri.frames = tracked.frames;
   ri.frames_skipped = tracked.frames_skipped;

@@ -233,7 +233,8 @@ json inputs_json(const calib::CalibrationResult& r, const ReportInputs& in) {
                      {"psi", num(in.options.prior.mean.psi)},
                      {"sigma_phi", num(in.options.prior.sigma(0))},
                      {"sigma_rho", num(in.options.prior.sigma(1))},
-                     {"sigma_psi", num(in.options.prior.sigma(2))}};
+                     {"sigma_psi", num(in.options.prior.sigma(2))},
+                     {"source", in.prior_source.empty() ? "default" : in.prior_source}};
   return inputs;
 }
 
@@ -412,7 +413,10 @@ void html_estimates(std::ostringstream& h,
     h << "</td><td>" << f("%.2f", p(0) * 1e3) << "</td><td>" << f("%.2f", p(1) * 1e3) << "</td><td>"
       << f("%.3f", rad2deg(e.yaw())) << "</td></tr>\n";
   };
-  row("prior (hand measurement)", in.options.prior.mean, nullptr);
+  row(in.prior_source.empty() ? std::string("prior (default)")
+                              : "prior (" + html_escape(in.prior_source) + ")",
+      in.options.prior.mean,
+      nullptr);
   row("filter (Sec. 8.2)", r.filter.extrinsics, &r.filter.covariance);
   if (r.source == calib::Estimator::kRefinement)
     row("batch refinement (--refine)", r.refinement.extrinsics, &r.refinement.covariance);

@@ -99,6 +99,30 @@ struct Problem {
     for (std::size_t k : used) J += weighted_residual(triples[k], S);
     return J;
   }
+  // The sandwich variance of the minimiser S* of J = sum_i q_i (q_i the weighted residual of
+  // triple i), with the slopes g_i and the curvature J'' taken over +-h:
+  //   var(S*) = sum_{i, k sharing an image} g_i g_k / J''^2.
+  // The model's 1 / a counts every triple as independent, but triples i and k share the
+  // wheels' noise of their common pairs (|i - k| <= 2) and the bearings of their common images
+  // (triple i spans images i-2 .. i+1: |i - k| <= 3), and the few triples
+  // where the motion changes carry nearly all the information; the sandwich takes both, and
+  // the residuals as they are rather than as modelled.
+  double sandwich_variance(double S, double h) const {
+    std::vector<std::pair<std::size_t, double>> g;  // (middle image, slope)
+    double curvature = 0;
+    for (std::size_t k : used) {
+      const double qp = weighted_residual(triples[k], S + h);
+      const double q0 = weighted_residual(triples[k], S);
+      const double qm = weighted_residual(triples[k], S - h);
+      g.emplace_back(triples[k].i, (qp - qm) / (2 * h));
+      curvature += (qp - 2 * q0 + qm) / (h * h);
+    }
+    double num = 0;
+    for (std::size_t a = 0; a < g.size(); ++a)
+      for (std::size_t b = a; b < g.size() && g[b].first <= g[a].first + 3; ++b)
+        num += (a == b ? 1.0 : 2.0) * g[a].second * g[b].second;
+    return curvature > 0 ? std::max(num, 0.0) / (curvature * curvature) : INFINITY;
+  }
 };
 
 struct Minimum {
@@ -190,6 +214,10 @@ TimeOffsetEstimate estimate_time_offset(const TimeOffsetInput& in, const TimeOff
   const double s2 = std::max(m.cost, 0.0) / (e.pairs - 1);
   e.residual_scale = std::sqrt(s2);
   e.sigma_s = m.curvature > 0 ? std::sqrt(std::max(s2, 1.0) / m.curvature) : INFINITY;
+  // The model's sigma is a floor: the sandwich may only widen it (too few triples carry S for
+  // their spread to be trusted below the model).
+  if (std::isfinite(e.sigma_s) && o.sigma_step_s > 0)
+    e.sigma_s = std::max(e.sigma_s, std::sqrt(p.sandwich_variance(m.S, o.sigma_step_s)));
   if (!(m.curvature > 0) || std::abs(m.S) >= o.max_offset_s - o.step_s) {
     e.why = "no minimum inside +-" + std::to_string(o.max_offset_s) + " s";
   } else if (!(e.sigma_s <= o.max_sigma_s) || !(m.rise >= o.min_rise * std::max(s2, 1.0))) {

@@ -79,6 +79,7 @@ void ImageSink::check_size(int w, int h, const std::string& enc, const std::stri
 std::int64_t ImageSink::add(const Message& m, const std::string& what, std::string& filename) {
   if (compressed_) {
     const CompressedImageMsg c = decode_compressed_image(m.data, serialization_, what);
+    if (width_ == 0) frame_id_ = c.frame_id;
     const auto& d = c.data;
     std::string kind;
     if (d.size() >= 8 && std::memcmp(d.data(), "\x89PNG\r\n\x1a\n", 8) == 0)
@@ -105,6 +106,7 @@ std::int64_t ImageSink::add(const Message& m, const std::string& what, std::stri
     return t;
   }
   const ImageMsg im = decode_image(m.data, serialization_, what);
+  if (width_ == 0) frame_id_ = im.frame_id;
   Layout l;
   if (!layout_of(im.encoding, l)) {
     throw InputError(what + ": image encoding '" + im.encoding + "' is not one we read (" +

@@ -26,6 +26,8 @@ class ImageSink {
   const PixelFormat& pixel_format() const { return pixel_; }
   // Images whose header stamp was 0: their recording time was used instead.
   std::size_t unstamped() const { return unstamped_; }
+  // The first image's header.frame_id: the camera's frame.
+  const std::string& frame_id() const { return frame_id_; }
 
  private:
   void check_size(int w, int h, const std::string& enc, const std::string& what);
@@ -36,6 +38,7 @@ class ImageSink {
   bool compressed_;
   int width_ = 0, height_ = 0;
   std::string encoding_;
+  std::string frame_id_;
   PixelFormat pixel_;
 };
 

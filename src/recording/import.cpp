@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
@@ -59,6 +60,8 @@ struct TempDir {
   }
 };
 
+// The wheel base and the radius may come from /robot_description (use_description): they are
+// checked once it has been read (check_wheels).
 void check_options(const Recording& rec, const ImportOptions& o) {
   const int sources =
       !o.joint_states_topic.empty() + !o.odometry_topic.empty() + !o.poses_csv.empty();
@@ -66,11 +69,14 @@ void check_options(const Recording& rec, const ImportOptions& o) {
     throw InputError(
         "give one odometry source: --joint-states-topic, --odometry-topic or --poses-csv");
   }
-  if (sources == 1 && !(o.wheel_base > 0)) throw InputError("--wheel-base is needed with odometry");
-  if (!o.joint_states_topic.empty() &&
-      (o.left_joint.empty() || o.right_joint.empty() || !(o.wheel_radius > 0))) {
+  if (!o.joint_states_topic.empty() && (o.left_joint.empty() || o.right_joint.empty())) {
     throw InputError("--joint-states-topic needs --wheel-joints LEFT,RIGHT and --wheel-radius");
   }
+  const bool desc = has_topic(rec, kRobotDescriptionTopic, "std_msgs/String");
+  if (!desc && !o.joint_states_topic.empty() && !(o.wheel_radius > 0))
+    throw InputError("--joint-states-topic needs --wheel-joints LEFT,RIGHT and --wheel-radius");
+  if (!desc && sources == 1 && !(o.wheel_base > 0))
+    throw InputError("--wheel-base is needed with odometry");
   require_topic(rec, o.image_topic, {"sensor_msgs/Image", "sensor_msgs/CompressedImage"});
   if (!o.joint_states_topic.empty())
     require_topic(rec, o.joint_states_topic, {"sensor_msgs/JointState"});
@@ -84,10 +90,24 @@ void check_options(const Recording& rec, const ImportOptions& o) {
 
 double seconds(std::int64_t ns) { return static_cast<double>(ns) * 1e-9; }
 
+void check_wheels(const Recording& rec, const ImportOptions& o) {
+  const std::string from =
+      " (the recording's " + std::string(kRobotDescriptionTopic) +
+      (o.left_joint.empty() ? " gives it with --wheel-joints LEFT,RIGHT)" : " does not give it)");
+  // (Without /robot_description check_options has refused a missing wheel base or radius.)
+  const bool odometry =
+      !o.joint_states_topic.empty() || !o.odometry_topic.empty() || !o.poses_csv.empty();
+  if (!o.joint_states_topic.empty() && !(o.wheel_radius > 0))
+    throw InputError(rec.path(), 0, "--wheel-radius is needed with joint states" + from);
+  if (odometry && !(o.wheel_base > 0))
+    throw InputError(rec.path(), 0, "--wheel-base is needed with odometry" + from);
+}
+
 }  // namespace
 
-ImportSummary import_recording(Recording& rec, const ImportOptions& o) {
-  check_options(rec, o);
+ImportSummary import_recording(Recording& rec, const ImportOptions& options) {
+  check_options(rec, options);
+  ImportOptions o = options;  // the wheel base and radius completed by the description
   const fs::path out = fs::absolute(o.out).lexically_normal();
   std::error_code ec;
   if (fs::exists(out, ec) && !o.overwrite) {
@@ -103,7 +123,17 @@ ImportSummary import_recording(Recording& rec, const ImportOptions& o) {
 
   ImportSummary s;
   s.format = rec.format();
-  Collected c = collect(rec, o, tmp.path / "cam0" / "data", s);
+  // Without a radius the joint angles are collected as they are, scaled and checked after the
+  // pass (the description that gives the radius may come last).
+  ImportOptions pass = o;
+  const bool scale_later = !o.joint_states_topic.empty() && !(o.wheel_radius > 0);
+  if (scale_later) pass.wheel_radius = 1.0, pass.max_speed = INFINITY;
+  Collected c = collect(rec, pass, tmp.path / "cam0" / "data", s);
+  use_description(rec, c, o, s);
+  check_wheels(rec, o);
+  if (scale_later) scale_wheel_travel(rec, o, c.wheel);
+  s.wheel_base = o.wheel_base;
+  s.wheel_radius = o.wheel_radius;
 
   std::vector<dataset::WheelRecord> wheel;
   const std::string odo_source = rec.path() + ", topic " + o.odometry_topic;
@@ -137,6 +167,7 @@ ImportSummary import_recording(Recording& rec, const ImportOptions& o) {
   for (const auto& [t, name] : c.images) cam.add(t, name);
   cam.close();
   write_camera_sensor(rec, o, c, tmp.path / "cam0");
+  if (s.mount) dataset::write_text_file((tmp.path / kPriorFile).string(), prior_yaml(s));
   s.images = c.images.size();
   if (!o.laser_topic.empty())
     s.laser_scans = import_laser_scans(rec, o.laser_topic, *o.laser_pose, tmp.path);

@@ -95,6 +95,30 @@ void check_wheel_step(const dataset::WheelRecord& prev,
 
 }  // namespace
 
+bool has_topic(const Recording& rec, const std::string& name, const std::string& type) {
+  const TopicInfo* t = rec.find(name);
+  return t && t->count > 0 && normalized_type(t->type) == type;
+}
+
+void scale_wheel_travel(const Recording& rec,
+                        const ImportOptions& o,
+                        std::vector<dataset::WheelRecord>& wheel) {
+  for (std::size_t i = 0; i < wheel.size(); ++i) {
+    dataset::WheelRecord& w = wheel[i];
+    w.travel.left *= o.wheel_radius;
+    w.travel.right *= o.wheel_radius;
+    if (i > 0) {
+      check_wheel_step(
+          wheel[i - 1],
+          w.timestamp_ns,
+          w.travel.left,
+          w.travel.right,
+          o,
+          rec.path() + ", topic " + o.joint_states_topic + ", message " + std::to_string(w.line));
+    }
+  }
+}
+
 void require_topic(const Recording& rec,
                    const std::string& name,
                    const std::vector<std::string>& types) {
@@ -123,6 +147,10 @@ Collected collect(Recording& rec,
   std::vector<std::string> topics = {o.image_topic};
   if (!o.joint_states_topic.empty()) topics.push_back(o.joint_states_topic);
   if (!o.odometry_topic.empty()) topics.push_back(o.odometry_topic);
+  const bool tf = has_topic(rec, kTfStaticTopic, "tf2_msgs/TFMessage");
+  const bool desc = has_topic(rec, kRobotDescriptionTopic, "std_msgs/String");
+  if (tf) topics.push_back(kTfStaticTopic);
+  if (desc) topics.push_back(kRobotDescriptionTopic);
   constexpr auto kNone = std::numeric_limits<std::int64_t>::min();
   std::int64_t last_odo = kNone;
   JointIndex idx;
@@ -159,6 +187,11 @@ Collected collect(Recording& rec,
           last_odo = od.stamp_ns;
           c.poses.push_back(
               {od.stamp_ns, od.x, od.y, dataset::yaw_of_quaternion(od.qx, od.qy, od.qz, od.qw)});
+        } else if (tf && m.topic->name == kTfStaticTopic) {
+          for (auto& t : decode_tf_message(m.data, rec.serialization(), what))
+            c.tf_static.push_back(std::move(t));
+        } else if (desc && m.topic->name == kRobotDescriptionTopic) {
+          c.robot_description = decode_string(m.data, rec.serialization(), what);
         }
       },
       o.progress);
@@ -168,6 +201,7 @@ Collected collect(Recording& rec,
   c.height = sink.height();
   c.encoding = sink.encoding();
   c.pixel = sink.pixel_format();
+  c.camera_frame_id = sink.frame_id();
   s.width = c.width;
   s.height = c.height;
   s.image_encoding = c.encoding;

@@ -11,6 +11,7 @@
 #include "omnivert/core/camera_geometry.hpp"
 #include "omnivert/dataset/dataset.hpp"
 #include "omnivert/recording/import.hpp"
+#include "omnivert/recording/messages.hpp"
 
 namespace omnivert::recording {
 
@@ -27,7 +28,16 @@ struct Collected {
   int width = 0, height = 0;
   std::string encoding;
   PixelFormat pixel;
+  std::string camera_frame_id;          // the images' header.frame_id
+  std::vector<TransformMsg> tf_static;  // of /tf_static, in the recording's order
+  std::string robot_description;        // the last /robot_description
 };
+
+// The description's topics, read when the recording has them with these types.
+inline constexpr const char* kTfStaticTopic = "/tf_static";
+inline constexpr const char* kRobotDescriptionTopic = "/robot_description";
+// Whether the recording has topic `name` of type `type` (normalised) with messages.
+bool has_topic(const Recording& rec, const std::string& name, const std::string& type);
 
 // The one pass: images written to `data_dir`, odometry kept.
 Collected collect(Recording& rec,
@@ -52,5 +62,19 @@ void write_camera_sensor(const Recording& rec,
                          const ImportOptions& o,
                          const Collected& c,
                          const std::filesystem::path& cam_dir);
+
+// The robot's description (import_description.cpp): a wheel base or wheel radius of 0 in `o`
+// taken from /robot_description (with the wheel joints' names), the camera's mount from
+// /tf_static (base_frame -> camera_frame), each recorded in `s`.
+void use_description(const Recording& rec, const Collected& c, ImportOptions& o, ImportSummary& s);
+
+// prior.yaml of the dataset: the mount of `s` as the keys of `calibrate --prior`.
+std::string prior_yaml(const ImportSummary& s);
+
+// Joint-state travel collected with a wheel radius of 1 (the radius unknown during the pass)
+// scaled by o.wheel_radius, and then checked against o.max_speed.
+void scale_wheel_travel(const Recording& rec,
+                        const ImportOptions& o,
+                        std::vector<dataset::WheelRecord>& wheel);
 
 }  // namespace omnivert::recording

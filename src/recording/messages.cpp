@@ -40,10 +40,11 @@ class Decoder {
            nsec;
   }
   // std_msgs/Header: ROS 1 has a sequence number first.
-  std::int64_t header() {
+  std::int64_t header(std::string* frame_id = nullptr) {
     if (!cdr_) get<std::uint32_t>();
     const std::int64_t t = stamp();
-    string();  // frame_id
+    std::string f = string();
+    if (frame_id) *frame_id = std::move(f);
     return t;
   }
   std::span<const std::uint8_t> byte_sequence() {
@@ -82,7 +83,7 @@ ImageMsg decode_image(std::span<const std::uint8_t> bytes,
                       const std::string& what) {
   Decoder d(bytes, s, what + " (sensor_msgs/Image)");
   ImageMsg m;
-  m.stamp_ns = d.header();
+  m.stamp_ns = d.header(&m.frame_id);
   m.height = d.get<std::uint32_t>();
   m.width = d.get<std::uint32_t>();
   m.encoding = d.string();
@@ -97,7 +98,7 @@ CompressedImageMsg decode_compressed_image(std::span<const std::uint8_t> bytes,
                                            const std::string& what) {
   Decoder d(bytes, s, what + " (sensor_msgs/CompressedImage)");
   CompressedImageMsg m;
-  m.stamp_ns = d.header();
+  m.stamp_ns = d.header(&m.frame_id);
   m.format = d.string();
   m.data = d.byte_sequence();
   return m;
@@ -129,6 +130,30 @@ OdometryMsg decode_odometry(std::span<const std::uint8_t> bytes,
   m.qz = d.get<double>();
   m.qw = d.get<double>();
   return m;
+}
+
+std::vector<TransformMsg> decode_tf_message(std::span<const std::uint8_t> bytes,
+                                            Serialization s,
+                                            const std::string& what) {
+  Decoder d(bytes, s, what + " (tf2_msgs/TFMessage)");
+  const auto n = d.get<std::uint32_t>();
+  std::vector<TransformMsg> v;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    TransformMsg t;  // geometry_msgs/TransformStamped
+    t.stamp_ns = d.header(&t.parent);
+    t.child = d.string();
+    for (double& x : t.translation) x = d.get<double>();
+    for (double& x : t.rotation) x = d.get<double>();
+    v.push_back(std::move(t));
+  }
+  return v;
+}
+
+std::string decode_string(std::span<const std::uint8_t> bytes,
+                          Serialization s,
+                          const std::string& what) {
+  Decoder d(bytes, s, what + " (std_msgs/String)");
+  return d.string();
 }
 
 }  // namespace omnivert::recording

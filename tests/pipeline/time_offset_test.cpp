@@ -108,8 +108,8 @@ TEST(TimeOffset, ShiftedStampsAreRecoveredWithinTheirSigma) {
       SCOPED_TRACE(::testing::Message() << "S " << S << ", seed " << seed);
       const TimeOffsetEstimate e = estimate_time_offset(simulate(driving(), S, 1.0, seed));
       ASSERT_TRUE(e.determined) << e.why;
-      // Over 40 seeds of this run the errors' RMS is 2.1 reported sigmas (5 of them 3.2-5.4
-      // sigmas, all near -10 ms): the sigma is optimistic, hence the 12 ms floor.
+      // Over 40 seeds of this run the errors' RMS is 1.8 reported sigmas (4 of them 3.1-4.8
+      // sigmas, near +-10 ms; TheSandwichSigmaIsLessOptimistic): hence the 12 ms floor.
       EXPECT_NEAR(e.offset_s, S, std::max(4 * e.sigma_s, 0.012));
       // The wheels' noise: 0.17 degree per image pair on a 0.3 rad/s turn's start is 10 ms; 8
       // starts and ends of turns and straights.
@@ -120,6 +120,40 @@ TEST(TimeOffset, ShiftedStampsAreRecoveredWithinTheirSigma) {
       }
     }
   }
+}
+
+// The errors in reported sigmas over 40 seeds at S = 40 ms: their RMS and how many are within
+// 3 sigmas, with the sigma of the model alone (sigma_step_s 0) and with the sandwich.
+struct Consistency {
+  double rms_z = 0;
+  int within = 0, determined = 0;
+};
+Consistency consistency(const TimeOffsetOptions& o) {
+  Consistency c;
+  double sum = 0;
+  for (std::uint32_t seed = 1; seed <= 40; ++seed) {
+    const TimeOffsetEstimate e = estimate_time_offset(simulate(driving(), 0.04, 1.0, seed), o);
+    if (!e.determined) continue;
+    const double z = (e.offset_s - 0.04) / e.sigma_s;
+    sum += z * z;
+    c.within += std::abs(z) <= 3.0;
+    ++c.determined;
+  }
+  c.rms_z = std::sqrt(sum / std::max(c.determined, 1));
+  return c;
+}
+
+// Measured: the model's sigma gives errors of RMS 2.36 sigmas, 32 of 40 within 3; the sandwich
+// 1.78 and 36 of 40. Still above 1: the first-order model of each triple (k_j, c_j constant over
+// three image pairs) errs where the motion changes, which no noise term covers.
+TEST(TimeOffset, TheSandwichSigmaIsLessOptimistic) {
+  TimeOffsetOptions model;
+  model.sigma_step_s = 0;
+  const Consistency m = consistency(model), s = consistency({});
+  EXPECT_EQ(s.determined, 40);
+  EXPECT_LT(s.rms_z, 0.9 * m.rms_z);
+  EXPECT_LT(s.rms_z, 1.9);
+  EXPECT_GE(s.within, 36);
 }
 
 TEST(TimeOffset, AWheelBaseErrorDoesNotMoveIt) {

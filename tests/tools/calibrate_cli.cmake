@@ -4,7 +4,7 @@
 # --tracks), and a bad prior file. The main job's results are asserted through the library
 # call (tests/pipeline).
 #   cmake -DOV=<omnivert> -DDATA=<12-frame dataset> -DWORK=<scratch dir> -DMODE=<mode> -P calibrate_cli.cmake
-# MODE: undetermined | forced | bad_prior
+# MODE: undetermined | forced | bad_prior | dataset_prior
 cmake_minimum_required(VERSION 3.20)
 
 function(fail msg)
@@ -73,6 +73,46 @@ elseif(MODE STREQUAL "bad_prior")
   endif()
   if(EXISTS ${out_dir}/summary.json)
     fail("a bad prior file left a summary.json")
+  endif()
+
+elseif(MODE STREQUAL "dataset_prior")
+  # The dataset's prior.yaml (as the import writes it from a recording's /tf_static): the
+  # prior's mean, its source in summary.json and report.html, its frames and height in the
+  # robot formats; the flags override its mean.
+  file(REMOVE_RECURSE ${WORK}/prior-data)
+  file(COPY ${DATA}/ DESTINATION ${WORK}/prior-data)
+  file(WRITE ${WORK}/prior-data/prior.yaml "source: \"/tf_static of run.bag (base_link -> omni_camera)\"
+base_frame: base_link
+camera_frame: omni_camera
+phi: 0.1
+rho: 0.25
+psi: -0.2
+camera_height: 0.35
+")
+  set(DATA ${WORK}/prior-data)
+  run_calibrate(${out_dir} --force)
+  if(NOT rc EQUAL 0 OR NOT out MATCHES "prior: the camera's mount of /tf_static of run.bag \\(base_link -> omni_camera\\)")
+    fail("expected the prior's source on the terminal, got ${rc}: ${out} ${err}")
+  endif()
+  file(READ ${out_dir}/summary.json j)
+  string(JSON phi GET "${j}" inputs prior phi)
+  string(JSON rho GET "${j}" inputs prior rho)
+  string(JSON source GET "${j}" inputs prior source)
+  if(NOT phi EQUAL 0.1 OR NOT rho EQUAL 0.25 OR NOT source STREQUAL "/tf_static of run.bag (base_link -> omni_camera)")
+    fail("summary.json's prior: phi ${phi}, rho ${rho}, source '${source}'")
+  endif()
+  file(READ ${out_dir}/report.html html)
+  file(READ ${out_dir}/camera_joint.urdf urdf)
+  if(NOT html MATCHES "prior \\(/tf_static of run.bag \\(base_link -&gt; omni_camera\\)\\)" OR
+     NOT urdf MATCHES "<child link=\"omni_camera\"/>" OR NOT urdf MATCHES "xyz=\"[^ ]+ [^ ]+ 0.35\"")
+    fail("the report must name the prior, the URDF its frame and height:\n${urdf}")
+  endif()
+  run_calibrate(${out_dir} --force --phi 0.3)
+  file(READ ${out_dir}/summary.json j)
+  string(JSON phi GET "${j}" inputs prior phi)
+  string(JSON source GET "${j}" inputs prior source)
+  if(NOT phi EQUAL 0.3 OR NOT source MATCHES ", then the flags$")
+    fail("--phi must override prior.yaml: phi ${phi}, source '${source}'")
   endif()
 
 else()

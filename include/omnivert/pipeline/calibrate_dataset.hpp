@@ -48,6 +48,11 @@ struct CalibrateDatasetOptions {
   std::string tracks_file;         // non-empty: calibrate from this earlier tracks.csv
   bool force = false;              // write extrinsics.yaml even when undetermined
   std::string command;             // the command line, recorded in the report
+  // What the report names as the input (a recording and its imported dataset); empty: the
+  // dataset folder.
+  std::string input_name;
+  // Where the prior of `calibration` came from, named in the report; empty: the defaults.
+  std::string prior_source;
   std::vector<std::string> notes;  // extra warnings of the caller, reported with the rest
   TiltCheckOptions tilt;           // the tilt of the mirror axis (pipeline/tilt_check.hpp)
   int threads = 0;                 // threads of the frame pipeline (TrackDatasetOptions)
@@ -55,8 +60,9 @@ struct CalibrateDatasetOptions {
   // (calib/robot_formats.hpp).
   calib::RobotFrames frames;
   // The camera-odometry time offset [s], positive when the image stamps are late: given (the
-  // stamps shifted before tracking), or empty: estimated from the tracks and applied to the
-  // calibration's input when significant (pipeline/time_offset.hpp, docs/calibration.md).
+  // stamps shifted before tracking), or empty: estimated from the tracks and, when significant,
+  // applied and the images tracked again on the corrected stamps (pipeline/time_offset.hpp,
+  // docs/calibration.md).
   std::optional<double> time_offset_s;
   TimeOffsetOptions time_offset;
   // The check by eye (pipeline/reprojection.hpp), written as reprojection.png: against
@@ -66,8 +72,8 @@ struct CalibrateDatasetOptions {
   ReprojectionOptions reprojection;
   bool check_reference = false;
   bool check_off = false;
-  // Called while tracking (stage "track", frames done, frames in all) and once before the
-  // calibration (stage "calibrate", 0, 0).
+  // Called while tracking (stage "track", frames done, frames in all; "track again" when an
+  // estimated time offset is applied) and once before the calibration (stage "calibrate", 0, 0).
   std::function<void(const std::string& stage, std::size_t done, std::size_t total)> progress;
 
   // The whole tree at once: features, tracker, calibration, input, tilt, frames, time offset.

@@ -31,7 +31,10 @@ ErrorsVsTruth errors_vs_truth(const calib::Extrinsics& estimate,
 
 // Everything the report shows, gathered by the caller.
 struct ReportInputs {
-  std::string dataset;      // the dataset folder
+  std::string dataset;  // the dataset folder (and the recording it was imported from)
+  // Where the prior's mean came from (the dataset's prior.yaml of the recording's /tf_static,
+  // a --prior file, flags); empty: the defaults.
+  std::string prior_source;
   std::string command;      // the command line, for reproduction
   std::int64_t frames = 0;  // images
   std::int64_t frames_skipped = 0;

@@ -20,9 +20,12 @@
 // S, each triple weighted by its modelled variance sigma_i^2 = trace(P Sigma P) (P the
 // projection away from A; Sigma the wheels' d_theta noise, eq. 31, common to every line, and
 // the bearings'), refined by the parabola through the grid minimum and its neighbours. Its
-// sigma is sigma_S^2 = max(s^2, 1) / a, J(S) ~ J_min + a (S - S*)^2, s^2 = J_min / (n - 1):
-// the wheels' noise in the triples where the motion changes limits it (0.17 degree per image
-// pair on the simulator: about 10 ms for one turn starting). Only those triples carry S: a run
+// sigma is the larger of the model's, sigma_S^2 = max(s^2, 1) / a, J(S) ~ J_min + a (S - S*)^2,
+// s^2 = J_min / (n - 1), and the sandwich's, sum_{|i-k|<=3} g_i g_k / J''^2 (g_i the slope of
+// triple i's term at S*, over +-sigma_step_s), which counts once the noise that overlapping
+// triples share and takes the residuals as they are: the wheels' noise in the triples where
+// the motion changes limits it (0.17 degree per image pair on the simulator: about 10 ms for
+// one turn starting). Only those triples carry S: a run
 // without turns (or starts and stops) leaves it undetermined.
 
 #include <cstdint>
@@ -45,6 +48,9 @@ struct TimeOffsetOptions {
   // (in units of the modelled variance): the wheels' noise alone makes J wiggle with S, a
   // minimum that stands out from the wiggles needs a change of motion.
   double min_rise = 25.0;
+  // The sandwich sigma's step [s]: the slopes and the curvature of J over +-this (J is a sum of
+  // medians, not smooth at the grid's step); 0: the model's sigma alone.
+  double sigma_step_s = 0.005;
   // An estimate is applied when |S| exceeds `significance` sigmas and `min_applied_s`: a
   // synchronised recording keeps its stamps (and its results) unchanged.
   double significance = 3.0;

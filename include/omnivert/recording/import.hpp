@@ -15,6 +15,7 @@
 
 #include "omnivert/dataset/laser.hpp"
 #include "omnivert/recording/recording.hpp"
+#include "omnivert/recording/robot_description.hpp"
 
 namespace omnivert::recording {
 
@@ -30,7 +31,9 @@ struct ImportOptions {
   std::string odometry_topic;
   // a TUM pose file ("t x y z qx qy qz qw", t in seconds on the recording's clock).
   std::string poses_csv;
-  double wheel_base = 0;             // e [m], eq. (15): wheel0/sensor.yaml
+  // e [m], eq. (15): wheel0/sensor.yaml. 0: from /robot_description (with left_joint and
+  // right_joint), as is a wheel_radius of 0.
+  double wheel_base = 0;
   std::optional<double> odometry_k;  // Chong-Kleeman K [m], eq. (31), when known
   // A cam0/sensor.yaml to copy (centre, annulus, mask); without it only the resolution and
   // the pixel format are written and `omnivert camera` finds the rest.
@@ -41,6 +44,11 @@ struct ImportOptions {
   std::optional<dataset::LaserSensor> laser_pose;
   // A pose step faster than this is an odometry jump [m/s].
   double max_speed = 5.0;
+  // The frames of the camera's mount in /tf_static (docs/import.md#the-robots-description):
+  // base_frame -> camera_frame becomes prior.yaml; an empty camera_frame is the images'
+  // header.frame_id.
+  std::string base_frame = "base_link";
+  std::string camera_frame;
   ProgressFn progress;
 };
 
@@ -55,7 +63,18 @@ struct ImportSummary {
   int width = 0, height = 0;
   double image_start_s = 0, image_end_s = 0, wheel_start_s = 0, wheel_end_s = 0;
   std::vector<std::string> warnings;
+  // The camera's mount from /tf_static (written as prior.yaml) when the recording has the
+  // transform; `mount_source` names it, or says why there is none.
+  std::optional<CameraMount> mount;
+  std::string base_frame, camera_frame, mount_source;
+  // The wheel base and radius written, and whether they came from /robot_description.
+  double wheel_base = 0, wheel_radius = 0;
+  bool wheel_base_from_description = false, wheel_radius_from_description = false;
 };
+
+// The dataset's prior.yaml (docs/dataset-format.md#prior): the mount of the recording's
+// /tf_static, which `calibrate` takes as its prior.
+inline constexpr const char* kPriorFile = "prior.yaml";
 
 // The topics of a recording as a table (name, type, messages), for --list and for messages.
 std::string topics_table(const Recording& rec);

@@ -17,6 +17,7 @@ namespace omnivert::recording {
 // sensor_msgs/Image
 struct ImageMsg {
   std::int64_t stamp_ns = 0;
+  std::string frame_id;
   std::uint32_t height = 0, width = 0, step = 0;
   std::string encoding;
   bool big_endian = false;
@@ -26,6 +27,7 @@ struct ImageMsg {
 // sensor_msgs/CompressedImage
 struct CompressedImageMsg {
   std::int64_t stamp_ns = 0;
+  std::string frame_id;
   std::string format;
   std::span<const std::uint8_t> data;
 };
@@ -44,6 +46,15 @@ struct OdometryMsg {
   double qx = 0, qy = 0, qz = 0, qw = 1;
 };
 
+// geometry_msgs/TransformStamped, an item of tf2_msgs/TFMessage: the pose of frame `child` in
+// frame `parent` (header.frame_id), which maps child coordinates into the parent's.
+struct TransformMsg {
+  std::int64_t stamp_ns = 0;
+  std::string parent, child;
+  double translation[3] = {0, 0, 0};  // x, y, z [m]
+  double rotation[4] = {0, 0, 0, 1};  // quaternion x, y, z, w
+};
+
 ImageMsg decode_image(std::span<const std::uint8_t> bytes,
                       Serialization s,
                       const std::string& what);
@@ -56,5 +67,13 @@ JointStateMsg decode_joint_state(std::span<const std::uint8_t> bytes,
 OdometryMsg decode_odometry(std::span<const std::uint8_t> bytes,
                             Serialization s,
                             const std::string& what);
+// tf2_msgs/TFMessage (/tf_static): its transforms.
+std::vector<TransformMsg> decode_tf_message(std::span<const std::uint8_t> bytes,
+                                            Serialization s,
+                                            const std::string& what);
+// std_msgs/String (/robot_description: the URDF).
+std::string decode_string(std::span<const std::uint8_t> bytes,
+                          Serialization s,
+                          const std::string& what);
 
 }  // namespace omnivert::recording
