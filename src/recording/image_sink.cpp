@@ -52,7 +52,8 @@ bool layout_of(const std::string& e, Layout& l) {
 void write_bytes(const std::filesystem::path& p, std::span<const std::uint8_t> data) {
   std::ofstream out(p, std::ios::binary);
   out.write(reinterpret_cast<const char*>(data.data()), static_cast<std::streamsize>(data.size()));
-  if (!out) throw std::runtime_error("cannot write " + p.string());
+  if (!out)
+    throw InputError(p.string(), 0, "cannot write (disk full, or a folder that is not writable?)");
 }
 
 }  // namespace
@@ -147,7 +148,9 @@ std::int64_t ImageSink::add(const Message& m, const std::string& what, std::stri
   filename = std::to_string(t) + ".png";
   const std::vector<int> params = {cv::IMWRITE_PNG_COMPRESSION, 3};
   if (!cv::imwrite((dir_ / filename).string(), out, params)) {
-    throw std::runtime_error("cannot write " + (dir_ / filename).string());
+    throw InputError((dir_ / filename).string(),
+                     0,
+                     "cannot write (disk full, or a folder that is not writable?)");
   }
   return t;
 }

@@ -1,8 +1,10 @@
 #include "omnivert/recording/import.hpp"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdio>
 #include <filesystem>
 
@@ -58,6 +60,21 @@ struct TempDir {
   }
 };
 
+// The temporary folders `prefix`<pid> beside `out` of imports that were killed (no process
+// has their pid any more): removed, so that a killed run leaves nothing after the next one.
+void remove_stale_temporaries(const fs::path& parent, const std::string& prefix) {
+  std::error_code ec;
+  for (fs::directory_iterator it(parent, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.rfind(prefix, 0) != 0) continue;
+    const std::string pid = name.substr(prefix.size());
+    if (pid.empty() || pid.size() > 9 || pid.find_first_not_of("0123456789") != std::string::npos)
+      continue;
+    std::error_code rm;
+    if (::kill(std::stoi(pid), 0) == -1 && errno == ESRCH) fs::remove_all(it->path(), rm);
+  }
+}
+
 void check_options(const Recording& rec, const ImportOptions& o) {
   const int sources =
       !o.joint_states_topic.empty() + !o.odometry_topic.empty() + !o.poses_csv.empty();
@@ -82,14 +99,18 @@ double seconds(std::int64_t ns) { return static_cast<double>(ns) * 1e-9; }
 
 ImportSummary import_recording(Recording& rec, const ImportOptions& o) {
   check_options(rec, o);
-  const fs::path out = fs::absolute(o.out).lexically_normal();
+  // "run/" names the folder run: its temporary sibling must not lie inside it.
+  fs::path out = fs::absolute(o.out).lexically_normal();
+  if (!out.has_filename() && out.has_parent_path()) out = out.parent_path();
   std::error_code ec;
   if (fs::exists(out, ec) && !o.overwrite) {
     throw InputError(out.string(), 0, "exists already (give --force to replace it)");
   }
+  if (o.overwrite) dataset::check_replaceable(out);
   std::string hidden = ".";
   hidden += out.filename().string();
   hidden += ".import-";
+  remove_stale_temporaries(out.parent_path(), hidden);
   hidden += std::to_string(getpid());
   TempDir tmp{out.parent_path() / hidden};
   fs::remove_all(tmp.path, ec);
