@@ -28,4 +28,14 @@ void write_text_atomic(const std::string& path, const std::string& text) {
   if (ec) throw InputError(path, 0, "cannot write: " + ec.message());
 }
 
+std::string unreadable_file_reason(const std::string& path) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (ec == std::errc::too_many_symbolic_link_levels) return "is a loop of symbolic links";
+  if (!fs::exists(st)) return "file not found";
+  if (fs::is_directory(st)) return "is a directory";
+  if (!fs::is_regular_file(st)) return "is not a regular file (a FIFO, a socket or a device)";
+  return {};
+}
+
 }  // namespace omnivert

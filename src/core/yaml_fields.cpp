@@ -7,16 +7,21 @@
 #include <yaml-cpp/yaml.h>
 
 #include "omnivert/core/error.hpp"
+#include "omnivert/core/file_io.hpp"
 
 namespace omnivert::yaml {
 
-int line_of(const YAML::Node& node) { return node.Mark().line + 1; }
+// 0 (no line) for a key that is absent: its node has no mark.
+int line_of(const YAML::Node& node) { return node.IsDefined() ? node.Mark().line + 1 : 0; }
 
 YAML::Node load_file(const std::string& path) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (!fs::exists(path, ec)) throw InputError(path, 0, "file not found");
   if (fs::is_directory(path, ec)) throw InputError(path, 0, "is a directory, expected a YAML file");
+  if (const std::string why = unreadable_file_reason(path); !why.empty()) {
+    throw InputError(path, 0, why);
+  }
   std::ifstream in(path);
   if (!in) throw InputError(path, 0, "cannot be opened for reading");
   YAML::Node root;

@@ -34,7 +34,7 @@ std::optional<std::vector<double>> optional_numbers(const YAML::Node& map,
 std::optional<std::string> optional_string(const YAML::Node& map,
                                            const std::string& key,
                                            const std::string& file);
-// 1-based line of a node, for messages.
+// 1-based line of a node, for messages; 0 for an absent key.
 int line_of(const YAML::Node& node);
 
 }  // namespace omnivert::yaml

@@ -14,6 +14,7 @@
 
 #include "core/yaml_fields.hpp"
 #include "omnivert/core/error.hpp"
+#include "omnivert/core/file_io.hpp"
 #include "omnivert/image/grey.hpp"
 
 namespace omnivert::dataset {
@@ -44,8 +45,9 @@ std::vector<CsvRow> read_csv(const std::string& path,
                              std::string* header_out,
                              std::vector<std::string>* notes) {
   int extra_rows = 0;
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw InputError(path, 0, "file not found");
+  if (const std::string why = unreadable_file_reason(path); !why.empty()) {
+    throw InputError(path, 0, why);
+  }
   std::ifstream in(path);
   if (!in) throw InputError(path, 0, "cannot be opened for reading");
   std::vector<CsvRow> rows;
@@ -151,7 +153,12 @@ std::string rel(const std::string& root, const std::string& sub) {
 }
 
 cv::Mat1b read_checked_image(const std::string& path, const CameraGeometry& cam) {
-  const cv::Mat raw = cv::imread(path, cv::IMREAD_UNCHANGED);
+  cv::Mat raw;
+  try {
+    raw = cv::imread(path, cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception& e) {
+    throw InputError(path, 0, std::string("cannot be read as an image: ") + e.what());
+  }
   if (raw.empty()) throw InputError(path, 0, "cannot be read as an image");
   if (raw.cols != cam.width || raw.rows != cam.height) {
     throw InputError(path,

@@ -4,6 +4,8 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "omnivert/core/error.hpp"
+
 namespace omnivert::dataset {
 
 namespace {
@@ -18,7 +20,8 @@ std::string fmt(const char* format, double v) {
 
 CsvWriter::CsvWriter(std::string path, const std::string& header) : path_(std::move(path)) {
   f_ = std::fopen(path_.c_str(), "w");
-  if (!f_) throw std::runtime_error("cannot write " + path_);
+  if (!f_)
+    throw InputError(path_, 0, "cannot write (disk full, or a folder that is not writable?)");
   row(header);
 }
 
@@ -36,7 +39,7 @@ void CsvWriter::close() {
   const bool bad = std::ferror(f_) != 0;
   const bool close_failed = std::fclose(f_) != 0;
   f_ = nullptr;
-  if (bad || close_failed) throw std::runtime_error("write error in " + path_);
+  if (bad || close_failed) throw InputError(path_, 0, "write error (disk full?)");
 }
 
 ImageCsvWriter::ImageCsvWriter(const std::string& path) : csv_(path, "#timestamp [ns],filename") {}
@@ -80,7 +83,25 @@ std::string wheel_sensor_yaml(const WheelSensor& s, double rate_hz, const std::s
 void write_text_file(const std::string& path, const std::string& text) {
   std::ofstream out(path);
   out << text;
-  if (!out) throw std::runtime_error("cannot write " + path);
+  if (!out)
+    throw InputError(path, 0, "cannot write (disk full, or a folder that is not writable?)");
+}
+
+void check_replaceable(const std::filesystem::path& out) {
+  namespace fs = std::filesystem;
+  const std::string name = out.filename().string();
+  if (name.empty() || name == "." || name == "..") {
+    throw InputError(out.string(), 0, "give the output folder by its name to replace it");
+  }
+  std::error_code ec;
+  if (!fs::exists(out, ec)) return;
+  if (!fs::is_directory(out, ec)) {
+    throw InputError(out.string(), 0, "is a file, not a dataset folder: not replaced");
+  }
+  if (fs::is_empty(out, ec) || fs::is_regular_file(out / "cam0" / "data.csv", ec)) return;
+  throw InputError(out.string(),
+                   0,
+                   "is not a dataset folder (no cam0/data.csv): --force replaces only a dataset");
 }
 
 }  // namespace omnivert::dataset

@@ -16,6 +16,9 @@ cv::Mat read_image(const std::string& path) {
   if (!fs::exists(path, ec)) throw InputError(path, 0, "file not found");
   if (fs::is_directory(path, ec))
     throw InputError(path, 0, "is a directory, expected an image file");
+  if (const std::string why = unreadable_file_reason(path); !why.empty()) {
+    throw InputError(path, 0, why);
+  }
   {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError(path, 0, "cannot be opened for reading (permissions?)");

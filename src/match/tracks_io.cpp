@@ -114,6 +114,9 @@ void write_tracks_csv(const fs::path& path, const std::vector<TrackRow>& rows) {
 
 std::vector<TrackRow> read_tracks_csv(const fs::path& path) {
   const std::string file = path.string();
+  if (const std::string why = unreadable_file_reason(file); !why.empty()) {
+    throw InputError(file, 0, why);
+  }
   std::ifstream f(path);
   if (!f) throw InputError(file, 0, "cannot open (missing file?)");
   std::string text;
@@ -128,7 +131,12 @@ std::vector<TrackRow> read_tracks_csv(const fs::path& path) {
     if (!have_header) {
       if (line.front() == '#') line.remove_prefix(1);
       const auto names = split(line);
-      for (int i = 0; i < static_cast<int>(names.size()); ++i) col[std::string(names[i])] = i;
+      for (int i = 0; i < static_cast<int>(names.size()); ++i) {
+        if (!col.emplace(std::string(names[i]), i).second) {
+          throw InputError(
+              file, line_no, "column '" + std::string(names[i]) + "' appears twice in the header");
+        }
+      }
       for (const char* required : {"frame", "timestamp_ns", "track_id", "bearing_rad"}) {
         if (!col.count(required)) {
           throw InputError(file,

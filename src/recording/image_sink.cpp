@@ -17,6 +17,8 @@ const char* kEncodings =
     "mono8, mono16, 8UC1, 16UC1, rgb8, bgr8, rgba8, bgra8, bayer_rggb8, bayer_bggr8, bayer_gbrg8, "
     "bayer_grbg8 and their 16-bit forms";
 
+constexpr std::uint32_t kMaxSide = 1 << 20;
+
 struct Layout {
   int cv_type = 0;
   int conversion = -1;  // cv::cvtColor code to BGR, or -1
@@ -50,7 +52,8 @@ bool layout_of(const std::string& e, Layout& l) {
 void write_bytes(const std::filesystem::path& p, std::span<const std::uint8_t> data) {
   std::ofstream out(p, std::ios::binary);
   out.write(reinterpret_cast<const char*>(data.data()), static_cast<std::streamsize>(data.size()));
-  if (!out) throw std::runtime_error("cannot write " + p.string());
+  if (!out)
+    throw InputError(p.string(), 0, "cannot write (disk full, or a folder that is not writable?)");
 }
 
 }  // namespace
@@ -112,6 +115,14 @@ std::int64_t ImageSink::add(const Message& m, const std::string& what, std::stri
     throw InputError(what + ": image encoding '" + im.encoding + "' is not one we read (" +
                      kEncodings + ")");
   }
+  // Before the sizes become an int and a cv::Mat: an empty image, or one wider or taller
+  // than any camera's, is refused.
+  if (im.width == 0 || im.height == 0)
+    throw InputError(what + ": an empty image (width or height 0)");
+  if (im.width > kMaxSide || im.height > kMaxSide) {
+    throw InputError(what + ": a " + std::to_string(im.width) + "x" + std::to_string(im.height) +
+                     " image (more than " + std::to_string(kMaxSide) + " pixels a side)");
+  }
   check_size(static_cast<int>(im.width), static_cast<int>(im.height), im.encoding, what);
   const std::size_t row = static_cast<std::size_t>(im.width) * CV_ELEM_SIZE(l.cv_type);
   if (im.step < row || im.data.size() < static_cast<std::size_t>(im.step) * im.height) {
@@ -135,13 +146,13 @@ std::int64_t ImageSink::add(const Message& m, const std::string& what, std::stri
   }
   if (l.conversion >= 0) cv::cvtColor(img, out, l.conversion);
   pixel_.bayer = l.bayer;
-  if (im.width == 0 || im.height == 0)
-    throw InputError(what + ": an empty image (width or height 0)");
   const std::int64_t t = stamp_or_log_time(im.stamp_ns, m);
   filename = std::to_string(t) + ".png";
   const std::vector<int> params = {cv::IMWRITE_PNG_COMPRESSION, 3};
   if (!cv::imwrite((dir_ / filename).string(), out, params)) {
-    throw std::runtime_error("cannot write " + (dir_ / filename).string());
+    throw InputError((dir_ / filename).string(),
+                     0,
+                     "cannot write (disk full, or a folder that is not writable?)");
   }
   return t;
 }

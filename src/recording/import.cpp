@@ -1,9 +1,11 @@
 #include "omnivert/recording/import.hpp"
 #include "omnivert/recording/laser_scan.hpp"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -60,6 +62,21 @@ struct TempDir {
   }
 };
 
+// The temporary folders `prefix`<pid> beside `out` of imports that were killed (no process
+// has their pid any more): removed, so that a killed run leaves nothing after the next one.
+void remove_stale_temporaries(const fs::path& parent, const std::string& prefix) {
+  std::error_code ec;
+  for (fs::directory_iterator it(parent, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.rfind(prefix, 0) != 0) continue;
+    const std::string pid = name.substr(prefix.size());
+    if (pid.empty() || pid.size() > 9 || pid.find_first_not_of("0123456789") != std::string::npos)
+      continue;
+    std::error_code rm;
+    if (::kill(std::stoi(pid), 0) == -1 && errno == ESRCH) fs::remove_all(it->path(), rm);
+  }
+}
+
 // The wheel base and the radius may come from /robot_description (use_description): they are
 // checked once it has been read (check_wheels).
 void check_options(const Recording& rec, const ImportOptions& o) {
@@ -108,14 +125,18 @@ void check_wheels(const Recording& rec, const ImportOptions& o) {
 ImportSummary import_recording(Recording& rec, const ImportOptions& options) {
   check_options(rec, options);
   ImportOptions o = options;  // the wheel base and radius completed by the description
-  const fs::path out = fs::absolute(o.out).lexically_normal();
+  // "run/" names the folder run: its temporary sibling must not lie inside it.
+  fs::path out = fs::absolute(o.out).lexically_normal();
+  if (!out.has_filename() && out.has_parent_path()) out = out.parent_path();
   std::error_code ec;
   if (fs::exists(out, ec) && !o.overwrite) {
     throw InputError(out.string(), 0, "exists already (give --force to replace it)");
   }
+  if (o.overwrite) dataset::check_replaceable(out);
   std::string hidden = ".";
   hidden += out.filename().string();
   hidden += ".import-";
+  remove_stale_temporaries(out.parent_path(), hidden);
   hidden += std::to_string(getpid());
   TempDir tmp{out.parent_path() / hidden};
   fs::remove_all(tmp.path, ec);

@@ -42,7 +42,8 @@ double distance_to_segment(const Eigen::Vector2d& p,
 
 FILE* open_or_throw(const fs::path& p) {
   FILE* f = std::fopen(p.c_str(), "w");
-  if (!f) throw std::runtime_error("cannot write " + p.string());
+  if (!f)
+    throw InputError(p.string(), 0, "cannot write (disk full, or a folder that is not writable?)");
   return f;
 }
 
@@ -56,7 +57,8 @@ struct FileCloser {
 void write_text(const fs::path& p, const std::string& text) {
   std::ofstream out(p);
   out << text;
-  if (!out) throw std::runtime_error("cannot write " + p.string());
+  if (!out)
+    throw InputError(p.string(), 0, "cannot write (disk full, or a folder that is not writable?)");
 }
 
 std::string fmt(const char* format, double v) {
@@ -306,7 +308,9 @@ void write_frames(const fs::path& dir,
     apply_image_sensor(clean, cfg.image, image_rng, img);
     const std::string name = std::to_string(ts) + ".png";
     if (!cv::imwrite((dir / "cam0" / "data" / name).string(), img, png_params)) {
-      throw std::runtime_error("cannot write image " + (dir / "cam0" / "data" / name).string());
+      throw InputError((dir / "cam0" / "data" / name).string(),
+                       0,
+                       "cannot write (disk full, or a folder that is not writable?)");
     }
     fcam.add(ts, name);
     std::fprintf(
@@ -327,7 +331,7 @@ void write_frames(const fs::path& dir,
   summary.mean_lines = static_cast<double>(total_lines) / n_frames;
   fcam.close();
   for (FILE* f : {fpose, flines}) {
-    if (std::ferror(f)) throw std::runtime_error("write error in " + dir.string());
+    if (std::ferror(f)) throw InputError(dir.string(), 0, "write error (disk full?)");
   }
 }
 
@@ -345,7 +349,8 @@ void write_map(const fs::path& path,
     cams.emplace_back(c.x, c.y);
   }
   if (!cv::imwrite(path.string(), draw_map(world, path_poses, cams))) {
-    throw std::runtime_error("cannot write " + path.string());
+    throw InputError(
+        path.string(), 0, "cannot write (disk full, or a folder that is not writable?)");
   }
 }
 
@@ -382,7 +387,9 @@ void write_dataset(const World& world,
     const cv::Mat mask =
         overlay_mask(overlay_picture(cfg.overlay, cfg.camera), cfg.overlay.mask_margin_px);
     if (!cv::imwrite((dir / "cam0" / "mask.png").string(), mask)) {
-      throw std::runtime_error("cannot write " + (dir / "cam0" / "mask.png").string());
+      throw InputError((dir / "cam0" / "mask.png").string(),
+                       0,
+                       "cannot write (disk full, or a folder that is not writable?)");
     }
   }
   write_extrinsics(dir / "ground_truth" / "extrinsics.yaml", cfg.extrinsics, cfg.camera_height);
@@ -437,11 +444,14 @@ SimSummary simulate(const World& world,
                      world.name + "' (0 to " + std::to_string(world.height) + " m)");
   }
 
-  const fs::path out = fs::path(out_dir);
+  // "run/" names the folder run: its temporary sibling must not lie inside it.
+  fs::path out = fs::path(out_dir).lexically_normal();
+  if (!out.has_filename() && out.has_parent_path()) out = out.parent_path();
   std::error_code ec;
   if (fs::exists(out, ec) && !overwrite) {
     throw InputError(out.string(), 0, "already exists (use --force to replace it)");
   }
+  if (overwrite) dataset::check_replaceable(out);
   fs::path parent = out.parent_path();
   if (parent.empty()) parent = ".";
   fs::create_directories(parent);

@@ -26,6 +26,7 @@
 // and skip the frame; the first image that exists is the one read on load.
 
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <span>
 #include <string>
@@ -143,13 +144,24 @@ class Dataset {
   // image_outside_wheel_data(i)). Returns the number of such images. 0 after load.
   int set_image_time_offset(std::int64_t offset_ns);
   std::int64_t image_time_offset_ns() const { return image_time_offset_ns_; }
-  // Image i's stamp on the odometry clock: images()[i].timestamp_ns - image_time_offset_ns().
+  // Image i's stamp on the odometry clock: images()[i].timestamp_ns - image_time_offset_ns(),
+  // saturated at the limits of int64 (a stamp near them, shifted by the offset).
   std::int64_t odometry_time(std::size_t i) const {
-    return images_[i].timestamp_ns - image_time_offset_ns_;
+    std::int64_t t = 0;
+    if (__builtin_sub_overflow(images_[i].timestamp_ns, image_time_offset_ns_, &t)) {
+      return image_time_offset_ns_ < 0 ? std::numeric_limits<std::int64_t>::max()
+                                       : std::numeric_limits<std::int64_t>::min();
+    }
+    return t;
   }
+  // Compared without overflow: stamps are >= 0 (load refuses negative ones).
   bool image_outside_wheel_data(std::size_t i) const {
-    return has_wheel() && (odometry_time(i) < wheel_.front().timestamp_ns ||
-                           odometry_time(i) > wheel_.back().timestamp_ns);
+    if (!has_wheel()) return false;
+    const std::int64_t t = images_[i].timestamp_ns, off = image_time_offset_ns_;
+    if (off >= 0) {
+      return t - off < wheel_.front().timestamp_ns || t - off > wheel_.back().timestamp_ns;
+    }
+    return t < wheel_.front().timestamp_ns + off || t > wheel_.back().timestamp_ns + off;
   }
 
   // Empty when there is no ground_truth/ folder or when it could not be read; then

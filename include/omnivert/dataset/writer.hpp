@@ -5,13 +5,14 @@
 
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 
 #include "omnivert/dataset/dataset.hpp"
 
 namespace omnivert::dataset {
 
-// A CSV file written row by row; throws std::runtime_error naming the file when it cannot be
+// A CSV file written row by row; throws InputError naming the file when it cannot be
 // opened or written.
 class CsvWriter {
  public:
@@ -61,7 +62,13 @@ std::string wheel_sensor_yaml(const WheelSensor& sensor,
                               double rate_hz,
                               const std::string& provenance);
 
-// Writes `text` to `path`; throws std::runtime_error naming the file on failure.
+// Writes `text` to `path`; throws InputError naming the file on failure (a full disk).
 void write_text_file(const std::string& path, const std::string& text);
+
+// What a writer's `--force` may replace: a folder named by its own name (not `.`, `..` or a
+// path ending in a separator) that is empty or holds a dataset (cam0/data.csv). Throws
+// InputError naming the folder otherwise, so that a mistyped --out never removes a folder
+// of the user's.
+void check_replaceable(const std::filesystem::path& out);
 
 }  // namespace omnivert::dataset
