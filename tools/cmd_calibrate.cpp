@@ -19,8 +19,8 @@
 
 #include "check_options.hpp"
 #include "commands.hpp"
-#include "core/parallel.hpp"
 #include "config_file.hpp"
+#include "core/parallel.hpp"
 #include "core/progress.hpp"
 #include "core/yaml_fields.hpp"
 #include "import_options.hpp"

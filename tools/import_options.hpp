@@ -18,9 +18,9 @@ inline constexpr const char* kRecordingGroup = "Recording (ROS 1 or ROS 2 bag; d
 
 struct ImportFlags {
   recording::ImportOptions o;
-  std::string wheel_joints;   // LEFT,RIGHT
-  double odometry_k = -1;     // < 0: not given
-  bool keep_dataset = false;  // track, calibrate: keep OUT/dataset
+  std::string wheel_joints;        // LEFT,RIGHT
+  double odometry_k = -1;          // < 0: not given
+  bool keep_dataset = false;       // track, calibrate: keep OUT/dataset
   std::vector<double> laser_pose;  // --laser-pose X Y YAW
 };
 

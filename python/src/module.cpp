@@ -60,7 +60,8 @@ py::dict defaults(const std::string& call) {
     add(options_dict(calibration_table(), calib::recommended_options()));
   if (call == "calibrate_dataset")
     add(options_dict(dataset_job_table(), pipeline::CalibrateDatasetOptions{}));
-  if (call == "track_dataset") add(options_dict(track_job_table(), pipeline::TrackDatasetOptions{}));
+  if (call == "track_dataset")
+    add(options_dict(track_job_table(), pipeline::TrackDatasetOptions{}));
   if (call == "simulate") add(options_dict(simulation_table(), sim::SimConfig{}));
   if (d.empty()) throw py::value_error("defaults(): no call named '" + call + "'");
   return d;

@@ -13,8 +13,8 @@ int resolve_threads(int requested) {
 }
 
 void parallel_for(std::size_t n, int threads, const std::function<void(std::size_t, int)>& fn) {
-  const int workers = static_cast<int>(std::min<std::size_t>(n, static_cast<std::size_t>(
-                                                                    std::max(threads, 1))));
+  const int workers =
+      static_cast<int>(std::min<std::size_t>(n, static_cast<std::size_t>(std::max(threads, 1))));
   if (workers <= 1) {
     for (std::size_t i = 0; i < n; ++i) fn(i, 0);
     return;
@@ -23,7 +23,8 @@ void parallel_for(std::size_t n, int threads, const std::function<void(std::size
   // threads' timing.
   std::vector<std::exception_ptr> errors(n);
   auto run = [&](int w) {
-    for (std::size_t i = static_cast<std::size_t>(w); i < n; i += static_cast<std::size_t>(workers)) {
+    for (std::size_t i = static_cast<std::size_t>(w); i < n;
+         i += static_cast<std::size_t>(workers)) {
       try {
         fn(i, w);
       } catch (...) {

@@ -241,11 +241,11 @@ std::string mounting_text(const calib::Extrinsics& x) {
 }
 
 viz::ReprojectionLayer layer_of(const FrameReference* ref,
-                           const calib::Extrinsics& x,
-                           const std::vector<double>& lines,
-                           double gate,
-                           const std::string& name,
-                           std::size_t frame) {
+                                const calib::Extrinsics& x,
+                                const std::vector<double>& lines,
+                                double gate,
+                                const std::string& name,
+                                std::size_t frame) {
   viz::ReprojectionLayer layer;
   const Eigen::Vector2d cam = x.position();
   std::vector<double> offsets;

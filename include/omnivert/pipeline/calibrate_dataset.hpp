@@ -44,10 +44,10 @@ struct CalibrateDatasetOptions {
   // Chong-Kleeman K come from wheel0/sensor.yaml (options_from_dataset); everything else
   // from here.
   calib::CalibrationOptions calibration = calib::recommended_options();
-  DatasetRunOptions input;         // wheel gaps, crowded lines
-  std::string tracks_file;         // non-empty: calibrate from this earlier tracks.csv
-  bool force = false;              // write extrinsics.yaml even when undetermined
-  std::string command;             // the command line, recorded in the report
+  DatasetRunOptions input;  // wheel gaps, crowded lines
+  std::string tracks_file;  // non-empty: calibrate from this earlier tracks.csv
+  bool force = false;       // write extrinsics.yaml even when undetermined
+  std::string command;      // the command line, recorded in the report
   // What the report names as the input (a recording and its imported dataset); empty: the
   // dataset folder.
   std::string input_name;
