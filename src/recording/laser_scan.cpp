@@ -2,56 +2,14 @@
 
 #include "omnivert/core/error.hpp"
 #include "omnivert/dataset/writer.hpp"
-#include "recording/bytes.hpp"
+#include "recording/decoder.hpp"
 
 namespace omnivert::recording {
-
-namespace {
-
-// ROS 1: packed little endian, sequences <u32 length><items>, time <u32 s><u32 ns>, a header
-// with a sequence number. CDR (XCDR1): a 4-byte encapsulation header, primitives aligned to
-// their size from its end, strings with their NUL, time <i32 s><u32 ns>.
-class ScanReader {
- public:
-  ScanReader(std::span<const std::uint8_t> bytes, Serialization s, const std::string& what)
-      : r_(bytes, what), cdr_(s == Serialization::kCdr) {
-    if (cdr_ && r_.bytes(4)[1] != 0x01) r_.fail("CDR encapsulation is not little-endian plain CDR");
-  }
-  template <typename T>
-  T get() {
-    if (cdr_) {
-      const std::size_t off = r_.pos() - 4;
-      if (off % sizeof(T)) r_.bytes(sizeof(T) - off % sizeof(T));
-    }
-    return r_.get<T>();
-  }
-  std::int64_t header() {
-    if (!cdr_) get<std::uint32_t>();  // seq
-    const auto sec = get<std::int32_t>();
-    const auto nsec = get<std::uint32_t>();
-    r_.bytes(get<std::uint32_t>());  // frame_id
-    return static_cast<std::int64_t>(cdr_ ? sec : static_cast<std::uint32_t>(sec)) * 1'000'000'000 +
-           nsec;
-  }
-  std::vector<float> floats() {
-    const auto n = get<std::uint32_t>();
-    r_.need(static_cast<std::size_t>(n) * 4);
-    std::vector<float> v(n);
-    for (auto& x : v) x = get<float>();
-    return v;
-  }
-
- private:
-  ByteReader r_;
-  bool cdr_;
-};
-
-}  // namespace
 
 LaserScanMsg decode_laser_scan(std::span<const std::uint8_t> bytes,
                                Serialization s,
                                const std::string& what) {
-  ScanReader d(bytes, s, what + " (sensor_msgs/LaserScan)");
+  Decoder d(bytes, s, what + " (sensor_msgs/LaserScan)");
   LaserScanMsg m;
   m.stamp_ns = d.header();
   m.angle_min = d.get<float>();
@@ -61,7 +19,7 @@ LaserScanMsg decode_laser_scan(std::span<const std::uint8_t> bytes,
   d.get<float>();  // scan_time
   m.range_min = d.get<float>();
   m.range_max = d.get<float>();
-  m.ranges = d.floats();
+  m.ranges = d.numbers<float>();
   return m;
 }
 
