@@ -256,6 +256,16 @@ void add_model_options(CLI::App* cmd, CalibrateArgs& a) {
       ->check(kPositive)
       ->capture_default_str()
       ->group(gm);
+  cmd->add_option("--calibration-length-fraction",
+                  a.options.input.min_annulus_fraction,
+                  "Lines shorter than this fraction of the annulus are tracked but their "
+                  "bearings are not used by the calibration (0.5: the paper's rule; 0: every "
+                  "line). Not given: 0.5, or shorter lines when fewer than 15 tracks hold such "
+                  "lines (docs/calibration.md#which-lines)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->each([&a](const std::string&) { a.options.input.enough_tracks = 0; })
+      ->capture_default_str()
+      ->group(gm);
   cmd->add_option("--time-offset",
                   a.time_offset,
                   "Camera-odometry time offset [s], positive when the image stamps are late: "

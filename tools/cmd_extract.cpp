@@ -113,6 +113,7 @@ void run_extract(const ExtractArgs& a) {
       jl["bearing"] = l.bearing;
       jl["image_angle"] = l.image_angle;
       jl["edge_pixels"] = l.edge_pixels;
+      jl["annulus_fraction"] = l.annulus_fraction;
       jl["r_inner"] = l.r_inner;
       jl["r_outer"] = l.r_outer;
       jl["polarity"] = l.polarity;

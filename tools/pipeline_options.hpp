@@ -70,16 +70,18 @@ inline void add_tilt_options(CLI::App* cmd, pipeline::TiltCheckOptions& o) {
 inline void add_pipeline_options(CLI::App* cmd, FeaturePipelineOptions& o) {
   const std::string g = kExtractionGroup;
   static const std::map<std::string, LineThreshold> kThreshold{
+      {"significant-or-long", LineThreshold::kSignificantOrLong},
       {"significance", LineThreshold::kSignificance},
       {"fraction", LineThreshold::kFractionOfAnnulus},
       {"adaptive", LineThreshold::kAdaptive},
       {"topk", LineThreshold::kTopK}};
   cmd->add_option("--line-threshold",
                   o.lines.threshold,
-                  "Which lines to keep: fraction (>= --length-fraction of R_max - R_min, the "
-                  "paper's), significance (fewer than 1 false alarm expected among random edge "
-                  "pixels, a contrario), adaptive (mean + 3 sigma "
-                  "of candidate lengths), topk")
+                  "Which lines to keep: significant-or-long (the default: either of the next "
+                  "two), significance (fewer than 10^-(--min-significance) false alarms expected "
+                  "among random edge pixels, a contrario), fraction (>= --length-fraction of "
+                  "R_max - R_min, the paper's), adaptive (mean + 3 sigma of candidate lengths), "
+                  "topk")
       ->transform(CLI::CheckedTransformer(kThreshold, CLI::ignore_case))
       ->group(g);
   cmd->add_option("--peak-window",

@@ -59,6 +59,8 @@ void bind_frame_features(py::module_& m) {
       .def_readonly("image_angle", &VerticalLine::image_angle, "[rad], (-pi, pi]")
       .def_readonly("bearing", &VerticalLine::bearing, "camera bearing [rad], (-pi, pi]")
       .def_readonly("edge_pixels", &VerticalLine::edge_pixels)
+      .def_readonly(
+          "annulus_fraction", &VerticalLine::annulus_fraction, "edge_pixels / (R_max - R_min)")
       .def_readonly("r_inner", &VerticalLine::r_inner)
       .def_readonly("r_outer", &VerticalLine::r_outer)
       .def_readonly("fit_rms_px", &VerticalLine::fit_rms_px)

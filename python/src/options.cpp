@@ -47,12 +47,14 @@ const OptionTable<FP>& extraction_table() {
   static const OptionTable<FP> t{
       choice<FP>(
           "line_threshold",
-          "which lines to keep: significance, fraction, adaptive or topk",
+          "which lines to keep: significant-or-long, significance, fraction, adaptive or topk",
           [](FP & o) -> auto& { return o.lines.threshold; },
-          std::map<std::string, LineThreshold>{{"significance", LineThreshold::kSignificance},
-                                               {"fraction", LineThreshold::kFractionOfAnnulus},
-                                               {"adaptive", LineThreshold::kAdaptive},
-                                               {"topk", LineThreshold::kTopK}}),
+          std::map<std::string, LineThreshold>{
+              {"significant-or-long", LineThreshold::kSignificantOrLong},
+              {"significance", LineThreshold::kSignificance},
+              {"fraction", LineThreshold::kFractionOfAnnulus},
+              {"adaptive", LineThreshold::kAdaptive},
+              {"topk", LineThreshold::kTopK}}),
       field<int, FP>(
           "peak_window",
           "sectors added on each side of a line peak's 0.5 degree sector",
@@ -283,6 +285,10 @@ const OptionTable<DO>& dataset_job_table() {
           "crowded_sigma", "bearing sigma factor of a crowded line", [](DO & o) -> auto& {
             return o.input.crowded_sigma_scale;
           }),
+      field<double, DO>(
+          "calibration_length_fraction",
+          "lines shorter than this fraction of the annulus are tracked, not used",
+          [](DO & o) -> auto& { return o.input.min_annulus_fraction; }),
       field<double, DO>(
           "max_wheel_gap", "wheel samples further apart are a gap [s]", [](DO & o) -> auto& {
             return o.input.max_wheel_gap_s;

@@ -248,6 +248,8 @@ void LineExtractor::extract(const cv::Mat& gray,
   suppress_non_maxima(circle);
   refit_crowded_lines(circle);
   threshold_lines(circle, out);
+  const double annulus = circle.r_max - circle.r_min;
+  for (VerticalLine& l : out) l.annulus_fraction = l.edge_pixels / annulus;
 }
 
 void LineExtractor::edge_pass(const cv::Mat& gray, int cxi, int cyi) {
@@ -384,12 +386,16 @@ void LineExtractor::suppress_non_maxima(const MirrorCircle& circle) {
     const double Li = std::max(1.0, std::floor(L));
     log10_tests_ = std::log10(2.0 * N * Li * (Li + 1) / 2);
   }
-  if (options_.threshold == LineThreshold::kSignificance) {
+  if (uses_significance()) {
     // Fewer hits than this cannot be significant even in a row (votes split between two
     // sectors: half of them).
     const double p = std::max(hit_probability_[0], hit_probability_[1]);
     const double k_min = (log10_tests_ + options_.min_significance) / -std::log10(p);
-    peak_min = static_cast<float>(std::max(2.0, 0.5 * k_min));
+    const float significant_min = static_cast<float>(std::max(2.0, 0.5 * k_min));
+    const float long_min = static_cast<float>(0.4 * options_.length_fraction * L);
+    peak_min = options_.threshold == LineThreshold::kSignificance
+                   ? significant_min
+                   : std::min(significant_min, long_min);
   }
   const double cx = circle.center.x(), cy = circle.center.y();
   const double max_gap = std::max(1.0, options_.max_gap_px);
@@ -461,8 +467,10 @@ bool LineExtractor::fit_peak(
   lc->length = covered;
   lc->line.significance =
       line_significance(radii, local_hit_probability(k, pol, a, cx, cy), log10_tests_);
-  return options_.threshold != LineThreshold::kSignificance ||
-         lc->line.significance >= options_.min_significance;
+  if (!uses_significance()) return true;  // threshold_lines decides
+  return lc->line.significance >= options_.min_significance ||
+         (options_.threshold == LineThreshold::kSignificantOrLong &&
+          covered >= options_.length_fraction * (lut_r_max_ - lut_r_min_));
 }
 
 void LineExtractor::refit_crowded_lines(const MirrorCircle& circle) {
@@ -515,9 +523,9 @@ void LineExtractor::threshold_lines(const MirrorCircle& circle, std::vector<Vert
   } else if (options_.threshold == LineThreshold::kTopK) {
     thr = options_.min_fraction * L;
   }
-  if (options_.threshold == LineThreshold::kSignificance) thr = 0;  // fit_peak kept them
+  if (uses_significance()) thr = 0;  // fit_peak kept them
   // The most significant (or longest) first, so that of two peaks of one edge it is kept.
-  const bool by_significance = options_.threshold == LineThreshold::kSignificance;
+  const bool by_significance = uses_significance();
   std::sort(found.begin(), found.end(), [&](const LineCandidate& x, const LineCandidate& y) {
     return by_significance ? x.line.significance > y.line.significance : x.length > y.length;
   });

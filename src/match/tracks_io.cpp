@@ -79,6 +79,7 @@ void append_track_rows(std::int64_t frame_index,
     r.line = static_cast<int>(i);
     r.matched_line = a.is_new() ? -1 : a.matched_line;
     r.crowded = l.crowded;
+    r.annulus_fraction = l.annulus_fraction;
     rows->push_back(r);
   }
 }
@@ -88,12 +89,12 @@ void write_tracks_csv(const fs::path& path, const std::vector<TrackRow>& rows) {
   out.reserve(rows.size() * 96 + 128);
   out +=
       "frame,timestamp_ns,track_id,bearing_rad,image_angle_rad,edge_pixels,r_inner,r_outer,"
-      "matched_frame,distance,line,matched_line,crowded\n";
+      "matched_frame,distance,line,matched_line,crowded,annulus_fraction\n";
   char buf[256];
   for (const TrackRow& r : rows) {
     const int n = std::snprintf(buf,
                                 sizeof(buf),
-                                "%lld,%lld,%lld,%.9f,%.9f,%d,%.3f,%.3f,%lld,%.6f,%d,%d,%d\n",
+                                "%lld,%lld,%lld,%.9f,%.9f,%d,%.3f,%.3f,%lld,%.6f,%d,%d,%d,%.4f\n",
                                 static_cast<long long>(r.frame),
                                 static_cast<long long>(r.timestamp_ns),
                                 static_cast<long long>(r.track_id),
@@ -106,7 +107,8 @@ void write_tracks_csv(const fs::path& path, const std::vector<TrackRow>& rows) {
                                 r.distance,
                                 r.line,
                                 r.matched_line,
-                                r.crowded ? 1 : 0);
+                                r.crowded ? 1 : 0,
+                                std::isfinite(r.annulus_fraction) ? r.annulus_fraction : -1.0);
     out.append(buf, static_cast<std::size_t>(n));
   }
   write_text_atomic(path.string(), out);
@@ -198,6 +200,13 @@ std::vector<TrackRow> read_tracks_csv(const fs::path& path) {
       const int c = parse_number<int>(field("crowded"), file, line_no, "crowded");
       if (c != 0 && c != 1) throw InputError(file, line_no, "column 'crowded' must be 0 or 1");
       r.crowded = c == 1;
+    }
+    if (has("annulus_fraction")) {
+      const double f =
+          parse_number<double>(field("annulus_fraction"), file, line_no, "annulus_fraction");
+      if (f > 1.5)
+        throw InputError(file, line_no, "annulus_fraction above 1.5 (a fraction of R_max - R_min)");
+      if (f >= 0) r.annulus_fraction = f;  // -1: not known
     }
     rows.push_back(r);
   }

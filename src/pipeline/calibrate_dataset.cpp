@@ -44,14 +44,18 @@ constexpr const char* kOutputs[] = {"extrinsics.yaml",
                                     calib::kRobotFormatFiles[2],
                                     "reprojection.png"};
 
-std::string few_tracks_warning(int tracks, const FeaturePipelineOptions& features) {
+std::string few_tracks_warning(int tracks,
+                               const FeaturePipelineOptions& features,
+                               double used_fraction) {
   std::string w = "only " + std::to_string(tracks) +
                   " lines were tracked: the estimate rests on few features and may be off by "
                   "more than its sigma";
-  if (features.lines.threshold == LineThreshold::kFractionOfAnnulus &&
-      features.lines.length_fraction > 0.3)
-    w += "; shorter lines help (--length-fraction 0.25 with --refine; docs/calibration.md, "
-         "\"Warnings\")";
+  if (used_fraction > 0.3)
+    w += "; shorter lines help (--calibration-length-fraction 0.25 with --refine; "
+         "docs/calibration.md, \"Warnings\")";
+  else if (features.lines.threshold == LineThreshold::kFractionOfAnnulus &&
+           features.lines.length_fraction > 0.3)
+    w += "; shorter lines help (the default --line-threshold significance)";
   return w;
 }
 
@@ -233,7 +237,8 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
   r.input = calibration_run_from_tracks(data, tracked.rows, o.input);
   r.warnings.insert(r.warnings.end(), r.input.warnings.begin(), r.input.warnings.end());
   if (r.input.tracks < kFewTracks)
-    r.warnings.push_back(few_tracks_warning(r.input.tracks, o.features));
+    r.warnings.push_back(
+        few_tracks_warning(r.input.tracks, o.features, r.input.min_annulus_fraction));
   r.warnings.insert(r.warnings.end(), o.notes.begin(), o.notes.end());
   for (const auto& w : r.warnings) spdlog::warn("{}", w);
   if (o.progress) o.progress("calibrate", 0, 0);

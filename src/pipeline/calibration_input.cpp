@@ -23,6 +23,9 @@ bool DatasetRunOptions::IsValid(std::string* why) const {
   if (min_track_length < 2) return fail("min_track_length must be >= 2");
   if (!(std::isfinite(crowded_sigma_scale) && crowded_sigma_scale > 0.0))
     return fail("crowded_sigma_scale must be > 0");
+  if (!(min_annulus_fraction >= 0.0 && min_annulus_fraction <= 1.0))
+    return fail("min_annulus_fraction must be in [0, 1]");
+  if (enough_tracks < 0) return fail("enough_tracks must be >= 0");
   return true;
 }
 
@@ -152,24 +155,76 @@ std::vector<char> wheel_gaps(const dataset::Dataset& data,
   return gap;
 }
 
+// The fraction of the annulus a line must cover for its bearing to be used:
+// options.min_annulus_fraction when at least options.enough_tracks tracks hold that many lines
+// of it, else the first of 0.35, 0.25 and 0 (every line) below it that gives as many, else the
+// one that gives the most tracks.
+double choose_annulus_fraction(const std::vector<TrackRow>& rows,
+                               const DatasetRunOptions& opt,
+                               DatasetRun& out) {
+  const double preferred = opt.min_annulus_fraction;
+  if (opt.enough_tracks <= 0 || preferred <= 0.0) return preferred;
+  auto tracks_at = [&](double f) {
+    std::map<std::int64_t, int> length;
+    for (const TrackRow& r : rows)
+      if (!(r.annulus_fraction < f)) ++length[r.track_id];  // NaN: not known, used
+    int tracks = 0;
+    for (const auto& [id, k] : length) tracks += k >= opt.min_track_length ? 1 : 0;
+    return tracks;
+  };
+  const int at_preferred = tracks_at(preferred);
+  if (at_preferred >= opt.enough_tracks) return preferred;
+  double best = preferred;
+  int best_tracks = at_preferred;
+  for (double f : {0.35, 0.25, 0.0}) {
+    if (f >= preferred) continue;
+    const int t = tracks_at(f);
+    if (t > best_tracks) best = f, best_tracks = t;
+    if (t >= opt.enough_tracks) break;
+  }
+  if (best != preferred) {
+    char text[320];
+    std::snprintf(text,
+                  sizeof(text),
+                  "only %d tracks hold lines at least %g of the annulus long; the bearings of "
+                  "lines at least %g of it are used (%d tracks): shorter lines' bearings are less "
+                  "accurate (docs/calibration.md#which-lines)",
+                  at_preferred,
+                  preferred,
+                  best,
+                  best_tracks);
+    out.warnings.emplace_back(text);
+  }
+  return best;
+}
+
 // Track lengths (short tracks carry no parallax) and double claims; the bearings used.
 void add_bearings(const std::vector<TrackRow>& rows,
                   const std::vector<char>& gap,
                   const DatasetRunOptions& opt,
                   DatasetRun& out) {
   const std::size_t n = out.run.frames.size();
-  std::map<std::int64_t, int> length;
-  std::map<std::pair<std::int64_t, std::int64_t>, int> per_frame;  // (frame, track) -> count
-  for (const TrackRow& r : rows) {
+  for (const TrackRow& r : rows)
     if (r.frame < 0 || static_cast<std::size_t>(r.frame) >= n)
       throw InputError("tracks: frame " + std::to_string(r.frame) + " outside the dataset's " +
                        std::to_string(n) + " images");
-    ++length[r.track_id];
+  const double min_fraction = choose_annulus_fraction(rows, opt, out);
+  std::map<std::int64_t, int> length;
+  std::map<std::pair<std::int64_t, std::int64_t>, int> per_frame;  // (frame, track) -> count
+  // A line shorter than min_fraction is tracked, not used (its track's length counts the
+  // bearings used only).
+  auto too_short = [&](const TrackRow& r) { return r.annulus_fraction < min_fraction; };
+  for (const TrackRow& r : rows) {
     ++per_frame[{r.frame, r.track_id}];
+    if (too_short(r)) {
+      ++out.short_bearings;
+      continue;
+    }
+    ++length[r.track_id];
   }
   std::map<std::int64_t, int> used_tracks;
   for (const TrackRow& r : rows) {
-    if (length[r.track_id] < opt.min_track_length) continue;
+    if (too_short(r) || length[r.track_id] < opt.min_track_length) continue;
     if (gap[static_cast<std::size_t>(r.frame)]) continue;
     if (!std::isfinite(r.bearing)) continue;
     if (per_frame[{r.frame, r.track_id}] > 1) {
@@ -184,6 +239,7 @@ void add_bearings(const std::vector<TrackRow>& rows,
   }
   out.tracks = static_cast<int>(used_tracks.size());
   out.crowded_sigma_scale = opt.crowded_sigma_scale;
+  out.min_annulus_fraction = min_fraction;
   if (out.double_claims > 0) {
     out.warnings.push_back(std::to_string(out.double_claims) +
                            " times a track held two lines of one frame (the paper's rules allow "

@@ -217,6 +217,8 @@ json inputs_json(const calib::CalibrationResult& r, const ReportInputs& in) {
     inputs["bearings_used"] = in.run->observations;
     inputs["crowded_bearings"] = in.run->crowded_bearings;
     inputs["crowded_sigma_scale"] = num(in.run->crowded_sigma_scale);
+    inputs["short_bearings_left_out"] = in.run->short_bearings;
+    inputs["min_annulus_fraction"] = num(in.run->min_annulus_fraction);
     inputs["path_length_m"] = num(in.run->path_length);
     inputs["rotation_deg"] = num(rad2deg(in.run->rotation));
     inputs["frames_dropped_for_wheel_gaps"] = in.run->frames_dropped_for_gaps;
@@ -464,6 +466,9 @@ void html_inputs(std::ostringstream& h, const calib::CalibrationResult& r, const
     kv("bearings of crowded lines (sigma x)",
        std::to_string(in.run->crowded_bearings) + " (x" + f("%g", in.run->crowded_sigma_scale) +
            ")");
+    kv("bearings of short lines left out (below)",
+       std::to_string(in.run->short_bearings) + " (" + f("%g", in.run->min_annulus_fraction) +
+           " of the annulus)");
     kv("frames with too few lines", std::to_string(in.run->starved_frames));
     kv("frames dropped for wheel gaps", std::to_string(in.run->frames_dropped_for_gaps));
   }

@@ -2,6 +2,7 @@
 #include "omnivert/viz/tracks_plot.hpp"
 
 #include <unistd.h>
+#include <cmath>
 
 #include <cstdlib>
 #include <fstream>
@@ -56,6 +57,7 @@ TEST(TracksCsv, RoundTrip) {
     v.r_inner = 40.5;
     v.r_outer = 180.25;
     v.crowded = i == 1;
+    v.annulus_fraction = 0.25 * (i + 1);
     frame.lines.push_back(v);
   }
   std::vector<TrackAssignment> as(3);
@@ -95,6 +97,7 @@ TEST(TracksCsv, RoundTrip) {
     EXPECT_EQ(back[i].line, static_cast<int>(i));
     EXPECT_EQ(back[i].matched_line, rows[i].matched_line);
     EXPECT_EQ(back[i].crowded, i == 1);
+    EXPECT_NEAR(back[i].annulus_fraction, 0.25 * (i + 1), 1e-4);
   }
   EXPECT_EQ(back[1].matched_line, -1);
   EXPECT_EQ(back[2].matched_line, 4);
@@ -110,6 +113,24 @@ TEST(TracksCsv, MinimalColumnsInAnyOrder) {
   EXPECT_EQ(rows[1].frame, 4);
   EXPECT_EQ(rows[1].track_id, 4);
   EXPECT_EQ(rows[1].matched_frame, -1);  // unknown: evaluation falls back to frame order
+  EXPECT_TRUE(std::isnan(rows[1].annulus_fraction));  // unknown: the calibration uses it
+}
+
+// A fraction not known (-1 in the file, NaN in memory) stays not known through a rewrite.
+TEST(TracksCsv, UnknownAnnulusFractionRoundTrips) {
+  const ScratchDir scratch;
+  const fs::path p = scratch.path() / "f.csv";
+  write_text(p,
+             "frame,timestamp_ns,track_id,bearing_rad,annulus_fraction\n0,1,2,0.1,-1\n"
+             "1,2,2,0.2,0.61\n");
+  auto rows = read_tracks_csv(p);
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_TRUE(std::isnan(rows[0].annulus_fraction));
+  EXPECT_DOUBLE_EQ(rows[1].annulus_fraction, 0.61);
+  write_tracks_csv(p, rows);
+  rows = read_tracks_csv(p);
+  EXPECT_TRUE(std::isnan(rows[0].annulus_fraction));
+  EXPECT_DOUBLE_EQ(rows[1].annulus_fraction, 0.61);
 }
 
 TEST(TracksCsv, BadInputNamesFileAndLine) {
@@ -134,6 +155,9 @@ TEST(TracksCsv, BadInputNamesFileAndLine) {
   expect_error("frame,timestamp_ns,track_id,bearing_rad\n-1,1,2,0.1\n", 2, "negative frame");
   expect_error("frame,timestamp_ns,track_id,bearing_rad\n0,1,2,4.0\n", 2, "outside");
   expect_error("frame,timestamp_ns,track_id,bearing_rad,crowded\n0,1,2,0.1,2\n", 2, "crowded");
+  expect_error("frame,timestamp_ns,track_id,bearing_rad,annulus_fraction\n0,1,2,0.1,7\n",
+               2,
+               "annulus_fraction");
   expect_error("", 0, "empty");
   EXPECT_THROW(read_tracks_csv(dir / "does_not_exist.csv"), InputError);
 }

@@ -252,20 +252,23 @@ TEST_F(CalibrateDataset, TracksOfAnotherDatasetAreRefusedByFileAndLine) {
   EXPECT_FALSE(fs::exists(other_out / "extrinsics.yaml"));
 }
 
-// Lines at least 70% of the annulus: 9 tracks in the corridor -> a warning that suggests
-// shorter lines, in the result and in summary.json; the default threshold: no such warning.
+// Bearings of lines at least 70% of the annulus used: 9 tracks in the corridor -> a warning
+// that suggests shorter lines, in the result and in summary.json; the default: no such warning.
 TEST_F(CalibrateDataset, FewTracksAreWarnedAboutWithAdvice) {
   const fs::path out = scratch("few-tracks");
   auto o = cli_defaults();
   o.force = true;
-  o.features.lines.length_fraction = 0.7;
+  o.input.min_annulus_fraction = 0.7;
+  o.input.enough_tracks = 0;  // as --calibration-length-fraction 0.7 does
   const auto r = calibrate_dataset(paper().string(), out.string(), o);
   expect_complete_outputs_without_nan(out);
   EXPECT_THAT(joined(r.warnings), ContainsRegex("only [0-9]+ lines were tracked"));
-  EXPECT_THAT(joined(r.warnings), HasSubstr("--length-fraction 0.25"));
+  EXPECT_THAT(joined(r.warnings), HasSubstr("--calibration-length-fraction 0.25"));
   EXPECT_THAT(read_text(out / "summary.json"), ContainsRegex("only [0-9]+ lines were tracked"));
+  EXPECT_LT(r.input.tracks, 15);
+  EXPECT_GT(r.input.short_bearings, 0);
 
-  o.features.lines.length_fraction = cli_defaults().features.lines.length_fraction;
+  o.input = cli_defaults().input;
   const auto d = calibrate_dataset(paper().string(), scratch("few-tracks-default").string(), o);
   EXPECT_THAT(joined(d.warnings), Not(HasSubstr("lines were tracked")));
 }

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -73,6 +74,61 @@ void expect_lines_follow_edges(const fs::path& out, const auto& gt, const SimCon
     ASSERT_GE(l.r_inner, cfg.camera.r_min - 1e-3);
     ASSERT_LE(l.r_outer, cfg.camera.r_max + 1e-3);
   }
+}
+
+void expect_short_lines_left_out(const dataset::Dataset& d,
+                                 const std::vector<TrackRow>& rows,
+                                 const pipeline::DatasetRun& run) {
+  // Lines shorter than DatasetRunOptions::min_annulus_fraction are tracked, not used: give
+  // every third track a short line in every frame, and every row of track 0 in its even
+  // frames only (its length counts the bearings used), and the run holds exactly the others.
+  std::vector<TrackRow> mixed = rows;
+  for (TrackRow& r : mixed) {
+    const bool is_short = r.track_id % 3 == 1 || (r.track_id == 0 && r.frame % 2 == 1);
+    r.annulus_fraction = is_short ? 0.3 : 0.7;
+  }
+  mixed.back().annulus_fraction = std::numeric_limits<double>::quiet_NaN();  // not known: used
+  // The plain count: rows not short, in tracks with at least two of them.
+  auto used = [](const TrackRow& r) { return !(r.annulus_fraction < 0.5); };
+  std::map<std::int64_t, int> long_rows;
+  int short_rows = 0, used_rows = 0;
+  for (const TrackRow& r : mixed) {
+    short_rows += !used(r);
+    long_rows[r.track_id] += used(r);
+  }
+  for (const TrackRow& r : mixed) used_rows += used(r) && long_rows[r.track_id] >= 2;
+  pipeline::DatasetRunOptions half;
+  half.enough_tracks = 0;  // 0.5 whatever the number of tracks
+  const pipeline::DatasetRun sel = pipeline::calibration_run_from_tracks(d, mixed, half);
+  EXPECT_GT(short_rows, 0);
+  EXPECT_EQ(sel.short_bearings, short_rows);
+  EXPECT_EQ(sel.observations, used_rows);
+  EXPECT_DOUBLE_EQ(sel.min_annulus_fraction, 0.5);
+  for (const auto& f : sel.run.frames)
+    for (const auto& ob : f.observations)
+      EXPECT_TRUE(ob.track_id % 3 != 1 || ob.track_id == mixed.back().track_id);
+  pipeline::DatasetRunOptions all;
+  all.min_annulus_fraction = 0.0;
+  const pipeline::DatasetRun every = pipeline::calibration_run_from_tracks(d, mixed, all);
+  EXPECT_EQ(every.short_bearings, 0);
+  EXPECT_EQ(every.observations, run.observations);
+
+  // Too few tracks of long lines: the shorter ones are used, with a warning. The fractions
+  // here are 0.3 and 0.7, so 0.35 gives what 0.5 gives and 0.25 gives every track.
+  pipeline::DatasetRunOptions want_more;
+  want_more.enough_tracks = sel.tracks + 1;
+  const pipeline::DatasetRun more = pipeline::calibration_run_from_tracks(d, mixed, want_more);
+  EXPECT_DOUBLE_EQ(more.min_annulus_fraction, 0.25);
+  EXPECT_EQ(more.short_bearings, 0);
+  EXPECT_EQ(more.observations, run.observations);
+  ASSERT_FALSE(more.warnings.empty());
+  EXPECT_NE(more.warnings.back().find("lines at least 0.25 of it are used"), std::string::npos)
+      << more.warnings.back();
+  want_more.enough_tracks = sel.tracks;  // enough at 0.5: no change, no warning
+  const pipeline::DatasetRun enough = pipeline::calibration_run_from_tracks(d, mixed, want_more);
+  EXPECT_DOUBLE_EQ(enough.min_annulus_fraction, 0.5);
+  EXPECT_EQ(enough.observations, sel.observations);
+  EXPECT_EQ(enough.warnings.size(), sel.warnings.size());
 }
 
 TEST_F(SimulatorTest, WheelTravelIntegratesToTheGroundTruthPoses) {
@@ -171,6 +227,8 @@ TEST_F(SimulatorTest, WheelTravelIntegratesToTheGroundTruthPoses) {
   EXPECT_LT(max_run, 1e-5);
   EXPECT_GT(max_one, 4e-4);
   EXPECT_NEAR(max_lateral, 4.75e-4, 1e-5);
+
+  expect_short_lines_left_out(d, rows, run);
 }
 
 TEST(Presets, EveryTrajectoryPresetFitsEveryWorldPreset) {

@@ -79,7 +79,11 @@ BearingErrors bearing_errors(const Renderer& r,
                              double direction = 0.0) {
   const CatadioptricCamera& cam = r.camera();
   const MirrorCircle circle = circle_of(cam);
-  LineExtractor extractor;
+  // The lines the calibration uses (pipeline::DatasetRunOptions::min_annulus_fraction): at
+  // least half the annulus, so that the nearest line to a long true line is a long one.
+  LineExtractorOptions lo;
+  lo.threshold = LineThreshold::kFractionOfAnnulus;
+  LineExtractor extractor(lo);
   std::optional<TiltRectifier> rect;
   if (rectify) rect.emplace(cam.geometry(), *rectify);
   BearingErrors e;

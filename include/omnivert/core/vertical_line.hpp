@@ -13,6 +13,10 @@ struct VerticalLine {
   // Length of the line in pixels: the radial extent covered by its edge pixels (short gaps
   // bridged); the paper thresholds it at 50% of R_max - R_min (Sec. 2).
   int edge_pixels = 0;
+  // edge_pixels as a fraction of the annulus, R_max - R_min: the paper's length criterion
+  // (Sec. 2, at least 0.5) and the calibration's choice of bearings
+  // (pipeline::DatasetRunOptions::min_annulus_fraction).
+  double annulus_fraction = 0.0;
   // Radial extent of the supporting edge pixels, in pixels from the mirror centre.
   double r_inner = 0.0;
   double r_outer = 0.0;

@@ -15,8 +15,8 @@
 //   line) are gathered and the line's angle is refined below the sector size by a weighted
 //   least-squares fit of a line through the mirror centre; its length is the radial extent
 //   covered by supporting pixels (gaps up to max_gap_px bridged), and it is kept by
-//   one of the criteria below (the paper's, the default: >= 50% of R_max - R_min; or when
-//   it is significant: its number of false alarms, a contrario, is below 1).
+//   one of the criteria below (the default: it is significant, its number of false alarms,
+//   a contrario, below 10^-35, or long, the paper's >= 50% of R_max - R_min).
 //
 // Speed: all per-pixel geometry (radial unit vector, sector coordinate, neighbour offsets)
 // comes from a lookup table built once per annulus (r_min, r_max) relative to the rounded
@@ -35,6 +35,11 @@
 namespace omnivert {
 
 enum class LineThreshold {
+  // The default: kSignificance or kFractionOfAnnulus, whichever keeps the line. The
+  // significant lines are the prominent edges of real rooms whose furniture hides the lower
+  // part of the walls; the long ones are kept even where many edges around them make them
+  // less significant (a line-rich hall).
+  kSignificantOrLong,
   // A contrario (docs/theory/extraction.md#significance): NFA = n_tests * P[B(n, p) >= k] <=
   // 10^-min_significance, k of the n radii between two support pixels holding one, p the
   // chance that a radius of a random line holds an edge pixel of this polarity (the image's
@@ -75,12 +80,15 @@ struct LineExtractorOptions {
   int peak_window = 0;
   int nms_radius = 1;
 
-  LineThreshold threshold = LineThreshold::kFractionOfAnnulus;
-  double min_significance = 0.0;  // kSignificance: -log10 of the largest NFA kept
-  double length_fraction = 0.5;   // kFractionOfAnnulus (the paper's 50%)
-  double adaptive_k = 3.0;        // kAdaptive
-  int top_k = 20;                 // kTopK
-  double min_fraction = 0.2;      // floor for kAdaptive and kTopK
+  // The default keeps the significant lines (docs/theory/extraction.md#significance): on real
+  // rooms the paper's 50 % rule keeps almost none, furniture hiding the lower part of most
+  // walls. The calibration still uses the long ones only (DatasetRunOptions).
+  LineThreshold threshold = LineThreshold::kSignificance;
+  double min_significance = 35.0;  // kSignificance: -log10 of the largest NFA kept
+  double length_fraction = 0.5;    // kFractionOfAnnulus (the paper's 50%)
+  double adaptive_k = 3.0;         // kAdaptive
+  int top_k = 20;                  // kTopK
+  double min_fraction = 0.2;       // floor for kAdaptive and kTopK
 
   bool IsValid(std::string* why) const;
 };
@@ -123,6 +131,10 @@ class LineExtractor {
     float sector;    // continuous sector coordinate of the pixel, in [0, sectors)
   };
   void build_lut(const MirrorCircle& circle);
+  bool uses_significance() const {
+    return options_.threshold == LineThreshold::kSignificance ||
+           options_.threshold == LineThreshold::kSignificantOrLong;
+  }
   // Step 5's fit: the angle of the radial line through the centre (cx, cy) fitted to the
   // support pixels of polarity `pol` near sector k, starting at angle a. With `avoid`, the
   // pixels at radii where any of those lines (angles) is nearer than avoid_px to this one

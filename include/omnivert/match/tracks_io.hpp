@@ -10,9 +10,13 @@
 //   image_angle_rad, edge_pixels, r_inner, r_outer   the detection (extract/vertical_line.hpp)
 //   matched_frame  frame of the observation this one was matched to; -1 starts a new track
 //   distance       descriptor distance of that match (eq. 6); 0 for a new track
+//   line, matched_line, crowded   see TrackRow
+//   annulus_fraction   edge_pixels / (R_max - R_min): the calibration uses the bearings of
+//                  lines at least DatasetRunOptions::min_annulus_fraction long; -1: not known
 
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -39,6 +43,9 @@ struct TrackRow {
   int matched_line = -1;
   // VerticalLine::crowded: another edge runs within a few pixels all along this line.
   bool crowded = false;
+  // VerticalLine::annulus_fraction; NaN when not known (a file without the column): such a
+  // bearing is used by the calibration whatever its length.
+  double annulus_fraction = std::numeric_limits<double>::quiet_NaN();
   // The line of the file it was read from (read_tracks_csv; 0: not read from a file), for
   // messages about it. Not written.
   int source_line = 0;

@@ -34,6 +34,16 @@ struct DatasetRunOptions {
   // A crowded line's bearing (TrackRow::crowded: another edge within a few pixels all along
   // it) has its sigma multiplied by this (BearingObservation::sigma_scale).
   double crowded_sigma_scale = 1.0;
+  // The bearings of lines shorter than this fraction of the annulus (TrackRow::
+  // annulus_fraction, R_max - R_min) are tracked but not used: the shorter a line, the
+  // larger the part of its bearing error that stays the same from frame to frame, which the
+  // filter's sigma does not model (docs/theory/extraction.md#significance). 0.5 is the
+  // paper's rule (Sec. 2); 0 uses every bearing. A row whose fraction is not known is used.
+  double min_annulus_fraction = 0.5;
+  // When fewer tracks than this hold two such lines, the bearings of shorter lines are used:
+  // those at least 0.35, 0.25 of the annulus, then every one, the first that gives this many
+  // tracks (with a warning; DatasetRun::min_annulus_fraction is the fraction used). 0: never.
+  int enough_tracks = 15;
 
   // True when every field is usable; otherwise false with the reason in *why (may be null),
   // naming the field, e.g. "max_wheel_gap_s must be > 0 [s]".
@@ -43,15 +53,17 @@ struct DatasetRunOptions {
 struct DatasetRun {
   calib::CalibrationRun run;
   std::vector<std::string> warnings;
-  int frames_dropped_for_gaps = 0;   // frames whose bearings were dropped (wheel gap)
-  int double_claims = 0;             // (frame, track) pairs dropped
-  int crowded_bearings = 0;          // bearings of crowded lines used
-  double crowded_sigma_scale = 1.0;  // their sigma scale (DatasetRunOptions)
-  int starved_frames = 0;            // frames with fewer than min_lines lines
-  int tracks = 0;                    // tracks used
-  int observations = 0;              // bearings used
-  double path_length = 0.0;          // distance driven by the axle midpoint [m]
-  double rotation = 0.0;             // total |heading change| [rad]
+  int frames_dropped_for_gaps = 0;    // frames whose bearings were dropped (wheel gap)
+  int double_claims = 0;              // (frame, track) pairs dropped
+  int crowded_bearings = 0;           // bearings of crowded lines used
+  int short_bearings = 0;             // bearings left out: line below min_annulus_fraction
+  double min_annulus_fraction = 0.0;  // that fraction (DatasetRunOptions)
+  double crowded_sigma_scale = 1.0;   // their sigma scale (DatasetRunOptions)
+  int starved_frames = 0;             // frames with fewer than min_lines lines
+  int tracks = 0;                     // tracks used
+  int observations = 0;               // bearings used
+  double path_length = 0.0;           // distance driven by the axle midpoint [m]
+  double rotation = 0.0;              // total |heading change| [rad]
 };
 
 // `rows` are tracks.csv rows of this dataset (frame = index into data.images()). The dataset
