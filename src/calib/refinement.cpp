@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -99,6 +101,61 @@ void canonical_extrinsics(Built* b) {
   b->ex[2] = wrap_angle(b->ex[2]);
 }
 
+// The problem of `b` again, its parameter blocks in one array in a fixed order (poses, the
+// extrinsics, features and biases by track id), the cost and loss functions shared.
+// ceres::Covariance orders the Jacobian's columns by the parameter blocks' addresses, and
+// SuiteSparseQR's ordering and rounding follow that order: with the features in map nodes,
+// where the heap put them moved the covariance's last digits from run to run.
+struct OrderedCopy {
+  std::vector<double> values;
+  std::unique_ptr<ceres::Problem> problem;
+  const double* ex = nullptr;
+};
+
+OrderedCopy ordered_copy(const Built& b) {
+  std::vector<double*> order;
+  for (const auto& p : b.poses) order.push_back(const_cast<double*>(p.data()));
+  order.push_back(const_cast<double*>(b.ex.data()));
+  for (const auto& [id, f] : b.features) order.push_back(const_cast<double*>(f.data()));
+  for (const auto& [id, v] : b.biases) order.push_back(const_cast<double*>(&v));
+  OrderedCopy c;
+  std::map<const double*, double*> moved;
+  std::vector<int> sizes;
+  std::size_t total = 0;
+  for (double* block : order) {
+    sizes.push_back(b.problem->HasParameterBlock(block) ? b.problem->ParameterBlockSize(block) : 0);
+    total += static_cast<std::size_t>(sizes.back());
+  }
+  c.values.resize(total);
+  ceres::Problem::Options po;
+  po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  c.problem = std::make_unique<ceres::Problem>(po);
+  std::size_t at = 0;
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    if (sizes[i] == 0) continue;
+    double* to = c.values.data() + at;
+    std::copy(order[i], order[i] + sizes[i], to);
+    c.problem->AddParameterBlock(to, sizes[i]);
+    if (b.problem->IsParameterBlockConstant(order[i])) c.problem->SetParameterBlockConstant(to);
+    moved[order[i]] = to;
+    at += static_cast<std::size_t>(sizes[i]);
+  }
+  c.ex = moved.at(b.ex.data());
+  std::vector<ceres::ResidualBlockId> blocks;
+  b.problem->GetResidualBlocks(&blocks);
+  for (ceres::ResidualBlockId id : blocks) {
+    std::vector<double*> params;
+    b.problem->GetParameterBlocksForResidualBlock(id, &params);
+    for (double*& p : params) p = moved.at(p);
+    c.problem->AddResidualBlock(
+        const_cast<ceres::CostFunction*>(b.problem->GetCostFunctionForResidualBlock(id)),
+        const_cast<ceres::LossFunction*>(b.problem->GetLossFunctionForResidualBlock(id)),
+        params);
+  }
+  return c;
+}
+
 // Covariance of (phi, rho, psi): the inverse of the Fisher information at the solution (of
 // the problem without robust loss, as it is the Gaussian model's bound), marginal. false
 // when the problem is rank deficient (the caller then falls back on the observability
@@ -112,14 +169,14 @@ bool extrinsics_covariance(Built* b, Eigen::Matrix3d* covariance) {
   co.null_space_rank = 0;
   co.num_threads = 1;
   ceres::Covariance cov(co);
-  const std::vector<std::pair<const double*, const double*>> blocks = {
-      {b->ex.data(), b->ex.data()}};
+  const OrderedCopy copy = ordered_copy(*b);
+  const std::vector<std::pair<const double*, const double*>> blocks = {{copy.ex, copy.ex}};
   // A rank-deficient problem is an expected outcome here (the caller falls back on the
   // observability analysis). ceres::Covariance has no logging option: its line about the
   // rank deficiency goes to Ceres' log, which the library leaves as the program set it.
-  if (!cov.Compute(blocks, b->problem.get())) return false;
+  if (!cov.Compute(blocks, copy.problem.get())) return false;
   double C[9];
-  cov.GetCovarianceBlock(b->ex.data(), b->ex.data(), C);
+  cov.GetCovarianceBlock(copy.ex, copy.ex, C);
   *covariance = Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(C);
   return true;
 }

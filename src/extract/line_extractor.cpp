@@ -524,9 +524,16 @@ void LineExtractor::threshold_lines(const MirrorCircle& circle, std::vector<Vert
     thr = options_.min_fraction * L;
   }
   if (uses_significance()) thr = 0;  // fit_peak kept them
-  // The most significant (or longest) first, so that of two peaks of one edge it is kept.
+  // The most significant (or longest) first, so that of two peaks of one edge it is kept;
+  // with kSignificantOrLong the long ones first, so that a shorter line in a sparser
+  // neighbourhood (more significant) does not take a long line's place.
   const bool by_significance = uses_significance();
+  const double long_length = options_.threshold == LineThreshold::kSignificantOrLong
+                                 ? options_.length_fraction * L
+                                 : std::numeric_limits<double>::infinity();
   std::sort(found.begin(), found.end(), [&](const LineCandidate& x, const LineCandidate& y) {
+    const bool xl = x.length >= long_length, yl = y.length >= long_length;
+    if (xl != yl) return xl;
     return by_significance ? x.line.significance > y.line.significance : x.length > y.length;
   });
   for (const LineCandidate& f : found) {
