@@ -2,15 +2,21 @@
 # same code (0 or 3) and leave the same files, byte for byte. The first run's folder is moved
 # aside before the second, so that both write the same paths. IGNORE: a regex of the lines of
 # text files (.json, .html) that may differ, the run times the reports give (summary.json
-# "seconds", the report's time row); every other line must match.
+# "seconds", the report's time row); every other line must match. CMD2 (optional): the second
+# run's command instead of CMD (the same job with another thread count).
 string(REPLACE "|" ";" CMD "${CMD}")
+if(CMD2)
+  string(REPLACE "|" ";" CMD2 "${CMD2}")
+else()
+  set(CMD2 ${CMD})
+endif()
 file(REMOVE_RECURSE "${OUT}" "${OUT}.first")
 execute_process(COMMAND ${CMD} RESULT_VARIABLE rc1 ERROR_VARIABLE err1 OUTPUT_QUIET)
 if(NOT rc1 EQUAL 0 AND NOT rc1 EQUAL 3)
   message(FATAL_ERROR "first run: exit ${rc1}\n${err1}")
 endif()
 file(RENAME "${OUT}" "${OUT}.first")
-execute_process(COMMAND ${CMD} RESULT_VARIABLE rc2 ERROR_VARIABLE err2 OUTPUT_QUIET)
+execute_process(COMMAND ${CMD2} RESULT_VARIABLE rc2 ERROR_VARIABLE err2 OUTPUT_QUIET)
 if(NOT rc1 EQUAL rc2)
   message(FATAL_ERROR "exit codes differ: ${rc1} then ${rc2}\n${err2}")
 endif()
