@@ -101,9 +101,10 @@ TEST(LineExtractor, ResolvesEdgesLittleMoreThanADegreeApart) {
       g.width = o.width;
       g.height = o.height;
       FeaturePipelineOptions po;
-      // The paper's length rule: this test is about the peaks. At the default significance
-      // (35) 598 of the 600 long edges pass: an edge 1.2 degrees from another one counts
-      // the other's pixels in its local density (docs/theory/extraction.md#significance).
+      // The paper's length rule: this test is about the peaks. By significance alone (35)
+      // 598 of the 600 long edges pass: an edge 1.2 degrees from another one counts the
+      // other's pixels in its local density (docs/theory/extraction.md#significance); the
+      // default keeps long lines whatever their significance.
       po.lines.threshold = LineThreshold::kFractionOfAnnulus;
       po.lines.peak_window = peak_window;
       po.lines.nms_radius = nms_radius;

@@ -80,12 +80,13 @@ struct LineExtractorOptions {
   int peak_window = 0;
   int nms_radius = 1;
 
-  // The default keeps the significant lines (docs/theory/extraction.md#significance): on real
-  // rooms the paper's 50 % rule keeps almost none, furniture hiding the lower part of most
-  // walls. The calibration still uses the long ones only (DatasetRunOptions).
-  LineThreshold threshold = LineThreshold::kSignificance;
-  double min_significance = 35.0;  // kSignificance: -log10 of the largest NFA kept
-  double length_fraction = 0.5;    // kFractionOfAnnulus (the paper's 50%)
+  // The default keeps the significant lines and the long ones
+  // (docs/theory/extraction.md#significance): in real rooms the paper's 50 % rule alone keeps
+  // almost none, furniture hiding the lower part of most walls. The calibration uses the
+  // long ones when there are enough (pipeline::DatasetRunOptions).
+  LineThreshold threshold = LineThreshold::kSignificantOrLong;
+  double min_significance = 35.0;  // kSignificance(OrLong): -log10 of the largest NFA kept
+  double length_fraction = 0.5;    // kFractionOfAnnulus, kSignificantOrLong (the paper's 50%)
   double adaptive_k = 3.0;         // kAdaptive
   int top_k = 20;                  // kTopK
   double min_fraction = 0.2;       // floor for kAdaptive and kTopK
