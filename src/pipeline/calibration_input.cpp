@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <map>
+#include <numeric>
 
 #include "omnivert/calib/model.hpp"
 #include "omnivert/core/error.hpp"
@@ -155,6 +157,40 @@ std::vector<char> wheel_gaps(const dataset::Dataset& data,
   return gap;
 }
 
+// The calibration's id of each row: its track id, except that where a track's long lines
+// resume after short ones the rest of it is a new track (ids above every track id, in the
+// order they start). A track whose line was short for a while may have slipped onto another
+// edge meanwhile: the tracker followed it by lines whose bearings the calibration does not
+// check. Rows in frame order within a track (tracks.csv's order; others are sorted).
+std::vector<std::int64_t> pieces_between_short_lines(
+    const std::vector<TrackRow>& rows, const std::function<bool(const TrackRow&)>& is_short) {
+  std::vector<std::size_t> order(rows.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return rows[a].frame < rows[b].frame;
+  });
+  std::int64_t next = 0;
+  for (const TrackRow& r : rows) next = std::max(next, r.track_id + 1);
+  struct State {
+    std::int64_t piece = -1;
+    bool short_since_long = false;
+  };
+  std::map<std::int64_t, State> state;
+  std::vector<std::int64_t> id(rows.size());
+  for (std::size_t i : order) {
+    State& st = state[rows[i].track_id];
+    if (st.piece < 0) st.piece = rows[i].track_id;
+    if (is_short(rows[i])) {
+      st.short_since_long = true;
+    } else if (st.short_since_long) {
+      st.piece = next++;
+      st.short_since_long = false;
+    }
+    id[i] = st.piece;
+  }
+  return id;
+}
+
 // The fraction of the annulus a line must cover for its bearing to be used:
 // options.min_annulus_fraction when at least options.enough_tracks tracks hold that many lines
 // of it, else the first of 0.35, 0.25 and 0 (every line) below it that gives as many, else the
@@ -165,9 +201,11 @@ double choose_annulus_fraction(const std::vector<TrackRow>& rows,
   const double preferred = opt.min_annulus_fraction;
   if (opt.enough_tracks <= 0 || preferred <= 0.0) return preferred;
   auto tracks_at = [&](double f) {
+    auto is_short = [f](const TrackRow& r) { return r.annulus_fraction < f; };  // NaN: used
+    const std::vector<std::int64_t> id = pieces_between_short_lines(rows, is_short);
     std::map<std::int64_t, int> length;
-    for (const TrackRow& r : rows)
-      if (!(r.annulus_fraction < f)) ++length[r.track_id];  // NaN: not known, used
+    for (std::size_t i = 0; i < rows.size(); ++i)
+      if (!is_short(rows[i])) ++length[id[i]];
     int tracks = 0;
     for (const auto& [id, k] : length) tracks += k >= opt.min_track_length ? 1 : 0;
     return tracks;
@@ -209,31 +247,33 @@ void add_bearings(const std::vector<TrackRow>& rows,
       throw InputError("tracks: frame " + std::to_string(r.frame) + " outside the dataset's " +
                        std::to_string(n) + " images");
   const double min_fraction = choose_annulus_fraction(rows, opt, out);
-  std::map<std::int64_t, int> length;
-  std::map<std::pair<std::int64_t, std::int64_t>, int> per_frame;  // (frame, track) -> count
   // A line shorter than min_fraction is tracked, not used (its track's length counts the
   // bearings used only).
   auto too_short = [&](const TrackRow& r) { return r.annulus_fraction < min_fraction; };
-  for (const TrackRow& r : rows) {
-    ++per_frame[{r.frame, r.track_id}];
-    if (too_short(r)) {
+  const std::vector<std::int64_t> id = pieces_between_short_lines(rows, too_short);
+  std::map<std::int64_t, int> length;
+  std::map<std::pair<std::int64_t, std::int64_t>, int> per_frame;  // (frame, piece) -> count
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    ++per_frame[{rows[i].frame, id[i]}];
+    if (too_short(rows[i])) {
       ++out.short_bearings;
       continue;
     }
-    ++length[r.track_id];
+    ++length[id[i]];
   }
   std::map<std::int64_t, int> used_tracks;
-  for (const TrackRow& r : rows) {
-    if (too_short(r) || length[r.track_id] < opt.min_track_length) continue;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const TrackRow& r = rows[i];
+    if (too_short(r) || length[id[i]] < opt.min_track_length) continue;
     if (gap[static_cast<std::size_t>(r.frame)]) continue;
     if (!std::isfinite(r.bearing)) continue;
-    if (per_frame[{r.frame, r.track_id}] > 1) {
+    if (per_frame[{r.frame, id[i]}] > 1) {
       ++out.double_claims;
       continue;
     }
     out.run.frames[static_cast<std::size_t>(r.frame)].observations.push_back(
-        {static_cast<int>(r.track_id), r.bearing, r.crowded ? opt.crowded_sigma_scale : 1.0});
-    ++used_tracks[r.track_id];
+        {static_cast<int>(id[i]), r.bearing, r.crowded ? opt.crowded_sigma_scale : 1.0});
+    ++used_tracks[id[i]];
     ++out.observations;
     out.crowded_bearings += r.crowded ? 1 : 0;
   }
