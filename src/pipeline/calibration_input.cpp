@@ -28,6 +28,8 @@ bool DatasetRunOptions::IsValid(std::string* why) const {
   if (!(min_annulus_fraction >= 0.0 && min_annulus_fraction <= 1.0))
     return fail("min_annulus_fraction must be in [0, 1]");
   if (enough_tracks < 0) return fail("enough_tracks must be >= 0");
+  if (!(std::isfinite(short_sigma_scale) && short_sigma_scale > 0.0))
+    return fail("short_sigma_scale must be > 0");
   return true;
 }
 
@@ -271,8 +273,14 @@ void add_bearings(const std::vector<TrackRow>& rows,
       ++out.double_claims;
       continue;
     }
+    // Shorter than the preferred fraction (used because too few tracks hold long lines):
+    // noisier, and partly the same from frame to frame (DatasetRunOptions).
+    const double shorter =
+        r.annulus_fraction < opt.min_annulus_fraction ? opt.short_sigma_scale : 1.0;
     out.run.frames[static_cast<std::size_t>(r.frame)].observations.push_back(
-        {static_cast<int>(id[i]), r.bearing, r.crowded ? opt.crowded_sigma_scale : 1.0});
+        {static_cast<int>(id[i]),
+         r.bearing,
+         (r.crowded ? opt.crowded_sigma_scale : 1.0) * shorter});
     ++used_tracks[id[i]];
     ++out.observations;
     out.crowded_bearings += r.crowded ? 1 : 0;

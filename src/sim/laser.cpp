@@ -5,6 +5,7 @@
 #include <fstream>
 #include <limits>
 
+#include "omnivert/core/error.hpp"
 #include "omnivert/dataset/laser.hpp"
 #include "omnivert/dataset/writer.hpp"
 
@@ -85,7 +86,11 @@ void write_laser(const std::string& dataset_dir,
   std::ofstream y(dir / "sensor.yaml");
   y << dataset::laser_sensor_yaml(
       sensor, "omnivert simulator: 2D laser scanner (dataset format: docs/dataset-format.md)");
-  if (!y) throw std::runtime_error("cannot write " + (dir / "sensor.yaml").string());
+  y.close();  // flushed: a full disk shows here
+  if (!y)
+    throw InputError((dir / "sensor.yaml").string(),
+                     0,
+                     "cannot write (disk full, or a folder that is not writable?)");
 }
 
 }  // namespace omnivert::sim

@@ -382,7 +382,8 @@ void save_world(const World& world, const std::string& path) {
   out << YAML::EndSeq << YAML::EndMap;
   std::ofstream f(path);
   f << "# omnivert simulator world (format: docs/simulator.md)\n" << out.c_str() << "\n";
-  if (!f) throw std::runtime_error("cannot write " + path);
+  f.close();  // flushed: a full disk shows here
+  if (!f) throw InputError(path, 0, "cannot write (disk full, or a folder that is not writable?)");
 }
 
 }  // namespace omnivert::sim

@@ -44,6 +44,9 @@ struct DatasetRunOptions {
   // those at least 0.35, 0.25 of the annulus, then every one, the first that gives this many
   // tracks (with a warning; DatasetRun::min_annulus_fraction is the fraction used). 0: never.
   int enough_tracks = 15;
+  // The bearing sigma of a line used that way (shorter than min_annulus_fraction) is
+  // multiplied by this (BearingObservation::sigma_scale).
+  double short_sigma_scale = 2.0;
 
   // True when every field is usable; otherwise false with the reason in *why (may be null),
   // naming the field, e.g. "max_wheel_gap_s must be > 0 [s]".
