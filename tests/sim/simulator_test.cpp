@@ -140,6 +140,16 @@ void expect_short_lines_left_out(const dataset::Dataset& d,
   EXPECT_DOUBLE_EQ(more.min_annulus_fraction, 0.25);
   EXPECT_EQ(more.short_bearings, 0);
   EXPECT_EQ(more.observations, run.observations);
+  int doubled = 0;  // the lines shorter than 0.5: sigma x DatasetRunOptions::short_sigma_scale
+  for (std::size_t k = 0; k < more.run.frames.size(); ++k)
+    for (const auto& ob : more.run.frames[k].observations) {
+      const bool is_short = (ob.track_id % 3 == 1 && ob.track_id <= max_id) ||
+                            (ob.track_id == longest && k >= 30 && k < 40);
+      if (is_short) ++doubled;
+      EXPECT_DOUBLE_EQ(ob.sigma_scale, is_short ? want_more.short_sigma_scale : 1.0)
+          << "frame " << k << " track " << ob.track_id;
+    }
+  EXPECT_GT(doubled, 0);
   ASSERT_FALSE(more.warnings.empty());
   EXPECT_NE(more.warnings.back().find("lines at least 0.25 of it are used"), std::string::npos)
       << more.warnings.back();
