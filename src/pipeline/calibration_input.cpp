@@ -28,6 +28,7 @@ bool DatasetRunOptions::IsValid(std::string* why) const {
   if (!(min_annulus_fraction >= 0.0 && min_annulus_fraction <= 1.0))
     return fail("min_annulus_fraction must be in [0, 1]");
   if (enough_tracks < 0) return fail("enough_tracks must be >= 0");
+  if (split_after_short < 0) return fail("split_after_short must be >= 0");
   if (!(std::isfinite(short_sigma_scale) && short_sigma_scale > 0.0))
     return fail("short_sigma_scale must be > 0");
   return true;
@@ -160,12 +161,16 @@ std::vector<char> wheel_gaps(const dataset::Dataset& data,
 }
 
 // The calibration's id of each row: its track id, except that where a track's long lines
-// resume after short ones the rest of it is a new track (ids above every track id, in the
-// order they start). A track whose line was short for a while may have slipped onto another
-// edge meanwhile: the tracker followed it by lines whose bearings the calibration does not
-// check. Rows in frame order within a track (tracks.csv's order; others are sorted).
+// resume after at least `split_after` short ones the rest of it is a new track (ids above
+// every track id, in the order they start). A track whose line was short for a while may
+// have slipped onto another edge meanwhile: the tracker followed it by lines whose bearings
+// the calibration does not check; a line that dips below the fraction for a frame or two
+// (one about half the annulus long) keeps its track. Rows in frame order within a track
+// (tracks.csv's order; others are sorted).
 std::vector<std::int64_t> pieces_between_short_lines(
-    const std::vector<TrackRow>& rows, const std::function<bool(const TrackRow&)>& is_short) {
+    const std::vector<TrackRow>& rows,
+    const std::function<bool(const TrackRow&)>& is_short,
+    int split_after) {
   std::vector<std::size_t> order(rows.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
@@ -175,7 +180,7 @@ std::vector<std::int64_t> pieces_between_short_lines(
   for (const TrackRow& r : rows) next = std::max(next, r.track_id + 1);
   struct State {
     std::int64_t piece = -1;
-    bool short_since_long = false;
+    int short_since_long = 0;
   };
   std::map<std::int64_t, State> state;
   std::vector<std::int64_t> id(rows.size());
@@ -183,10 +188,10 @@ std::vector<std::int64_t> pieces_between_short_lines(
     State& st = state[rows[i].track_id];
     if (st.piece < 0) st.piece = rows[i].track_id;
     if (is_short(rows[i])) {
-      st.short_since_long = true;
-    } else if (st.short_since_long) {
-      st.piece = next++;
-      st.short_since_long = false;
+      ++st.short_since_long;
+    } else {
+      if (split_after > 0 && st.short_since_long >= split_after) st.piece = next++;
+      st.short_since_long = 0;
     }
     id[i] = st.piece;
   }
@@ -204,7 +209,8 @@ double choose_annulus_fraction(const std::vector<TrackRow>& rows,
   if (opt.enough_tracks <= 0 || preferred <= 0.0) return preferred;
   auto tracks_at = [&](double f) {
     auto is_short = [f](const TrackRow& r) { return r.annulus_fraction < f; };  // NaN: used
-    const std::vector<std::int64_t> id = pieces_between_short_lines(rows, is_short);
+    const std::vector<std::int64_t> id =
+        pieces_between_short_lines(rows, is_short, opt.split_after_short);
     std::map<std::int64_t, int> length;
     for (std::size_t i = 0; i < rows.size(); ++i)
       if (!is_short(rows[i])) ++length[id[i]];
@@ -252,7 +258,8 @@ void add_bearings(const std::vector<TrackRow>& rows,
   // A line shorter than min_fraction is tracked, not used (its track's length counts the
   // bearings used only).
   auto too_short = [&](const TrackRow& r) { return r.annulus_fraction < min_fraction; };
-  const std::vector<std::int64_t> id = pieces_between_short_lines(rows, too_short);
+  const std::vector<std::int64_t> id =
+      pieces_between_short_lines(rows, too_short, opt.split_after_short);
   std::map<std::int64_t, int> length;
   std::map<std::pair<std::int64_t, std::int64_t>, int> per_frame;  // (frame, piece) -> count
   for (std::size_t i = 0; i < rows.size(); ++i) {

@@ -85,15 +85,27 @@ void expect_short_lines_left_out(const dataset::Dataset& d,
   // fraction is not known (used).
   std::map<std::int64_t, int> rows_of;
   for (const TrackRow& r : rows) ++rows_of[r.track_id];
-  std::int64_t longest = -1, max_id = -1;
+  std::int64_t longest = -1, max_id = -1, second = -1;
   for (const auto& [id, k] : rows_of) {
     if (id % 3 != 1 && (longest < 0 || k > rows_of[longest])) longest = id;
     max_id = std::max(max_id, id);
   }
+  // Another track short in two frames only (fewer than split_after_short): it keeps its id.
+  std::map<std::int64_t, std::pair<bool, bool>> spans;  // rows before frame 50, after 51
+  for (const TrackRow& r : rows) {
+    if (r.frame < 50) spans[r.track_id].first = true;
+    if (r.frame > 51) spans[r.track_id].second = true;
+  }
+  for (const auto& [id, k] : rows_of)
+    if (id % 3 != 1 && id != longest && spans[id].first && spans[id].second &&
+        (second < 0 || k > rows_of[second]))
+      second = id;
+  ASSERT_GE(second, 0);
   std::vector<TrackRow> mixed = rows;
   for (TrackRow& r : mixed) {
-    const bool is_short =
-        r.track_id % 3 == 1 || (r.track_id == longest && r.frame >= 30 && r.frame < 40);
+    const bool is_short = r.track_id % 3 == 1 ||
+                          (r.track_id == longest && r.frame >= 30 && r.frame < 40) ||
+                          (r.track_id == second && (r.frame == 50 || r.frame == 51));
     r.annulus_fraction = is_short ? 0.3 : 0.7;
   }
   mixed.back().annulus_fraction = std::numeric_limits<double>::quiet_NaN();  // not known: used
@@ -118,6 +130,7 @@ void expect_short_lines_left_out(const dataset::Dataset& d,
   EXPECT_EQ(sel.short_bearings, short_rows);
   EXPECT_EQ(sel.observations, used_rows);
   EXPECT_DOUBLE_EQ(sel.min_annulus_fraction, 0.5);
+  int second_after = 0;
   for (std::size_t k = 0; k < sel.run.frames.size(); ++k)
     for (const auto& ob : sel.run.frames[k].observations) {
       EXPECT_TRUE(ob.track_id > max_id || ob.track_id % 3 != 1 ||
@@ -125,7 +138,9 @@ void expect_short_lines_left_out(const dataset::Dataset& d,
       if (ob.track_id == longest) {
         EXPECT_LT(k, 30u);  // after frame 39: a new id
       }
+      if (ob.track_id == second && k > 51) ++second_after;
     }
+  EXPECT_GT(second_after, 0);  // the same id after its two short frames
   pipeline::DatasetRunOptions all;
   all.min_annulus_fraction = 0.0;
   const pipeline::DatasetRun every = pipeline::calibration_run_from_tracks(d, mixed, all);
@@ -144,7 +159,8 @@ void expect_short_lines_left_out(const dataset::Dataset& d,
   for (std::size_t k = 0; k < more.run.frames.size(); ++k)
     for (const auto& ob : more.run.frames[k].observations) {
       const bool is_short = (ob.track_id % 3 == 1 && ob.track_id <= max_id) ||
-                            (ob.track_id == longest && k >= 30 && k < 40);
+                            (ob.track_id == longest && k >= 30 && k < 40) ||
+                            (ob.track_id == second && (k == 50 || k == 51));
       if (is_short) ++doubled;
       EXPECT_DOUBLE_EQ(ob.sigma_scale, is_short ? want_more.short_sigma_scale : 1.0)
           << "frame " << k << " track " << ob.track_id;
