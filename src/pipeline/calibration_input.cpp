@@ -164,7 +164,7 @@ std::vector<char> wheel_gaps(const dataset::Dataset& data,
 // resume after at least `split_after` short ones the rest of it is a new track (ids above
 // every track id, in the order they start). A track whose line was short for a while may
 // have slipped onto another edge meanwhile: the tracker followed it by lines whose bearings
-// the calibration does not check; a line that dips below the fraction for a frame or two
+// the calibration does not check; a line that dips below the fraction for a single frame
 // (one about half the annulus long) keeps its track. Rows in frame order within a track
 // (tracks.csv's order; others are sorted).
 std::vector<std::int64_t> pieces_between_short_lines(

@@ -90,7 +90,7 @@ void expect_short_lines_left_out(const dataset::Dataset& d,
     if (id % 3 != 1 && (longest < 0 || k > rows_of[longest])) longest = id;
     max_id = std::max(max_id, id);
   }
-  // Another track short in two frames only (fewer than split_after_short): it keeps its id.
+  // Another track short in one frame only (fewer than split_after_short): it keeps its id.
   std::map<std::int64_t, std::pair<bool, bool>> spans;  // rows before frame 50, after 51
   for (const TrackRow& r : rows) {
     if (r.frame < 50) spans[r.track_id].first = true;
@@ -105,7 +105,7 @@ void expect_short_lines_left_out(const dataset::Dataset& d,
   for (TrackRow& r : mixed) {
     const bool is_short = r.track_id % 3 == 1 ||
                           (r.track_id == longest && r.frame >= 30 && r.frame < 40) ||
-                          (r.track_id == second && (r.frame == 50 || r.frame == 51));
+                          (r.track_id == second && r.frame == 50);
     r.annulus_fraction = is_short ? 0.3 : 0.7;
   }
   mixed.back().annulus_fraction = std::numeric_limits<double>::quiet_NaN();  // not known: used
@@ -140,7 +140,7 @@ void expect_short_lines_left_out(const dataset::Dataset& d,
       }
       if (ob.track_id == second && k > 51) ++second_after;
     }
-  EXPECT_GT(second_after, 0);  // the same id after its two short frames
+  EXPECT_GT(second_after, 0);  // the same id after its short frame
   pipeline::DatasetRunOptions all;
   all.min_annulus_fraction = 0.0;
   const pipeline::DatasetRun every = pipeline::calibration_run_from_tracks(d, mixed, all);
@@ -160,7 +160,7 @@ void expect_short_lines_left_out(const dataset::Dataset& d,
     for (const auto& ob : more.run.frames[k].observations) {
       const bool is_short = (ob.track_id % 3 == 1 && ob.track_id <= max_id) ||
                             (ob.track_id == longest && k >= 30 && k < 40) ||
-                            (ob.track_id == second && (k == 50 || k == 51));
+                            (ob.track_id == second && k == 50);
       if (is_short) ++doubled;
       EXPECT_DOUBLE_EQ(ob.sigma_scale, is_short ? want_more.short_sigma_scale : 1.0)
           << "frame " << k << " track " << ob.track_id;
