@@ -21,6 +21,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "core/yaml_fields.hpp"
+#include "omnivert/core/camera_geometry.hpp"
 #include "omnivert/core/error.hpp"
 #include "omnivert/dataset/dataset.hpp"
 #include "omnivert/match/tracks_io.hpp"
@@ -313,6 +314,23 @@ TEST_F(HostileTest, LineOfAnAbsentYamlKeyIsZero) {
   const YAML::Node y = yaml::load_file(p("prior.yaml"));
   EXPECT_EQ(yaml::line_of(y["rho"]), 2);
   EXPECT_EQ(yaml::line_of(y["psi"]), 0);
+}
+
+// Found by the cam0/sensor.yaml fuzz harness (tests/fuzz/regressions/cam0_sensor): a
+// resolution of 5.6e44 pixels was converted to int (undefined behaviour).
+TEST_F(HostileTest, HugeResolutionIsRefused) {
+  const std::string found = OMNIVERT_FUZZ_DIR "/regressions/cam0_sensor/huge-resolution.yaml";
+  try {
+    (void)load_camera_geometry(found);
+    ADD_FAILURE() << "read";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              found + ":1: field 'resolution' must hold two whole numbers of pixels, 1 to 100000");
+  }
+  write("sensor.yaml", "resolution: [100001, 480]\n");
+  EXPECT_THROW((void)load_camera_geometry(p("sensor.yaml")), InputError);
+  write("sensor.yaml", "resolution: [100000, 480]\n");
+  EXPECT_EQ(load_camera_geometry(p("sensor.yaml")).width, 100000);
 }
 
 }  // namespace
