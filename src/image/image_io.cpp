@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <string>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -10,6 +11,23 @@
 namespace omnivert {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+// The first bytes of the formats read_image accepts.
+bool has_image_signature(const std::string& h) {
+  auto starts = [&h](const char* sig, std::size_t n) {
+    return h.size() >= n && h.compare(0, n, sig, n) == 0;
+  };
+  if (starts("\x89PNG\r\n\x1a\n", 8)) return true;                              // PNG
+  if (starts("\xff\xd8\xff", 3)) return true;                                   // JPEG
+  if (starts("II*\0", 4) || starts("MM\0*", 4)) return true;                    // TIFF
+  if (starts("BM", 2)) return true;                                             // BMP
+  if (h.size() >= 2 && h[0] == 'P' && h[1] >= '1' && h[1] <= '7') return true;  // PNM
+  return starts("RIFF", 4);                                                     // WebP
+}
+
+}  // namespace
 
 cv::Mat read_image(const std::string& path) {
   std::error_code ec;
@@ -22,6 +40,17 @@ cv::Mat read_image(const std::string& path) {
   {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError(path, 0, "cannot be opened for reading (permissions?)");
+    // Only the formats we read are handed to OpenCV: cv::imread tries every decoder it was
+    // built with, and some abort the program on a hostile file (fuzz_image found a file
+    // that makes GDCM's DICOM reader fail an assertion).
+    char head[8] = {};
+    in.read(head, sizeof(head));
+    if (!has_image_signature(std::string(head, static_cast<std::size_t>(in.gcount())))) {
+      throw InputError(path,
+                       0,
+                       "not a readable image (it does not start with the signature of PNG, "
+                       "JPEG, TIFF, PGM/PPM, BMP or WebP)");
+    }
   }
   cv::Mat img;
   try {

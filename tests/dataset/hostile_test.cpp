@@ -24,6 +24,7 @@
 #include "omnivert/core/camera_geometry.hpp"
 #include "omnivert/core/error.hpp"
 #include "omnivert/dataset/dataset.hpp"
+#include "omnivert/image/image_io.hpp"
 #include "omnivert/match/tracks_io.hpp"
 
 namespace omnivert::dataset {
@@ -331,6 +332,25 @@ TEST_F(HostileTest, HugeResolutionIsRefused) {
   EXPECT_THROW((void)load_camera_geometry(p("sensor.yaml")), InputError);
   write("sensor.yaml", "resolution: [100000, 480]\n");
   EXPECT_EQ(load_camera_geometry(p("sensor.yaml")).width, 100000);
+}
+
+// Found by the image fuzz harness (tests/fuzz/regressions/image): a file that is no image made
+// OpenCV's DICOM reader (GDCM) fail an assertion and abort the program.
+TEST_F(HostileTest, FileOfNoImageFormatIsRefusedBeforeDecoding) {
+  const std::string found = OMNIVERT_FUZZ_DIR "/regressions/image/gdcm-assertion.bin";
+  try {
+    (void)read_image(found);
+    ADD_FAILURE() << "read";
+  } catch (const InputError& e) {
+    EXPECT_NE(
+        std::string(e.what()).find("not a readable image (it does not start with the signature"),
+        std::string::npos)
+        << e.what();
+  }
+  cv::imwrite(p("ok.png"), cv::Mat(4, 5, CV_8UC1, cv::Scalar(7)));
+  EXPECT_EQ(read_image(p("ok.png")).cols, 5);
+  cv::imwrite(p("ok.pgm"), cv::Mat(4, 5, CV_8UC1, cv::Scalar(7)));
+  EXPECT_EQ(read_image(p("ok.pgm")).rows, 4);
 }
 
 }  // namespace
