@@ -4,6 +4,8 @@
 #include <cmath>
 #include <set>
 
+#include <spdlog/spdlog.h>
+
 #include "calib/updater.hpp"
 #include "omnivert/calib/model.hpp"
 #include "omnivert/calib/track_ids.hpp"
@@ -157,7 +159,10 @@ AssociationEnd associate(Built* b,
   // each line starting at its first piece's point.
   for (int round = 0; setup.join_pieces && round < kMergeRounds; ++round) {
     BatchPoint at;
+    const std::size_t before = out->merges.size();
     if (!merge_round(b, *setup.options, &out->merged, &at, &out->merges)) break;
+    spdlog::debug(
+        "association: round {} joined {} pairs of pieces", round + 1, out->merges.size() - before);
     if (const AssociationEnd end = rebuild_and_judge(b, out->merged, at, setup, out);
         end != AssociationEnd::kDone)
       return end;
@@ -167,6 +172,7 @@ AssociationEnd associate(Built* b,
   for (int round = 0; setup.split.split_chi2 > 0.0 && round < setup.split.split_rounds; ++round) {
     const std::map<int, int> found = find_splits(*b, setup.split);
     if (found.empty()) break;
+    spdlog::debug("association: round {} split {} tracks", round + 1, found.size());
     BatchPoint at = point_of(*b);
     out->split = split_round(
         out->merged, round == 0 ? out->merged : out->split, found, &out->splits, &out->origin, &at);

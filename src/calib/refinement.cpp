@@ -1,6 +1,7 @@
 #include "omnivert/calib/refinement.hpp"
 
 #include <ceres/ceres.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <cmath>
@@ -39,6 +40,23 @@ ceres::Solver::Options solver_options(const RefinementOptions& refinement) {
   return so;
 }
 
+// One solve of the batch problem, logged at debug level (iterations, cost, time).
+void solve_logged(const ceres::Solver::Options& so,
+                  Built* b,
+                  ceres::Solver::Summary* summary,
+                  const char* what) {
+  ceres::Solve(so, b->problem.get(), summary);
+  spdlog::debug(
+      "refinement {}: {} features, {} bearings, {} iterations, cost {:.6g} -> {:.6g}, {:.2f} s",
+      what,
+      b->features.size(),
+      b->num_bearings,
+      summary->iterations.size(),
+      summary->initial_cost,
+      summary->final_cost,
+      summary->total_time_in_seconds);
+}
+
 // The association loop of the refinement: the decisions under the bearing's whole error
 // (`assoc`, association_options), the problem rebuilt as it was first built.
 AssociationSetup association_setup(const CalibrationOptions& assoc,
@@ -52,7 +70,7 @@ AssociationSetup association_setup(const CalibrationOptions& assoc,
   s.rebuild = [&assoc](const CalibrationRun& run, const BatchPoint& at) {
     return build(run, assoc, at, assoc.refinement.robust);
   };
-  s.solve = [&so, summary](Built* b) { ceres::Solve(so, b->problem.get(), summary); };
+  s.solve = [&so, summary](Built* b) { solve_logged(so, b, summary, "association"); };
   return s;
 }
 
@@ -198,7 +216,7 @@ RefinementResult refine_batch(const CalibrationRun& run,
 
   const ceres::Solver::Options so = solver_options(options.refinement);
   ceres::Solver::Summary summary;
-  ceres::Solve(so, b.problem.get(), &summary);
+  solve_logged(so, &b, &summary, "first solve");
   // Lines that cross, outliers (false matches, at the filter's gate), pieces of one line,
   // slipped tracks; the problem solved again after each decision.
   Association association;
@@ -207,7 +225,7 @@ RefinementResult refine_batch(const CalibrationRun& run,
   if (model.noise.track_bias_sigma > 0.0) {
     b = final_with_bias(
         res.renamed() ? res.solved_run : run, b, model, options.refinement.robust, 2);
-    ceres::Solve(so, b.problem.get(), &summary);
+    solve_logged(so, &b, &summary, "with the track biases");
   }
   res.guarded = b.guarded;
   res.rejected =
