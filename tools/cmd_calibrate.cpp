@@ -179,7 +179,8 @@ void run_calibrate(CLI::App* cmd, const CalibrateArgs& a) {
     std::printf("%s%s\n", r.tilt.describe().c_str(), r.tilt_corrected ? "; frames rectified" : "");
   }
   std::printf("%s", r.BriefReport().c_str());
-  if (o.tracks_file.empty() && tracking_s > 0)
+  if (!r.streaming_message.empty()) std::printf("%s\n", r.streaming_message.c_str());
+  if (o.tracks_file.empty() && tracking_s > 0 && !o.streaming)
     std::printf("tracking: %s\n",
                 throughput(r.frames, tracking_s, resolve_threads(a.options.threads)).c_str());
   if (!r.wrote_extrinsics) {
@@ -333,6 +334,12 @@ void add_calibrate_command(CLI::App& app) {
       "--refine",
       a->options.calibration.refinement.enabled,
       "Refine the filter's result by batch maximum likelihood over the whole run (Ceres)");
+  cmd->add_flag("--streaming",
+                a->options.streaming,
+                "Calibrate as the robot would while driving: each image through extraction, "
+                "tracker and filter as it comes, on one thread, nothing looked ahead; the "
+                "estimate after every frame and the time it took in streaming.csv "
+                "(docs/calibration.md#streaming). Not with --refine or --tracks");
   cmd->add_option("--split-chi2",
                   a->options.calibration.association.split_chi2,
                   "Filter's window and refinement: split a track in two where two features "

@@ -232,6 +232,29 @@ CalibrationResult calibrate_once(const CalibrationRun& run, const CalibrationOpt
 }
 }  // namespace
 
+CalibrationResult result_of_filter(const CalibrationRun& run,
+                                   const CalibrationOptions& options,
+                                   FilterResult filter) {
+  std::string why;
+  if (!options.IsValid(&why)) throw InputError("calibration options: " + why);
+  CalibrationOptions o = options;
+  o.refinement.enabled = false;
+  CalibrationResult r;
+  r.model.bearing_sigma = o.noise.bearing_sigma;
+  r.model.track_bias_sigma = o.noise.track_bias_sigma;
+  r.noise_check.level = o.noise_check.level;
+  r.noise_check.lower_level = o.noise_check.lower_level;
+  r.filter = std::move(filter);
+  StageTimer timer;
+  const BatchPoint filter_point = batch_point_from_filter(run, o, r.filter);
+  refine_and_analyse(run, o, filter_point, &timer, &r);
+  r.noise_check.filter_model_covariance = r.filter.covariance;
+  r.extrinsics = r.filter.extrinsics;
+  r.covariance = r.filter.covariance;
+  r.source = Estimator::kFilter;
+  return r;
+}
+
 const char* estimator_name(Estimator e) {
   return e == Estimator::kRefinement ? "refinement" : "filter";
 }

@@ -56,6 +56,7 @@ const std::vector<BearingKey>& CalibrationFilter::guarded() const { return impl_
 const std::vector<BearingKey>& CalibrationFilter::rejected() const { return impl_->rejected_; }
 const std::vector<TrackJoin>& CalibrationFilter::joins() const { return impl_->joins_; }
 int CalibrationFilter::frames_processed() const { return impl_->frame_; }
+bool CalibrationFilter::bootstrapping() const { return impl_->bootstrapping_; }
 const CalibrationOptions& CalibrationFilter::options() const { return impl_->options_; }
 
 CalibrationFilter::Impl::Impl(const CalibrationOptions& options)

@@ -17,6 +17,7 @@
 #include "omnivert/pipeline/calibration_report.hpp"
 #include "omnivert/viz/convergence_plot.hpp"
 #include "omnivert/viz/tracks_plot.hpp"
+#include "pipeline/streaming_run.hpp"
 
 namespace omnivert::pipeline {
 
@@ -42,7 +43,8 @@ constexpr const char* kOutputs[] = {"extrinsics.yaml",
                                     calib::kRobotFormatFiles[0],
                                     calib::kRobotFormatFiles[1],
                                     calib::kRobotFormatFiles[2],
-                                    "reprojection.png"};
+                                    "reprojection.png",
+                                    "streaming.csv"};
 
 std::string few_tracks_warning(int tracks,
                                const FeaturePipelineOptions& features,
@@ -171,6 +173,14 @@ bool CalibrateDatasetOptions::IsValid(std::string* why) const {
   if (!calibration.IsValid(&w)) return fail("calibration");
   if (!input.IsValid(&w)) return fail("input");
   if (!time_offset.IsValid(&w)) return fail("time offset");
+  if (streaming && !tracks_file.empty()) {
+    w = "streaming needs the images, not an earlier tracks file";
+    return fail("input");
+  }
+  if (streaming && calibration.refinement.enabled) {
+    w = "streaming gives the filter's estimate; the refinement needs the whole run";
+    return fail("calibration");
+  }
   if (time_offset_s && !std::isfinite(*time_offset_s)) {
     w = "time_offset_s must be finite [s]";
     return fail("time offset");
@@ -178,9 +188,13 @@ bool CalibrateDatasetOptions::IsValid(std::string* why) const {
   return true;
 }
 
-CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
-                                         const std::string& out_dir,
-                                         const CalibrateDatasetOptions& o) {
+namespace {
+
+// The dataset and the checks made before any work (bad input, exit code 2); *opt: the
+// calibration options with the dataset's wheel base and K.
+dataset::Dataset load_checked(const std::string& dataset_dir,
+                              const CalibrateDatasetOptions& o,
+                              calib::CalibrationOptions* opt) {
   std::string why;
   if (!o.IsValid(&why)) throw InputError("invalid " + why);
   dataset::LoadOptions lo;
@@ -192,11 +206,21 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
   // warning, not a reason to refuse the calibration.
   if (!data.ground_truth_error().empty())
     spdlog::warn("ground truth not used: {}", data.ground_truth_error());
-  const calib::CalibrationOptions opt = options_from_dataset(data, o.calibration);
-  if (!opt.IsValid(&why)) throw InputError("invalid calibration options: " + why);
+  *opt = options_from_dataset(data, o.calibration);
+  if (!opt->IsValid(&why)) throw InputError("invalid calibration options: " + why);
   if (!o.reprojection.IsValid(&why)) throw InputError("invalid check options: " + why);
   // A reference asked for is checked before the work (bad input, exit code 2).
   if (o.check_reference && !o.check_off) (void)load_references(data, o.reprojection.reference);
+  return data;
+}
+
+}  // namespace
+
+CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
+                                         const std::string& out_dir,
+                                         const CalibrateDatasetOptions& o) {
+  calib::CalibrationOptions opt;
+  auto data = load_checked(dataset_dir, o, &opt);
 
   // Read before the output folder is cleared: the tracks file may be out_dir/tracks.csv.
   std::optional<TrackDatasetResult> given;
@@ -206,16 +230,20 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
 
   CalibrateDatasetResult r;
   r.out_dir = out_dir;
-  r.noise_check_requested = o.calibration.noise_check.enabled;
+  r.noise_check_requested = o.calibration.noise_check.enabled && !o.streaming;
   const auto t0 = Clock::now();
   if (o.time_offset_s) apply_time_offset(data, *o.time_offset_s, true, r);  // before tracking
   const bool from_images = !given.has_value();
-  TrackDatasetResult tracked = tracks_of(data, o, std::move(given));
+  std::optional<internal::StreamedRun> streamed;
+  if (o.streaming) streamed = internal::stream_dataset(data, o, opt);
+  TrackDatasetResult tracked =
+      streamed ? std::move(streamed->tracked) : tracks_of(data, o, std::move(given));
 
   // The time offset, estimated from the tracks when not given. Applied, it also changes the
   // wheel travel between frames that the tracker's odometry gate predicts with (Sec. 9.1), so
   // the images are tracked again on the corrected stamps.
-  if (!o.time_offset_s) {
+  if (o.streaming && !o.time_offset_s) r.time_offset.why = "not estimated when streaming";
+  if (!o.time_offset_s && !o.streaming) {
     r.time_offset = estimate_time_offset(
         data, tracked.rows, opt.robot.odometry_K, opt.noise.bearing_sigma, o.time_offset);
     if (r.time_offset.significant(o.time_offset)) {
@@ -234,7 +262,8 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
   r.detections = static_cast<std::int64_t>(tracked.rows.size());
 
   // Step 2: the calibration's input; step 3: filter, observability, refinement (Sec. 8).
-  r.input = calibration_run_from_tracks(data, tracked.rows, o.input);
+  r.input = streamed ? std::move(streamed->input)
+                     : calibration_run_from_tracks(data, tracked.rows, o.input);
   r.warnings.insert(r.warnings.end(), r.input.warnings.begin(), r.input.warnings.end());
   if (r.input.tracks < kFewTracks)
     r.warnings.push_back(
@@ -242,7 +271,8 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
   r.warnings.insert(r.warnings.end(), o.notes.begin(), o.notes.end());
   for (const auto& w : r.warnings) spdlog::warn("{}", w);
   if (o.progress) o.progress("calibrate", 0, 0);
-  r.calibration = calib::calibrate(r.input.run, opt);
+  r.calibration = streamed ? calib::result_of_filter(r.input.run, opt, std::move(streamed->filter))
+                           : calib::calibrate(r.input.run, opt);
   const auto t2 = Clock::now();
   const calib::CalibrationResult& result = r.calibration;
   if (!result.extrinsics.vec().allFinite() || !result.covariance.allFinite())
@@ -287,6 +317,12 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
       time_offset_line(r.time_offset, r.time_offset_given, r.time_offset_applied, o.time_offset);
   ri.time_offset = time_offset_report(r);
   reprojection_check(data, tracked.rows, opt.prior.mean, result.extrinsics, o, ri, r);
+  if (streamed) {
+    internal::write_streaming_csv((out / "streaming.csv").string(), streamed->estimates);
+    ri.streaming_json = internal::streaming_json(streamed->estimates);
+    ri.streaming_html = internal::streaming_html(streamed->estimates);
+    r.streaming_message = internal::streaming_line(streamed->estimates);
+  }
   if (r.wrote_extrinsics) {
     calib::write_extrinsics_yaml((out / "extrinsics.yaml").string(), result);
     calib::write_robot_formats(out.string(), result.extrinsics, result.covariance, o.frames);

@@ -50,13 +50,26 @@ std::size_t sample_before(const std::vector<dataset::WheelRecord>& w, std::int64
 
 }  // namespace
 
+std::vector<Eigen::Vector2d> wheel_travel_between_images(const dataset::Dataset& data,
+                                                         std::size_t i) {
+  const auto& travel = data.travel_at_images();
+  const auto& wheel = data.wheel();
+  // On the odometry clock: the stamps shifted by the camera-odometry time offset.
+  const std::int64_t t0 = data.odometry_time(i - 1), t1 = data.odometry_time(i);
+  std::vector<Eigen::Vector2d> steps(1, Eigen::Vector2d(travel[i - 1].left, travel[i - 1].right));
+  for (std::size_t k = sample_before(wheel, t0) + 1; k < wheel.size() && wheel[k].timestamp_ns < t1;
+       ++k)
+    if (wheel[k].timestamp_ns > t0) steps.emplace_back(wheel[k].travel.left, wheel[k].travel.right);
+  steps.emplace_back(travel[i].left, travel[i].right);
+  return steps;
+}
+
 namespace {
 
 // Wheel travel per frame (eq. 14-15's inputs), and the heading for the motion summary.
 void add_frame_motion(const dataset::Dataset& data, DatasetRun& out) {
   const auto& images = data.images();
   const auto& travel = data.travel_at_images();
-  const auto& wheel = data.wheel();
   const std::size_t n = images.size();
   // Every wheel sample between two images is used: eq. (14) per sample, composed
   // (compose_wheel_steps), so that a frame in which the robot ends a straight and starts to
@@ -68,15 +81,7 @@ void add_frame_motion(const dataset::Dataset& data, DatasetRun& out) {
   std::vector<Eigen::Vector2d> steps;
   for (std::size_t i = 1; i < n; ++i) {
     calib::FrameInput& f = out.run.frames[i];
-    // On the odometry clock: the stamps shifted by the camera-odometry time offset.
-    const std::int64_t t0 = data.odometry_time(i - 1), t1 = data.odometry_time(i);
-    steps.assign(1, Eigen::Vector2d(travel[i - 1].left, travel[i - 1].right));
-    for (std::size_t k = sample_before(wheel, t0) + 1;
-         k < wheel.size() && wheel[k].timestamp_ns < t1;
-         ++k)
-      if (wheel[k].timestamp_ns > t0)
-        steps.emplace_back(wheel[k].travel.left, wheel[k].travel.right);
-    steps.emplace_back(travel[i].left, travel[i].right);
+    steps = wheel_travel_between_images(data, i);
     if (e > 0) {
       const Eigen::Vector3d m = calib::compose_wheel_steps(steps, e, &f.covariance_per_K);
       f.d_right = m(0);

@@ -389,6 +389,7 @@ std::string summary_json(const calib::CalibrationResult& r, const ReportInputs& 
                         {"message", t.line}};
   }
   if (!in.reprojection_json.empty()) j["reprojection"] = json::parse(in.reprojection_json);
+  if (!in.streaming_json.empty()) j["streaming"] = json::parse(in.streaming_json);
   j["warnings"] = in.warnings;
   return j.dump(2) + "\n";
 }
@@ -546,6 +547,7 @@ std::string report_html(const calib::CalibrationResult& r, const ReportInputs& i
   h << "<h2>Tracks (the paper's Fig. 22)</h2>\n<img src=\"tracks.png\" alt=\"bearing of every "
        "tracked line against the frame\">\n";
   h << in.reprojection_html;
+  h << in.streaming_html;
   h << "<p>Files: extrinsics.yaml, states.csv, tracks.csv, summary.json.</p>\n</body></html>\n";
   return h.str();
 }

@@ -115,6 +115,14 @@ std::string noise_check_chance(double limit, const char* side, double level);
 // Throws InputError on invalid options or input (non-finite values, repeated track ids).
 CalibrationResult calibrate(const CalibrationRun& run, const CalibrationOptions& options = {});
 
+// The result of a filter already run over `run` (a CalibrationFilter fed frame by frame as the
+// robot drives, then finished): Sec. 8.1 at its estimate, on the bearings it used, as
+// calibrate() analyses it; neither refinement nor noise check (both need the whole run as a
+// batch). The answer is the filter's.
+CalibrationResult result_of_filter(const CalibrationRun& run,
+                                   const CalibrationOptions& options,
+                                   FilterResult filter);
+
 // What a user should be told about a result (empty when nothing): the filter's gate refused
 // more than 20% of the bearings after its start-up window (it has probably diverged, or the
 // tracks mix lines), and, when refined, the refinement lies outside the filter's 99.9%

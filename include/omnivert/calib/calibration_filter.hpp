@@ -92,6 +92,9 @@ class CalibrationFilter {
   // estimate.
   const std::vector<TrackJoin>& joins() const;
   int frames_processed() const;
+  // Whether the start-up window is still collecting frames (the estimate is then the prior's;
+  // it is solved at the first turn of filter.bootstrap_rotation, or by finish()).
+  bool bootstrapping() const;
   const CalibrationOptions& options() const;
 
  private:

@@ -56,6 +56,12 @@ struct CalibrateDatasetOptions {
   std::vector<std::string> notes;  // extra warnings of the caller, reported with the rest
   TiltCheckOptions tilt;           // the tilt of the mirror axis (pipeline/tilt_check.hpp)
   int threads = 0;                 // threads of the frame pipeline (TrackDatasetOptions)
+  // The causal mode of a robot that calibrates as it drives (pipeline/streaming.hpp): each
+  // image through extraction, tracker and filter in turn on one thread, the estimate after
+  // each written to streaming.csv with the time the frame took. The answer is the filter's;
+  // no refinement, no noise check, no time-offset estimate (each needs the whole run), and
+  // the images themselves (no tracks_file).
+  bool streaming = false;
   // Frame names and camera height of the robot-format files written with extrinsics.yaml
   // (calib/robot_formats.hpp).
   calib::RobotFrames frames;
@@ -98,6 +104,7 @@ struct CalibrateDatasetResult {
   bool time_offset_given = false, time_offset_applied = false;
   std::string time_offset_message;   // time_offset_line(): the terminal's and the report's line
   std::string reprojection_message;  // the check by eye's line; empty when not made
+  std::string streaming_message;     // a streaming run's times per frame; empty otherwise
 
   // The answer: the refinement's estimate when it ran and its covariance is usable, else the
   // filter's (the same as calibration.extrinsics / calibration.covariance).

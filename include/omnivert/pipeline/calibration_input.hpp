@@ -15,8 +15,11 @@
 //     long"): the filter dead-reckons through them; reported with their frames and duration.
 // A run in which no frame has `min_lines` lines is an InputError.
 
+#include <cstddef>
 #include <string>
 #include <vector>
+
+#include <Eigen/Core>
 
 #include "omnivert/calib/options.hpp"
 #include "omnivert/dataset/dataset.hpp"
@@ -78,6 +81,12 @@ struct DatasetRun {
 DatasetRun calibration_run_from_tracks(const dataset::Dataset& data,
                                        const std::vector<TrackRow>& rows,
                                        const DatasetRunOptions& options = {});
+
+// The cumulative wheel travel (left, right) [m] from image i - 1 to image i, on the odometry
+// clock: the travel at image i - 1, every wheel sample between, the travel at image i (the
+// input of calib::compose_wheel_steps). 1 <= i < data.size(); the dataset has wheel data.
+std::vector<Eigen::Vector2d> wheel_travel_between_images(const dataset::Dataset& data,
+                                                         std::size_t i);
 
 // CalibrationOptions filled from the dataset: wheel base from wheel0/sensor.yaml, Chong-Kleeman K
 // from its odometry_k when given (else the default of CalibrationOptions), the rest from `base`.

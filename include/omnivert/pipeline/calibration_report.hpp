@@ -61,6 +61,9 @@ struct ReportInputs {
   // The check by eye (pipeline/reprojection.hpp), when made: summary.json's "reprojection"
   // object (JSON text) and report.html's section.
   std::string reprojection_json, reprojection_html;
+  // A streaming run (pipeline/streaming.hpp), when it was one: summary.json's "streaming"
+  // object (JSON text) and report.html's section.
+  std::string streaming_json, streaming_html;
 };
 
 // One line on the noise check (docs/theory/noise-check.md), for the terminal and the

@@ -1,0 +1,231 @@
+#include "pipeline/streaming_run.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <set>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "omnivert/core/error.hpp"
+#include "omnivert/core/file_io.hpp"
+
+namespace omnivert::pipeline::internal {
+
+namespace {
+
+// The value below which a fraction q of `v` lies (nearest rank); 0 for none.
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  const std::size_t k =
+      std::min(v.size() - 1, static_cast<std::size_t>(std::ceil(q * static_cast<double>(v.size()))) -
+                                 (q > 0.0 ? 1 : 0));
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
+
+// The frame whose filter step solved the start-up window (-1: none).
+std::int64_t window_frame(const std::vector<StreamingEstimate>& e) {
+  for (std::size_t i = 1; i < e.size(); ++i)
+    if (e[i - 1].bootstrapping && !e[i].bootstrapping) return e[i].frame;
+  return -1;
+}
+
+struct Times {
+  std::vector<double> all, front_end, tracker, filter;
+};
+
+// The frames' times, the window's frame left out of the filter's (it is reported alone).
+Times times_of(const std::vector<StreamingEstimate>& e) {
+  Times t;
+  const std::int64_t w = window_frame(e);
+  for (const StreamingEstimate& s : e) {
+    t.front_end.push_back(s.front_end_ms);
+    t.tracker.push_back(s.tracker_ms);
+    if (s.frame == w) continue;
+    t.all.push_back(s.latency_ms());
+    t.filter.push_back(s.filter_ms);
+  }
+  return t;
+}
+
+}  // namespace
+
+StreamedRun stream_dataset(const dataset::Dataset& data,
+                           const CalibrateDatasetOptions& o,
+                           const calib::CalibrationOptions& opt) {
+  const std::string csv = data.root() + "/cam0/data.csv";
+  if (data.size() == 0) throw InputError(csv, 0, "the dataset has no images");
+  StreamingOptions so;
+  so.features = o.features;
+  so.tracker = o.tracker;
+  so.calibration = opt;
+  so.input = o.input;
+  CameraGeometry camera = data.camera();
+  if (!o.mask.empty()) camera.mask = o.mask;
+  StreamingCalibrator cal(camera, data.wheel_sensor().wheel_base, so);
+  StreamedRun s;
+  const std::size_t n = data.size();
+  s.input.run.frames.reserve(n);
+  s.estimates.reserve(n);
+  const auto& travel = data.travel_at_images();
+  std::set<int> tracks;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& im = data.images()[i];
+    cv::Mat image;
+    std::string why;
+    try {
+      image = data.image(i);
+    } catch (const InputError& e) {
+      why = e.what();
+    }
+    const std::vector<Eigen::Vector2d> wheel =
+        i == 0 ? std::vector<Eigen::Vector2d>{Eigen::Vector2d(travel[0].left, travel[0].right)}
+               : wheel_travel_between_images(data, i);
+    StreamingEstimate e = cal.add_frame(im.timestamp_ns, image, wheel);
+    if (!e.described) {
+      ++s.tracked.frames_skipped;
+      s.tracked.warnings.push_back((why.empty() ? im.path + ": " + e.problem : why) +
+                                   "; frame " + std::to_string(i) + " skipped");
+    }
+    const auto& rows = cal.last_rows();
+    s.tracked.rows.insert(s.tracked.rows.end(), rows.begin(), rows.end());
+    const calib::FrameInput& f = cal.last_input();
+    s.input.run.frames.push_back(f);
+    s.input.observations += static_cast<int>(f.observations.size());
+    for (const auto& b : f.observations) tracks.insert(b.track_id);
+    s.input.path_length += std::abs(0.5 * (f.d_left + f.d_right));
+    s.input.rotation += std::abs((f.d_right - f.d_left) / data.wheel_sensor().wheel_base);
+    s.estimates.push_back(e);
+    ++s.tracked.frames;
+    if (o.progress) o.progress("stream", i + 1, n);
+  }
+  if (s.tracked.frames_skipped == s.tracked.frames)
+    throw InputError(csv, 0, "no frame could be processed (" + s.tracked.warnings.front() + ")");
+  cal.finish();
+  const calib::CalibrationFilter& f = cal.filter();
+  s.filter.extrinsics = f.extrinsics();
+  s.filter.covariance = f.covariance();
+  s.filter.history = f.history();
+  s.filter.tracks = f.tracks();
+  s.filter.splits = f.splits();
+  s.filter.window_frames = f.window_frames();
+  s.filter.window_failure = f.window_failure();
+  s.filter.guarded = f.guarded();
+  s.filter.rejected = f.rejected();
+  s.filter.joins = f.joins();
+  s.tracked.stats = cal.tracker_stats();
+  s.input.tracks = static_cast<int>(tracks.size());
+  s.input.short_bearings = cal.short_bearings();
+  s.input.min_annulus_fraction = o.input.min_annulus_fraction;
+  s.input.crowded_sigma_scale = o.input.crowded_sigma_scale;
+  return s;
+}
+
+void write_streaming_csv(const std::string& path, const std::vector<StreamingEstimate>& estimates) {
+  std::ostringstream s;
+  s << "frame,timestamp_ns,state,phi,rho,psi,sigma_phi,sigma_rho,sigma_psi,lines,bearings,"
+       "features,front_end_ms,tracker_ms,filter_ms,latency_ms\n";
+  char buf[512];
+  for (const StreamingEstimate& e : estimates) {
+    const Eigen::Vector3d sd = e.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+    std::snprintf(buf,
+                  sizeof buf,
+                  "%lld,%lld,%s,%.10g,%.10g,%.10g,%.6g,%.6g,%.6g,%d,%d,%d,%.4f,%.4f,%.4f,%.4f\n",
+                  static_cast<long long>(e.frame),
+                  static_cast<long long>(e.timestamp_ns),
+                  e.bootstrapping ? "window" : "filter",
+                  e.extrinsics.phi,
+                  e.extrinsics.rho,
+                  e.extrinsics.psi,
+                  sd(0),
+                  sd(1),
+                  sd(2),
+                  e.lines,
+                  e.bearings,
+                  e.features,
+                  e.front_end_ms,
+                  e.tracker_ms,
+                  e.filter_ms,
+                  e.latency_ms());
+    s << buf;
+  }
+  write_text_atomic(path, s.str());
+}
+
+std::string streaming_json(const std::vector<StreamingEstimate>& estimates) {
+  const Times t = times_of(estimates);
+  const std::int64_t w = window_frame(estimates);
+  auto stats = [](const std::vector<double>& v) {
+    return nlohmann::json{
+        {"median", quantile(v, 0.5)}, {"p95", quantile(v, 0.95)}, {"max", quantile(v, 1.0)}};
+  };
+  nlohmann::json j;
+  j["frames"] = estimates.size();
+  j["window_solved_at_frame"] = w;
+  j["window_ms"] = w >= 0 ? estimates[static_cast<std::size_t>(w)].latency_ms() : 0.0;
+  j["latency_ms"] = stats(t.all);
+  j["front_end_ms"] = stats(t.front_end);
+  j["tracker_ms"] = stats(t.tracker);
+  j["filter_ms"] = stats(t.filter);
+  return j.dump();
+}
+
+std::string streaming_line(const std::vector<StreamingEstimate>& estimates) {
+  const Times t = times_of(estimates);
+  const std::int64_t w = window_frame(estimates);
+  char buf[400];
+  std::snprintf(buf,
+                sizeof buf,
+                "streaming: %zu frames, %.2f ms per frame (median; 95%%: %.2f, largest %.2f), of "
+                "which the filter %.2f ms",
+                estimates.size(),
+                quantile(t.all, 0.5),
+                quantile(t.all, 0.95),
+                quantile(t.all, 1.0),
+                quantile(t.filter, 0.5));
+  std::string s = buf;
+  if (w >= 0) {
+    std::snprintf(buf,
+                  sizeof buf,
+                  "; start-up window solved at frame %lld in %.1f ms",
+                  static_cast<long long>(w),
+                  estimates[static_cast<std::size_t>(w)].latency_ms());
+    s += buf;
+  }
+  return s + "; streaming.csv";
+}
+
+std::string streaming_html(const std::vector<StreamingEstimate>& estimates) {
+  const Times t = times_of(estimates);
+  const std::int64_t w = window_frame(estimates);
+  std::ostringstream h;
+  char buf[600];
+  h << "<h2>Streaming</h2>\n<p>Each frame went through extraction, tracker and filter as it "
+       "came, on one thread, nothing looked ahead (streaming.csv has the estimate after every "
+       "frame).";
+  if (w >= 0) {
+    std::snprintf(buf,
+                  sizeof buf,
+                  " The start-up window was solved at frame %lld (%.1f ms).",
+                  static_cast<long long>(w),
+                  estimates[static_cast<std::size_t>(w)].latency_ms());
+    h << buf;
+  }
+  std::snprintf(buf,
+                sizeof buf,
+                "</p>\n<table><tr><th>per frame [ms]</th><th>median</th><th>95%%</th><th>largest"
+                "</th></tr>\n<tr><td>in all</td><td>%.2f</td><td>%.2f</td><td>%.2f</td></tr>\n"
+                "<tr><td>filter</td><td>%.2f</td><td>%.2f</td><td>%.2f</td></tr></table>\n",
+                quantile(t.all, 0.5),
+                quantile(t.all, 0.95),
+                quantile(t.all, 1.0),
+                quantile(t.filter, 0.5),
+                quantile(t.filter, 0.95),
+                quantile(t.filter, 1.0));
+  h << buf;
+  return h.str();
+}
+
+}  // namespace omnivert::pipeline::internal
