@@ -86,8 +86,7 @@ struct StreamingCalibrator::Impl {
     }
     for (const auto& [id, r] : used) {
       if (count[id] > 1) continue;
-      input.observations.push_back(
-          {id, r->bearing, r->crowded ? in.crowded_sigma_scale : 1.0});
+      input.observations.push_back({id, r->bearing, r->crowded ? in.crowded_sigma_scale : 1.0});
     }
   }
 

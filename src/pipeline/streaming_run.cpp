@@ -18,9 +18,9 @@ namespace {
 // The value below which a fraction q of `v` lies (nearest rank); 0 for none.
 double quantile(std::vector<double> v, double q) {
   if (v.empty()) return 0.0;
-  const std::size_t k =
-      std::min(v.size() - 1, static_cast<std::size_t>(std::ceil(q * static_cast<double>(v.size()))) -
-                                 (q > 0.0 ? 1 : 0));
+  const std::size_t k = std::min(
+      v.size() - 1,
+      static_cast<std::size_t>(std::ceil(q * static_cast<double>(v.size()))) - (q > 0.0 ? 1 : 0));
   std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
   return v[k];
 }
@@ -86,8 +86,8 @@ StreamedRun stream_dataset(const dataset::Dataset& data,
     StreamingEstimate e = cal.add_frame(im.timestamp_ns, image, wheel);
     if (!e.described) {
       ++s.tracked.frames_skipped;
-      s.tracked.warnings.push_back((why.empty() ? im.path + ": " + e.problem : why) +
-                                   "; frame " + std::to_string(i) + " skipped");
+      s.tracked.warnings.push_back((why.empty() ? im.path + ": " + e.problem : why) + "; frame " +
+                                   std::to_string(i) + " skipped");
     }
     const auto& rows = cal.last_rows();
     s.tracked.rows.insert(s.tracked.rows.end(), rows.begin(), rows.end());

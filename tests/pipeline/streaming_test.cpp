@@ -71,7 +71,8 @@ TEST_F(Streaming, EstimateIsWithinItsSigmasOfTheTruthAndNeverLooksAhead) {
 
   // The final estimate: within its sigmas of the truth (NEES under chi-square(3)'s 99.9%), and
   // millimetres from it (docs/validation.md, streaming).
-  const Eigen::Vector3d err = cal.filter().extrinsics().vec() - Eigen::Vector3d(g.phi, g.rho, g.psi);
+  const Eigen::Vector3d err =
+      cal.filter().extrinsics().vec() - Eigen::Vector3d(g.phi, g.rho, g.psi);
   const Eigen::Matrix3d C = cal.filter().covariance();
   const double nees = err.dot(C.ldlt().solve(err));
   EXPECT_LT(nees, 16.27) << "error " << err.transpose() << ", sigmas "
@@ -130,9 +131,9 @@ TEST_F(Streaming, RefinementAndEarlierTracksAreRefused) {
                 pipeline::calibrate_dataset(paper().string(), scratch("s-tracks").string(), o);
               }),
               HasSubstr("streaming needs the images"));
-  EXPECT_THROW(pipeline::StreamingCalibrator(
-                   dataset::Dataset::load(paper().string()).camera(), 0.0, {}),
-               InputError);
+  EXPECT_THROW(
+      pipeline::StreamingCalibrator(dataset::Dataset::load(paper().string()).camera(), 0.0, {}),
+      InputError);
 }
 
 }  // namespace

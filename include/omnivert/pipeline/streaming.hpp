@@ -59,8 +59,8 @@ inline constexpr int kFirstPieceId = 1 << 30;
 struct StreamingEstimate {
   std::int64_t frame = 0;  // index of the frame, from 0
   std::int64_t timestamp_ns = 0;
-  bool described = false;  // false: no image, or the mirror was not found (no lines then)
-  std::string problem;     // why not described, or what the frame pipeline warned of
+  bool described = false;     // false: no image, or the mirror was not found (no lines then)
+  std::string problem;        // why not described, or what the frame pipeline warned of
   bool bootstrapping = true;  // the start-up window still collects frames (prior's estimate)
   calib::Extrinsics extrinsics;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
