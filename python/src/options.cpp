@@ -277,6 +277,10 @@ const OptionTable<DO>& dataset_job_table() {
           "tracks", "calibrate from this tracks.csv instead of the images", [](DO & o) -> auto& {
             return o.tracks_file;
           }),
+      field<bool, DO>(
+          "streaming",
+          "frame by frame as the robot drives, nothing looked ahead (streaming.csv)",
+          [](DO & o) -> auto& { return o.streaming; }),
       field<std::string, DO>(
           "mask", "image mask file instead of sensor.yaml's mask:", [](DO & o) -> auto& {
             return o.mask;

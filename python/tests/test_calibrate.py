@@ -85,6 +85,21 @@ def known_run(frames_straight=30, frames_turn=30, seed=5):
     return np.array(increments), np.array(observations), truth
 
 
+def test_streaming_dataset_same_as_cli(demo_run, tmp_path):
+    """calibrate_dataset(streaming=True) gives `calibrate --streaming`'s estimate to the last
+    printed digit, and streaming.csv has a row per frame (its times differ from run to run)."""
+    cli("calibrate", demo_run, "--out", tmp_path / "cli", "--streaming")
+    r = omnivert.calibrate_dataset(str(demo_run), str(tmp_path / "py"), streaming=True)
+    assert ((tmp_path / "py" / "extrinsics.yaml").read_text()
+            == (tmp_path / "cli" / "extrinsics.yaml").read_text())
+    assert r.calibration.source == "filter" and r.summary["streaming"]["frames"] == 93
+    rows = (tmp_path / "py" / "streaming.csv").read_text().splitlines()
+    assert len(rows) == 94 and rows[0].startswith("frame,timestamp_ns,state,phi")
+    assert rows[-1].split(",")[2] == "filter"
+    with pytest.raises(omnivert.InputError, match="streaming gives the filter's estimate"):
+        omnivert.calibrate_dataset(str(demo_run), str(tmp_path / "bad"), streaming=True, refine=True)
+
+
 def test_calibrate_recovers_known_geometry():
     increments, observations, truth = known_run()
     r = omnivert.calibrate(increments, observations, wheel_base=0.4, refine=True)
