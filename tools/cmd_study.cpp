@@ -178,6 +178,7 @@ struct DatasetArgs {
   int stride = 1;
   int max_frames = 0;
   std::uint64_t seed = 1;
+  int threads = 0;
   FeaturePipelineOptions pipeline;
 };
 
@@ -191,6 +192,7 @@ eval::StudySet load_set(const DatasetArgs& a, dataset::Dataset& data) {
   so.max_frames = a.max_frames;
   so.pipeline = a.pipeline;
   so.progress = Progress::enabled();
+  so.threads = a.threads;
   eval::StudySet set = eval::load_study_set(data, so);
   std::printf(
       "%s: %zu frames, %zu lines (%zu associated to ground truth), %zu frame pairs within %.2f m\n",
@@ -331,6 +333,7 @@ void add_dataset_options(CLI::App* cmd, DatasetArgs& a) {
       ->check(kNonNegative)
       ->capture_default_str();
   cmd->add_option("--seed", a.seed, "Seed of the image noise (Fig. 14)")->capture_default_str();
+  add_threads_option(cmd, a.threads);
   add_pipeline_options(cmd, a.pipeline);
   cmd->add_flag("!--linear-intensity",
                 a.pipeline.descriptor.log_intensity,

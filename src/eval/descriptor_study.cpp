@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/line_descriptor.hpp>
 
+#include "core/parallel.hpp"
 #include "core/progress.hpp"
 #include "omnivert/core/error.hpp"
 #include "omnivert/eval/panorama.hpp"
@@ -90,14 +91,34 @@ StudySet load_study_set(const dataset::Dataset& data, const StudyOptions& o) {
     picks.push_back(i);
     if (o.max_frames > 0 && static_cast<int>(picks.size()) >= o.max_frames) break;
   }
-  Progress progress("study: extracting lines", picks.size());
-  FrameFeatures f;
-  for (std::size_t n = 0; n < picks.size(); ++n) {
+  // The images read on the threads; each mirror circle located in order (its search starts
+  // from the previous frame's, Sec. 2 step 1); lines and descriptors on the threads again,
+  // one describer each (pipeline/frame_source.cpp does the same for tracking).
+  const int threads = resolve_threads(o.threads);
+  const std::size_t m = picks.size();
+  std::vector<cv::Mat> images(m), grays(m);
+  std::vector<MirrorCircle> circles(m);
+  std::vector<FrameFeatures> features(m);
+  parallel_for(m, threads, [&](std::size_t n, int) { images[n] = data.image(picks[n]); });
+  Progress progress("study: extracting lines", m);
+  for (std::size_t n = 0; n < m; ++n) {
+    if (!pipe.locate(images[n], grays[n], circles[n], &why))
+      throw InputError(data.images()[picks[n]].path, 0, why);
+    if (o.progress) progress.update(n + 1);
+  }
+  std::vector<FrameDescriber> describers;
+  for (int t = 0; t < threads; ++t) describers.push_back(pipe.make_describer());
+  parallel_for(m, threads, [&](std::size_t n, int worker) {
+    describers[static_cast<std::size_t>(worker)].describe(grays[n], circles[n], features[n]);
+    grays[n].release();
+  });
+  for (std::size_t n = 0; n < m; ++n) {
     const std::size_t i = picks[n];
+    const FrameFeatures& f = features[n];
     StudyFrame fr;
     fr.index = i;
-    fr.image = data.image(i);
-    if (!pipe.process(fr.image, f, &why)) throw InputError(data.images()[i].path, 0, why);
+    fr.image = images[n];
+    images[n].release();
     fr.circle = f.circle;
     if (i >= gt->poses.size())
       throw InputError(gt_dir + "/poses.csv", 0, "fewer poses than images");
@@ -111,7 +132,6 @@ StudySet load_study_set(const dataset::Dataset& data, const StudyOptions& o) {
                           l.r_inner,
                           l.r_outer});
     set.frames.push_back(std::move(fr));
-    if (o.progress) progress.update(n + 1);
   }
   if (o.progress) progress.finish();
   set.neighbours.resize(set.frames.size());

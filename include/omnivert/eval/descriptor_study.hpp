@@ -39,6 +39,9 @@ struct StudyOptions {
   int max_frames = 0;                           // 0: all (after the stride)
   FeaturePipelineOptions pipeline;              // extraction (the descriptor is varied later)
   bool progress = true;
+  // Threads reading images and extracting lines and descriptors (0: every core); the mirror
+  // circle is located frame after frame, so the set is the same, bit for bit, for every count.
+  int threads = 0;
 };
 
 struct StudyLine {
