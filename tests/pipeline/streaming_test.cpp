@@ -117,6 +117,26 @@ TEST_F(Streaming, CalibrateDatasetWritesTheEstimateOfEveryFrame) {
   EXPECT_LE(json["errors_vs_ground_truth"]["filter"]["position_mm"].get<double>(), 3.0);
 }
 
+// A frame whose image cannot be read is skipped with a warning naming the file, and the run
+// goes on (the batch's FrameSource does the same); streaming.csv still has its row.
+TEST_F(Streaming, UnreadableImageIsSkippedWithAWarning) {
+  const fs::path data = scratch("streaming-damaged-data");
+  copy_dataset(paper(), data);
+  const std::string name = image_names(data)[30];
+  write_text(data / "cam0/data" / name, "not an image");
+  pipeline::CalibrateDatasetOptions o = cli_defaults();
+  o.streaming = true;
+  const fs::path out = scratch("streaming-damaged");
+  const auto r = pipeline::calibrate_dataset(data.string(), out.string(), o);
+  EXPECT_EQ(r.frames, 93);
+  EXPECT_EQ(r.frames_skipped, 1);
+  bool named = false;
+  for (const std::string& w : r.warnings) named = named || w.find(name) != std::string::npos;
+  EXPECT_TRUE(named) << "no warning names " << name;
+  EXPECT_EQ(read_lines(out / "streaming.csv").size(), 94u);
+  EXPECT_TRUE(r.calibration.extrinsics.vec().allFinite());
+}
+
 TEST_F(Streaming, RefinementAndEarlierTracksAreRefused) {
   pipeline::CalibrateDatasetOptions o = cli_defaults();
   o.streaming = true;
