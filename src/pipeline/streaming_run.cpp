@@ -15,38 +15,53 @@ namespace omnivert::pipeline::internal {
 
 namespace {
 
-// The value below which a fraction q of `v` lies (nearest rank); 0 for none.
-double quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  const std::size_t k = std::min(
-      v.size() - 1,
-      static_cast<std::size_t>(std::ceil(q * static_cast<double>(v.size()))) - (q > 0.0 ? 1 : 0));
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
-}
-
-// The frame whose filter step solved the start-up window (-1: none).
-std::int64_t window_frame(const std::vector<StreamingEstimate>& e) {
-  for (std::size_t i = 1; i < e.size(); ++i)
-    if (e[i - 1].bootstrapping && !e[i].bootstrapping) return e[i].frame;
-  return -1;
-}
-
-struct Times {
-  std::vector<double> all, front_end, tracker, filter;
+// The median, 95th percentile and largest of a series (nearest rank; 0 for none).
+struct Spread {
+  double median = 0.0, p95 = 0.0, max = 0.0;
 };
 
-// The frames' times, the window's frame left out of the filter's (it is reported alone).
+Spread spread_of(std::vector<double> v) {
+  Spread s;
+  if (v.empty()) return s;
+  std::sort(v.begin(), v.end());
+  const auto at = [&](double q) {
+    const std::size_t k = static_cast<std::size_t>(std::ceil(q * static_cast<double>(v.size())));
+    return v[std::min(v.size(), std::max<std::size_t>(k, 1)) - 1];
+  };
+  s.median = at(0.5), s.p95 = at(0.95), s.max = v.back();
+  return s;
+}
+
+// What the three reports say of a run's times: the frame whose filter step solved the
+// start-up window (-1: none) and its time, and the spread of each stage's time per frame
+// (the window's frame left out of the whole frame's and the filter's: it is reported alone).
+struct Times {
+  std::size_t frames = 0;
+  std::int64_t window = -1;
+  double window_ms = 0.0;
+  Spread all, front_end, tracker, filter;
+};
+
 Times times_of(const std::vector<StreamingEstimate>& e) {
   Times t;
-  const std::int64_t w = window_frame(e);
+  t.frames = e.size();
+  for (std::size_t i = 1; i < e.size() && t.window < 0; ++i)
+    if (e[i - 1].bootstrapping && !e[i].bootstrapping) {
+      t.window = e[i].frame;
+      t.window_ms = e[i].latency_ms();
+    }
+  std::vector<double> all, front_end, tracker, filter;
   for (const StreamingEstimate& s : e) {
-    t.front_end.push_back(s.front_end_ms);
-    t.tracker.push_back(s.tracker_ms);
-    if (s.frame == w) continue;
-    t.all.push_back(s.latency_ms());
-    t.filter.push_back(s.filter_ms);
+    front_end.push_back(s.front_end_ms);
+    tracker.push_back(s.tracker_ms);
+    if (s.frame == t.window) continue;
+    all.push_back(s.latency_ms());
+    filter.push_back(s.filter_ms);
   }
+  t.all = spread_of(std::move(all));
+  t.front_end = spread_of(std::move(front_end));
+  t.tracker = spread_of(std::move(tracker));
+  t.filter = spread_of(std::move(filter));
   return t;
 }
 
@@ -156,42 +171,39 @@ void write_streaming_csv(const std::string& path, const std::vector<StreamingEst
 
 std::string streaming_json(const std::vector<StreamingEstimate>& estimates) {
   const Times t = times_of(estimates);
-  const std::int64_t w = window_frame(estimates);
-  auto stats = [](const std::vector<double>& v) {
-    return nlohmann::json{
-        {"median", quantile(v, 0.5)}, {"p95", quantile(v, 0.95)}, {"max", quantile(v, 1.0)}};
+  auto json = [](const Spread& v) {
+    return nlohmann::json{{"median", v.median}, {"p95", v.p95}, {"max", v.max}};
   };
   nlohmann::json j;
-  j["frames"] = estimates.size();
-  j["window_solved_at_frame"] = w;
-  j["window_ms"] = w >= 0 ? estimates[static_cast<std::size_t>(w)].latency_ms() : 0.0;
-  j["latency_ms"] = stats(t.all);
-  j["front_end_ms"] = stats(t.front_end);
-  j["tracker_ms"] = stats(t.tracker);
-  j["filter_ms"] = stats(t.filter);
+  j["frames"] = t.frames;
+  j["window_solved_at_frame"] = t.window;
+  j["window_ms"] = t.window_ms;
+  j["latency_ms"] = json(t.all);
+  j["front_end_ms"] = json(t.front_end);
+  j["tracker_ms"] = json(t.tracker);
+  j["filter_ms"] = json(t.filter);
   return j.dump();
 }
 
 std::string streaming_line(const std::vector<StreamingEstimate>& estimates) {
   const Times t = times_of(estimates);
-  const std::int64_t w = window_frame(estimates);
   char buf[400];
   std::snprintf(buf,
                 sizeof buf,
                 "streaming: %zu frames, %.2f ms per frame (median; 95%%: %.2f, largest %.2f), of "
                 "which the filter %.2f ms",
-                estimates.size(),
-                quantile(t.all, 0.5),
-                quantile(t.all, 0.95),
-                quantile(t.all, 1.0),
-                quantile(t.filter, 0.5));
+                t.frames,
+                t.all.median,
+                t.all.p95,
+                t.all.max,
+                t.filter.median);
   std::string s = buf;
-  if (w >= 0) {
+  if (t.window >= 0) {
     std::snprintf(buf,
                   sizeof buf,
                   "; start-up window solved at frame %lld in %.1f ms",
-                  static_cast<long long>(w),
-                  estimates[static_cast<std::size_t>(w)].latency_ms());
+                  static_cast<long long>(t.window),
+                  t.window_ms);
     s += buf;
   }
   return s + "; streaming.csv";
@@ -199,18 +211,17 @@ std::string streaming_line(const std::vector<StreamingEstimate>& estimates) {
 
 std::string streaming_html(const std::vector<StreamingEstimate>& estimates) {
   const Times t = times_of(estimates);
-  const std::int64_t w = window_frame(estimates);
   std::ostringstream h;
   char buf[600];
   h << "<h2>Streaming</h2>\n<p>Each frame went through extraction, tracker and filter as it "
        "came, on one thread, nothing looked ahead (streaming.csv has the estimate after every "
        "frame).";
-  if (w >= 0) {
+  if (t.window >= 0) {
     std::snprintf(buf,
                   sizeof buf,
                   " The start-up window was solved at frame %lld (%.1f ms).",
-                  static_cast<long long>(w),
-                  estimates[static_cast<std::size_t>(w)].latency_ms());
+                  static_cast<long long>(t.window),
+                  t.window_ms);
     h << buf;
   }
   std::snprintf(buf,
@@ -218,12 +229,12 @@ std::string streaming_html(const std::vector<StreamingEstimate>& estimates) {
                 "</p>\n<table><tr><th>per frame [ms]</th><th>median</th><th>95%%</th><th>largest"
                 "</th></tr>\n<tr><td>in all</td><td>%.2f</td><td>%.2f</td><td>%.2f</td></tr>\n"
                 "<tr><td>filter</td><td>%.2f</td><td>%.2f</td><td>%.2f</td></tr></table>\n",
-                quantile(t.all, 0.5),
-                quantile(t.all, 0.95),
-                quantile(t.all, 1.0),
-                quantile(t.filter, 0.5),
-                quantile(t.filter, 0.95),
-                quantile(t.filter, 1.0));
+                t.all.median,
+                t.all.p95,
+                t.all.max,
+                t.filter.median,
+                t.filter.p95,
+                t.filter.max);
   h << buf;
   return h.str();
 }
