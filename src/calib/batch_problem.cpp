@@ -126,6 +126,18 @@ Built build(const CalibrationRun& run,
   for (auto& p : b.poses) b.problem->AddParameterBlock(p.data(), 3);
   b.problem->SetParameterBlockConstant(b.poses[0].data());  // gauge: frame 0 is the origin
   b.problem->AddParameterBlock(b.ex.data(), 3);
+  // The time offset's correction, with its prior (RefinementOptions::estimate_time_offset).
+  const bool timed = options.refinement.estimate_time_offset && run.clock &&
+                     run.clock->image_t.size() == run.frames.size() && run.clock->t.size() >= 2 &&
+                     options.robot.wheel_base > 0.0;
+  if (timed) {
+    b.time_offset = {at.time_offset};
+    b.problem->AddResidualBlock(
+        new ceres::AutoDiffCostFunction<TimeOffsetPrior, 1, 1>(
+            new TimeOffsetPrior{1.0 / options.refinement.time_offset_prior_sigma_s}),
+        nullptr,
+        b.time_offset.data());
+  }
 
   const double K = options.robot.odometry_K * options.refinement.odometry_inflation;
   for (std::size_t k = 1; k < run.frames.size(); ++k) {
@@ -146,10 +158,19 @@ Built build(const CalibrationRun& run,
     // W = L^-1 with S = L L^T: W^T W = S^-1.
     const Eigen::LLT<Eigen::Matrix3d> llt(S);
     const Eigen::Matrix3d W = llt.matrixL().solve(Eigen::Matrix3d::Identity());
-    auto* cost = new ceres::AutoDiffCostFunction<OdometryResidual, 3, 3, 3>(
-        new OdometryResidual{f.d_right, f.d_left, f.lateral, options.robot.wheel_base, W});
-    b.odometry_blocks.push_back(
-        b.problem->AddResidualBlock(cost, nullptr, b.poses[k - 1].data(), b.poses[k].data()));
+    const OdometryResidual step{f.d_right, f.d_left, f.lateral, options.robot.wheel_base, W};
+    if (timed) {
+      auto* cost = new ceres::AutoDiffCostFunction<TimedOdometryResidual, 3, 3, 3, 1>(
+          new TimedOdometryResidual{
+              step, run.clock, run.clock->image_t[k - 1], run.clock->image_t[k]});
+      b.odometry_blocks.push_back(b.problem->AddResidualBlock(
+          cost, nullptr, b.poses[k - 1].data(), b.poses[k].data(), b.time_offset.data()));
+    } else {
+      auto* cost =
+          new ceres::AutoDiffCostFunction<OdometryResidual, 3, 3, 3>(new OdometryResidual(step));
+      b.odometry_blocks.push_back(
+          b.problem->AddResidualBlock(cost, nullptr, b.poses[k - 1].data(), b.poses[k].data()));
+    }
   }
   if (options.noise.track_bias_sigma > 0.0)
     for (const auto& [id, f] : b.features) {
@@ -196,6 +217,7 @@ BatchPoint point_of(const Built& b) {
   for (const auto& q : b.poses) p.poses.emplace_back(q[0], q[1], q[2]);
   for (const auto& [id, f] : b.features) p.features[id] = Eigen::Vector2d(f[0], f[1]);
   p.extrinsics = {wrap_angle(b.ex[0]), b.ex[1], wrap_angle(b.ex[2])};
+  if (!b.time_offset.empty()) p.time_offset = b.time_offset[0];
   return p;
 }
 

@@ -27,6 +27,9 @@ struct Built {
   std::map<int, ceres::ResidualBlockId> bias_priors;  // their priors, by track
   // (phi, rho, psi); heap storage: moving a Built keeps the address Ceres holds.
   std::vector<double> ex = std::vector<double>(3, 0.0);
+  // The time offset's correction dS (RefinementOptions::estimate_time_offset): one value when
+  // estimated, else empty; heap storage like ex.
+  std::vector<double> time_offset;
   std::unique_ptr<ceres::Problem> problem;
   int num_bearings = 0;
   std::vector<ceres::ResidualBlockId> bearing_blocks;

@@ -128,12 +128,14 @@ struct OrderedCopy {
   std::vector<double> values;
   std::unique_ptr<ceres::Problem> problem;
   const double* ex = nullptr;
+  const double* time_offset = nullptr;  // when estimated
 };
 
 OrderedCopy ordered_copy(const Built& b) {
   std::vector<double*> order;
   for (const auto& p : b.poses) order.push_back(const_cast<double*>(p.data()));
   order.push_back(const_cast<double*>(b.ex.data()));
+  if (!b.time_offset.empty()) order.push_back(const_cast<double*>(b.time_offset.data()));
   for (const auto& [id, f] : b.features) order.push_back(const_cast<double*>(f.data()));
   for (const auto& [id, v] : b.biases) order.push_back(const_cast<double*>(&v));
   OrderedCopy c;
@@ -160,6 +162,7 @@ OrderedCopy ordered_copy(const Built& b) {
     at += static_cast<std::size_t>(sizes[i]);
   }
   c.ex = moved.at(b.ex.data());
+  if (!b.time_offset.empty()) c.time_offset = moved.at(b.time_offset.data());
   std::vector<ceres::ResidualBlockId> blocks;
   b.problem->GetResidualBlocks(&blocks);
   for (ceres::ResidualBlockId id : blocks) {
@@ -175,10 +178,10 @@ OrderedCopy ordered_copy(const Built& b) {
 }
 
 // Covariance of (phi, rho, psi): the inverse of the Fisher information at the solution (of
-// the problem without robust loss, as it is the Gaussian model's bound), marginal. false
-// when the problem is rank deficient (the caller then falls back on the observability
-// analysis).
-bool extrinsics_covariance(Built* b, Eigen::Matrix3d* covariance) {
+// the problem without robust loss, as it is the Gaussian model's bound), marginal; with the
+// time offset's correction estimated, its variance too. false when the problem is rank
+// deficient (the caller then falls back on the observability analysis).
+bool extrinsics_covariance(Built* b, Eigen::Matrix3d* covariance, double* time_offset_variance) {
   ceres::Covariance::Options co;
   // Sparse QR: fails on a rank-deficient problem. DENSE_SVD gives the same covariance to 13
   // digits but takes 100 times longer on 1440 variables (15 s against 0.15 s).
@@ -188,7 +191,8 @@ bool extrinsics_covariance(Built* b, Eigen::Matrix3d* covariance) {
   co.num_threads = 1;
   ceres::Covariance cov(co);
   const OrderedCopy copy = ordered_copy(*b);
-  const std::vector<std::pair<const double*, const double*>> blocks = {{copy.ex, copy.ex}};
+  std::vector<std::pair<const double*, const double*>> blocks = {{copy.ex, copy.ex}};
+  if (copy.time_offset) blocks.emplace_back(copy.time_offset, copy.time_offset);
   // A rank-deficient problem is an expected outcome here (the caller falls back on the
   // observability analysis). ceres::Covariance has no logging option: its line about the
   // rank deficiency goes to Ceres' log, which the library leaves as the program set it.
@@ -196,6 +200,8 @@ bool extrinsics_covariance(Built* b, Eigen::Matrix3d* covariance) {
   double C[9];
   cov.GetCovarianceBlock(copy.ex, copy.ex, C);
   *covariance = Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(C);
+  if (copy.time_offset)
+    cov.GetCovarianceBlock(copy.time_offset, copy.time_offset, time_offset_variance);
   return true;
 }
 
@@ -244,7 +250,14 @@ RefinementResult refine_batch(const CalibrationRun& run,
   canonical_extrinsics(&b);  // and the covariance below is computed there
   res.solution = point_of(b);
   res.extrinsics = res.solution.extrinsics;
-  if (extrinsics_covariance(&b, &res.covariance)) res.covariance_ok = res.covariance.allFinite();
+  double time_offset_variance = std::numeric_limits<double>::quiet_NaN();
+  if (extrinsics_covariance(&b, &res.covariance, &time_offset_variance))
+    res.covariance_ok = res.covariance.allFinite();
+  if (!b.time_offset.empty()) {
+    res.time_offset_estimated = true;
+    res.time_offset_s = b.time_offset[0];
+    res.time_offset_sigma_s = std::sqrt(time_offset_variance);
+  }
   return res;
 }
 

@@ -98,6 +98,23 @@ void apply_time_offset(dataset::Dataset& data,
                          std::to_string(offset_s * 1e3) + " ms); their bearings are not used");
 }
 
+// The refinement's estimate of the time offset (calib::RefinementOptions::estimate_time_offset)
+// in place of the tracks': the offset applied before tracking plus the refinement's
+// correction, with the refinement's sigma (not determined above options.max_sigma_s).
+void refined_time_offset(const calib::RefinementResult& ref,
+                         const TimeOffsetOptions& options,
+                         CalibrateDatasetResult& r) {
+  if (!ref.time_offset_estimated || !std::isfinite(ref.time_offset_sigma_s)) return;
+  TimeOffsetEstimate& e = r.time_offset;
+  e.refined = true;
+  e.tracks_offset_s = e.offset_s;
+  e.tracks_sigma_s = e.sigma_s;
+  e.offset_s = (r.time_offset_applied ? e.offset_s : 0.0) + ref.time_offset_s;
+  e.sigma_s = ref.time_offset_sigma_s;
+  e.determined = e.sigma_s <= options.max_sigma_s;
+  if (!e.determined) e.why = "the refinement leaves it undetermined";
+}
+
 ReportInputs::TimeOffset time_offset_report(const CalibrateDatasetResult& r) {
   ReportInputs::TimeOffset t;
   const TimeOffsetEstimate& e = r.time_offset;
@@ -108,6 +125,9 @@ ReportInputs::TimeOffset time_offset_report(const CalibrateDatasetResult& r) {
   t.sigma_s = e.sigma_s;
   t.pairs = e.pairs;
   t.residual_scale = e.residual_scale;
+  t.refined = e.refined;
+  t.tracks_offset_s = e.tracks_offset_s;
+  t.tracks_sigma_s = e.tracks_sigma_s;
   t.line = r.time_offset_message;
   return t;
 }
@@ -214,6 +234,28 @@ dataset::Dataset load_checked(const std::string& dataset_dir,
   return data;
 }
 
+// The time offset, estimated from the tracks when not given. Applied, it also changes the
+// wheel travel between frames that the tracker's odometry gate predicts with (Sec. 9.1), so
+// the images are tracked again on the corrected stamps.
+void time_offset_from_tracks(dataset::Dataset& data,
+                             const CalibrateDatasetOptions& o,
+                             const calib::CalibrationOptions& opt,
+                             bool from_images,
+                             TrackDatasetResult& tracked,
+                             CalibrateDatasetResult& r) {
+  if (o.time_offset_s) return;
+  if (o.streaming) {
+    r.time_offset.why = "not estimated when streaming";
+    return;
+  }
+  r.time_offset = estimate_time_offset(
+      data, tracked.rows, opt.robot.odometry_K, opt.noise.bearing_sigma, o.time_offset);
+  if (r.time_offset.significant(o.time_offset)) {
+    apply_time_offset(data, r.time_offset.offset_s, false, r);
+    if (from_images) tracked = tracks_of(data, o, std::nullopt, "track again");
+  }
+}
+
 }  // namespace
 
 CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
@@ -239,18 +281,7 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
   TrackDatasetResult tracked =
       streamed ? std::move(streamed->tracked) : tracks_of(data, o, std::move(given));
 
-  // The time offset, estimated from the tracks when not given. Applied, it also changes the
-  // wheel travel between frames that the tracker's odometry gate predicts with (Sec. 9.1), so
-  // the images are tracked again on the corrected stamps.
-  if (o.streaming && !o.time_offset_s) r.time_offset.why = "not estimated when streaming";
-  if (!o.time_offset_s && !o.streaming) {
-    r.time_offset = estimate_time_offset(
-        data, tracked.rows, opt.robot.odometry_K, opt.noise.bearing_sigma, o.time_offset);
-    if (r.time_offset.significant(o.time_offset)) {
-      apply_time_offset(data, r.time_offset.offset_s, false, r);
-      if (from_images) tracked = tracks_of(data, o, std::nullopt, "track again");
-    }
-  }
+  time_offset_from_tracks(data, o, opt, from_images, tracked, r);
   r.warnings.insert(r.warnings.begin(), tracked.warnings.begin(), tracked.warnings.end());
   r.tilt = tracked.tilt;
   r.tilt_corrected = tracked.tilt_corrected;
@@ -270,11 +301,21 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
         few_tracks_warning(r.input.tracks, o.features, r.input.min_annulus_fraction));
   r.warnings.insert(r.warnings.end(), o.notes.begin(), o.notes.end());
   for (const auto& w : r.warnings) spdlog::warn("{}", w);
+  // The time offset's correction estimated with the extrinsics by the refinement, from the
+  // offset applied (or none): the tracks' estimate is the first order of a model whose
+  // coefficients change where the motion changes; the refinement's is the whole model's.
+  const bool refine_offset =
+      !o.time_offset_s && !streamed && opt.refinement.enabled && r.time_offset.determined;
+  if (refine_offset) {
+    r.input.run.clock = wheel_clock(data);
+    opt.refinement.estimate_time_offset = true;
+  }
   if (o.progress) o.progress("calibrate", 0, 0);
   r.calibration = streamed ? calib::result_of_filter(r.input.run, opt, std::move(streamed->filter))
                            : calib::calibrate(r.input.run, opt);
   const auto t2 = Clock::now();
   const calib::CalibrationResult& result = r.calibration;
+  if (refine_offset) refined_time_offset(result.refinement, o.time_offset, r);
   if (!result.extrinsics.vec().allFinite() || !result.covariance.allFinite())
     throw std::runtime_error(
         "the calibration diverged (non-finite estimate); nothing written but tracks.csv. Check "

@@ -64,6 +64,21 @@ std::vector<Eigen::Vector2d> wheel_travel_between_images(const dataset::Dataset&
   return steps;
 }
 
+std::shared_ptr<const calib::WheelClock> wheel_clock(const dataset::Dataset& data) {
+  auto c = std::make_shared<calib::WheelClock>();
+  const auto& wheel = data.wheel();
+  if (wheel.empty()) return c;
+  const std::int64_t t0 = wheel.front().timestamp_ns;
+  for (const auto& w : wheel) {
+    c->t.push_back(static_cast<double>(w.timestamp_ns - t0) * 1e-9);
+    c->left.push_back(w.travel.left);
+    c->right.push_back(w.travel.right);
+  }
+  for (std::size_t i = 0; i < data.images().size(); ++i)
+    c->image_t.push_back(static_cast<double>(data.odometry_time(i) - t0) * 1e-9);
+  return c;
+}
+
 namespace {
 
 // Wheel travel per frame (eq. 14-15's inputs), and the heading for the motion summary.

@@ -386,6 +386,9 @@ std::string summary_json(const calib::CalibrationResult& r, const ReportInputs& 
                         {"applied", t.applied},
                         {"pairs", t.pairs},
                         {"residual_scale", num(t.residual_scale)},
+                        {"refined", t.refined},
+                        {"from_tracks_s", t.refined ? num(t.tracks_offset_s) : json(nullptr)},
+                        {"from_tracks_sigma_s", t.refined ? num(t.tracks_sigma_s) : json(nullptr)},
                         {"message", t.line}};
   }
   if (!in.reprojection_json.empty()) j["reprojection"] = json::parse(in.reprojection_json);

@@ -280,6 +280,21 @@ std::string time_offset_line(const TimeOffsetEstimate& e,
   if (given) {
     std::snprintf(
         buf, sizeof buf, "time offset: image stamps late by %.1f ms (given)", e.offset_s * 1e3);
+  } else if (e.refined) {
+    const std::string before = applied ? "applied before tracking"
+                                       : "not applied before tracking (applied above " +
+                                             fmt_g(o.significance) + " sigma and " +
+                                             fmt_g(o.min_applied_s * 1e3) + " ms)";
+    std::snprintf(buf,
+                  sizeof buf,
+                  "time offset: image stamps late by %.1f +- %.1f ms (refined with the "
+                  "extrinsics; from the tracks %.1f +- %.1f ms over %d image pairs, %s)",
+                  e.offset_s * 1e3,
+                  e.sigma_s * 1e3,
+                  e.tracks_offset_s * 1e3,
+                  e.tracks_sigma_s * 1e3,
+                  e.pairs,
+                  before.c_str());
   } else if (!e.determined) {
     std::snprintf(buf, sizeof buf, "time offset: not determined (%s); none applied", e.why.c_str());
   } else {

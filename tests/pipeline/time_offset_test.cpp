@@ -192,6 +192,11 @@ TEST(TimeOffset, TheLineSaysWhatWasDone) {
   EXPECT_EQ(time_offset_line(e, false, false),
             "time offset: image stamps late by 15.6 +- 0.8 ms (from 92 image pairs); not applied "
             "(applied above 3 sigma and 20 ms)");
+  e.refined = true, e.tracks_offset_s = 0.0156, e.tracks_sigma_s = 0.0008;
+  e.offset_s = 0.0419, e.sigma_s = 0.0021;
+  EXPECT_EQ(time_offset_line(e, false, true),
+            "time offset: image stamps late by 41.9 +- 2.1 ms (refined with the extrinsics; from "
+            "the tracks 15.6 +- 0.8 ms over 92 image pairs, applied before tracking)");
 }
 
 }  // namespace

@@ -164,6 +164,12 @@ struct RefinementOptions {
   bool robust = false;        // Huber loss on bearings
   double huber_sigmas = 3.0;  // Huber threshold in bearing sigmas
   int max_iterations = 100;
+  // With the run's CalibrationRun::clock: a correction dS of the camera-odometry time offset
+  // estimated with the extrinsics (the image stamps late by a further dS; docs/calibration.md
+  // #time-offset), with the prior dS ~ N(0, time_offset_prior_sigma_s^2) that keeps a run
+  // without a change of motion (where dS moves nothing) well posed.
+  bool estimate_time_offset = false;
+  double time_offset_prior_sigma_s = 0.1;
 };
 
 // The data's check of the bearing noise (BatchNoiseCheck, at a batch solution).

@@ -50,7 +50,13 @@ struct RefinementResult {
   // has (infinity without redundancy).
   double bearing_residual_sigma = std::numeric_limits<double>::infinity();
   BatchNoiseCheck noise;  // at the solution (outliers removed, splits made)
-  std::string report;     // Ceres' brief report
+  // The time offset's correction dS [s] and its sigma, estimated with the extrinsics
+  // (RefinementOptions::estimate_time_offset and the run's clock); the sigma is the marginal
+  // of the same covariance as the extrinsics' (NaN when that failed).
+  bool time_offset_estimated = false;
+  double time_offset_s = 0.0;
+  double time_offset_sigma_s = std::numeric_limits<double>::quiet_NaN();
+  std::string report;  // Ceres' brief report
 };
 
 // Batch maximum-likelihood refinement over the whole run (Ceres, Levenberg-Marquardt),

@@ -9,6 +9,7 @@
 
 #include <compare>
 #include <map>
+#include <memory>
 #include <vector>
 
 #include <Eigen/Core>
@@ -59,9 +60,23 @@ struct FrameInput {
   std::vector<BearingObservation> observations;
 };
 
+// The wheels' cumulative travel on the odometry clock and each frame's stamp on it: what the
+// refinement needs to estimate a correction of the camera-odometry time offset with the
+// extrinsics (RefinementOptions::estimate_time_offset). With the image stamps late by a
+// further dS, frame k was taken at odometry time image_t[k] - dS, and the wheel travel
+// between two frames is read there (piecewise linear between samples, held beyond the ends).
+struct WheelClock {
+  std::vector<double> t;            // sample times [s], increasing
+  std::vector<double> left, right;  // cumulative travel at t [m]
+  std::vector<double> image_t;      // each frame's stamp on the odometry clock [s]
+};
+
 // A whole recorded run (what the batch refinement and the observability analysis need).
 struct CalibrationRun {
   std::vector<FrameInput> frames;
+  // Optional: with RefinementOptions::estimate_time_offset, the refinement estimates the time
+  // offset's correction from it (shared: runs are copied as tracks are split and joined).
+  std::shared_ptr<const WheelClock> clock;
 };
 
 // A point of the batch (whole-run) problem of the refinement and the observability analysis
@@ -71,6 +86,8 @@ struct BatchPoint {
   std::vector<Eigen::Vector3d> poses;
   std::map<int, Eigen::Vector2d> features;
   Extrinsics extrinsics;
+  // The time offset's correction dS [s] (CalibrationRun::clock), 0 when not estimated.
+  double time_offset = 0.0;
 };
 
 // One bearing of a run: its track id and its frame (index into CalibrationRun::frames).

@@ -16,6 +16,7 @@
 // A run in which no frame has `min_lines` lines is an InputError.
 
 #include <cstddef>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -87,6 +88,11 @@ DatasetRun calibration_run_from_tracks(const dataset::Dataset& data,
 // input of calib::compose_wheel_steps). 1 <= i < data.size(); the dataset has wheel data.
 std::vector<Eigen::Vector2d> wheel_travel_between_images(const dataset::Dataset& data,
                                                          std::size_t i);
+
+// The wheels' cumulative travel and the image stamps on the odometry clock (with the dataset's
+// time offset applied), in seconds from the first wheel sample: what the refinement estimates
+// a correction of the time offset from (calib::RefinementOptions::estimate_time_offset).
+std::shared_ptr<const calib::WheelClock> wheel_clock(const dataset::Dataset& data);
 
 // CalibrationOptions filled from the dataset: wheel base from wheel0/sensor.yaml, Chong-Kleeman K
 // from its odometry_k when given (else the default of CalibrationOptions), the rest from `base`.

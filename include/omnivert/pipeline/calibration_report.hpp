@@ -56,6 +56,8 @@ struct ReportInputs {
     double offset_s = 0, sigma_s = 0;
     int pairs = 0;
     double residual_scale = 0;
+    bool refined = false;  // refined with the extrinsics (TimeOffsetEstimate::refined)
+    double tracks_offset_s = 0, tracks_sigma_s = 0;
     std::string line;  // time_offset_line(): the terminal's and the report's words
   } time_offset;
   // The check by eye (pipeline/reprojection.hpp), when made: summary.json's "reprojection"

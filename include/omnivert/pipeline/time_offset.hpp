@@ -67,6 +67,11 @@ struct TimeOffsetEstimate {
   int pairs = 0;                // triples of image pairs used
   double residual_scale = 0.0;  // s: the residuals' RMS in units of their modelled sigma
   std::string why;              // why not determined
+  // Refined with the extrinsics (calib::RefinementOptions::estimate_time_offset): offset_s and
+  // sigma_s are then the refinement's (the offset applied before tracking plus its
+  // correction), and the estimate from the tracks alone is kept here.
+  bool refined = false;
+  double tracks_offset_s = 0.0, tracks_sigma_s = 0.0;
   // Whether the estimate is significant (TimeOffsetOptions::significance, min_applied_s).
   bool significant(const TimeOffsetOptions& o) const;
 };
@@ -96,7 +101,9 @@ TimeOffsetEstimate estimate_time_offset(const dataset::Dataset& data,
                                         const TimeOffsetOptions& options = {});
 
 // One line for the terminal and the report, e.g. "time offset: image stamps late by 41.2 +-
-// 0.8 ms (from 92 image pairs); applied" (or "not applied (applied above 3 sigma and 20 ms)").
+// 0.8 ms (from 92 image pairs); applied" (or "not applied (applied above 3 sigma and 20 ms)");
+// refined: "... late by 41.9 +- 2.1 ms (refined with the extrinsics; from the tracks 41.2 +-
+// 0.8 ms over 92 image pairs, applied before tracking)".
 std::string time_offset_line(const TimeOffsetEstimate& e,
                              bool given,
                              bool applied,
