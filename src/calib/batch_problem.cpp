@@ -4,6 +4,7 @@
 #include <string>
 
 #include <Eigen/Cholesky>
+#include <Eigen/SparseCholesky>
 
 #include "calib/batch_factors.hpp"
 #include "omnivert/calib/model.hpp"
@@ -210,6 +211,46 @@ Built build(const CalibrationRun& run,
     }
   }
   return b;
+}
+
+// The marginal covariance of (phi, rho, psi) and the variance of the time offset's correction
+// from the Fisher information J^T J at the solution (without robust loss), by one sparse LDLT
+// factorisation and four solves: where ceres::Covariance gives up on a badly scaled problem, the
+// observability analysis's fallback holds the offset fixed, and would leave its share out of the
+// extrinsics'.
+bool marginal_with_time_offset(Built* b,
+                               Eigen::Matrix3d* covariance,
+                               double* time_offset_variance) {
+  ceres::Problem::EvaluateOptions eo;
+  eo.parameter_blocks = variable_blocks(*b);
+  eo.parameter_blocks.push_back(b->time_offset.data());
+  eo.apply_loss_function = false;
+  ceres::CRSMatrix crs;
+  if (!b->problem->Evaluate(eo, nullptr, nullptr, nullptr, &crs) || crs.num_cols < 4) return false;
+  // No ridge (information_with_ridge's 1e-10 of the diagonal moved the extrinsics' covariance
+  // by 4e-5 of itself: the pose chain is that badly conditioned); a variable without any
+  // residual gets a unit diagonal. Scaled to a unit diagonal, F_s = D^-1/2 F D^-1/2, for the
+  // factorisation.
+  const Eigen::SparseMatrix<double> J = sparse_jacobian(crs);
+  Eigen::SparseMatrix<double> F = J.transpose() * J;
+  for (int i = 0; i < F.rows(); ++i)
+    if (!(F.coeff(i, i) > 0.0)) F.coeffRef(i, i) = 1.0;
+  const Eigen::VectorXd d = F.diagonal().cwiseSqrt().cwiseInverse();
+  F = d.asDiagonal() * F * d.asDiagonal();
+  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(F);
+  if (ldlt.info() != Eigen::Success) return false;
+  const int n = crs.num_cols;  // the extrinsics, then the correction: the last four columns
+  Eigen::Matrix4d C;
+  for (int k = 0; k < 4; ++k) {
+    Eigen::VectorXd e = Eigen::VectorXd::Zero(n);
+    e(n - 4 + k) = 1.0;
+    C.col(k) = ldlt.solve(e).tail<4>();
+  }
+  C = d.tail<4>().asDiagonal() * C * d.tail<4>().asDiagonal();
+  if (!C.allFinite() || !(C.diagonal().array() > 0.0).all()) return false;
+  *covariance = 0.5 * (C.topLeftCorner<3, 3>() + C.topLeftCorner<3, 3>().transpose());
+  *time_offset_variance = C(3, 3);
+  return true;
 }
 
 BatchPoint point_of(const Built& b) {

@@ -128,4 +128,10 @@ Built build(const CalibrationRun& run,
 // The problem's current values, angles wrapped.
 BatchPoint point_of(const Built& b);
 
+// With the time offset's correction estimated (Built::time_offset): the marginal covariance
+// of (phi, rho, psi) and the correction's variance from the Fisher information J^T J at the
+// current values (no robust loss), by one sparse LDLT factorisation.
+// false when the factorisation fails or a variance is not positive.
+bool marginal_with_time_offset(Built* b, Eigen::Matrix3d* covariance, double* time_offset_variance);
+
 }  // namespace omnivert::calib::internal

@@ -88,6 +88,7 @@ void refine_and_analyse(const CalibrationRun& run,
   if (options.refinement.enabled) {
     r->refinement = refine_batch(run, options, at);
     r->refined = true;
+    r->covariance_from_information = r->refinement.covariance_from_information;
     at = r->refinement.solution;
     // The same problem (split where the refinement split the tracks), without the guarded
     // bearings and those the refinement rejected as outliers: the bound is that of the

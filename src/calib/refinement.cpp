@@ -253,6 +253,11 @@ RefinementResult refine_batch(const CalibrationRun& run,
   double time_offset_variance = std::numeric_limits<double>::quiet_NaN();
   if (extrinsics_covariance(&b, &res.covariance, &time_offset_variance))
     res.covariance_ok = res.covariance.allFinite();
+  if (!res.covariance_ok && !b.time_offset.empty() &&
+      marginal_with_time_offset(&b, &res.covariance, &time_offset_variance)) {
+    res.covariance_ok = true;
+    res.covariance_from_information = true;
+  }
   if (!b.time_offset.empty()) {
     res.time_offset_estimated = true;
     res.time_offset_s = b.time_offset[0];

@@ -4,6 +4,7 @@
 // its derivative in the shift the numerical one; on runs of the paper's shape (a straight, a
 // turn in place, a straight) whose image stamps are late by S, the shift is recovered within
 // its sigma, and over Monte-Carlo runs the sigma is the spread of the errors.
+#include <ceres/ceres.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,6 +15,7 @@
 #include <Eigen/Core>
 
 #include "calib/batch_factors.hpp"
+#include "calib/batch_problem.hpp"
 #include "omnivert/calib/model.hpp"
 #include "omnivert/calib/refinement.hpp"
 #include "omnivert/core/angles.hpp"
@@ -107,7 +109,8 @@ TimedRun make_run(double late, std::uint32_t seed) {
     }
     for (int j = 0; j < 12; ++j)
       f.observations.push_back(
-          {j, bearing_from_geometry(out.truth.poses.back(), lines[j], kTruth) + kSigma * unit(rng)});
+          {j,
+           bearing_from_geometry(out.truth.poses.back(), lines[j], kTruth) + kSigma * unit(rng)});
     out.run.frames.push_back(std::move(f));
   }
   // Frame 0 is the gauge: the poses relative to it.
@@ -117,7 +120,8 @@ TimedRun make_run(double late, std::uint32_t seed) {
     const Eigen::Vector2d d = q - p0.head<2>();
     return Eigen::Vector2d(c * d(0) + s * d(1), -s * d(0) + c * d(1));
   };
-  for (Eigen::Vector3d& p : out.truth.poses) p = {to0(p.head<2>())(0), to0(p.head<2>())(1), p(2) - p0(2)};
+  for (Eigen::Vector3d& p : out.truth.poses)
+    p = {to0(p.head<2>())(0), to0(p.head<2>())(1), p(2) - p0(2)};
   for (auto& [id, f] : out.truth.features) f = to0(f);
   out.run.clock = clock;
   return out;
@@ -183,6 +187,31 @@ TEST(TimeOffsetRefinement, TheSigmaIsTheSpreadOfTheErrors) {
   }
   EXPECT_GT(sum / n, 0.45);
   EXPECT_LT(sum / n, 1.8);
+}
+
+TEST(TimeOffsetRefinement, TheSparseMarginalEqualsCeresCovariance) {
+  // The fallback where ceres::Covariance gives up (marginal_with_time_offset) against
+  // ceres::Covariance (dense SVD: the plain reference) on the same problem, at the solution.
+  const TimedRun r = make_run(0.04, 3);
+  const RefinementResult res = refine_batch(r.run, options(), r.truth);
+  ASSERT_FALSE(res.renamed());
+  internal::Built b = internal::build(r.run, options(), res.solution, false);
+  Eigen::Matrix3d C;
+  double v = 0;
+  ASSERT_TRUE(internal::marginal_with_time_offset(&b, &C, &v));
+  ceres::Covariance::Options co;
+  co.algorithm_type = ceres::DENSE_SVD;
+  ceres::Covariance cov(co);
+  const double* ex = b.ex.data();
+  const double* dS = b.time_offset.data();
+  ASSERT_TRUE(cov.Compute({{ex, ex}, {dS, dS}}, b.problem.get()));
+  double ref[9], ref_v = 0;
+  cov.GetCovarianceBlock(ex, ex, ref);
+  cov.GetCovarianceBlock(dS, dS, &ref_v);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      EXPECT_NEAR(C(i, j), ref[3 * i + j], 1e-6 * std::sqrt(C(i, i) * C(j, j)));
+  EXPECT_NEAR(v, ref_v, 1e-6 * ref_v);
 }
 
 TEST(TimeOffsetRefinement, WithoutTheOptionNothingIsEstimated) {

@@ -21,6 +21,9 @@ struct RefinementResult {
   Extrinsics extrinsics;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Constant(std::numeric_limits<double>::quiet_NaN());
   bool covariance_ok = false;  // false when the problem is rank deficient (not observable)
+  // The covariance is the marginal of the Fisher information at the solution, computed here
+  // because ceres::Covariance gave up (with the time offset estimated; see refine_batch).
+  bool covariance_from_information = false;
   double initial_cost = 0.0;
   double final_cost = 0.0;
   int iterations = 0;
