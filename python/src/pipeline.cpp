@@ -206,8 +206,15 @@ void bind_pipeline(py::module_& m) {
       .def_property_readonly("time_offset",
                              [](const DatasetCalibration& r) {
                                py::dict d;
+                               const auto& t = r.job.time_offset;
                                d["given"] = r.job.time_offset_given;
                                d["applied"] = r.job.time_offset_applied;
+                               d["determined"] = t.determined;
+                               d["refined"] = t.refined;
+                               d["offset_s"] = t.determined ? py::cast(t.offset_s) : py::none();
+                               d["sigma_s"] = t.determined && !r.job.time_offset_given
+                                                  ? py::cast(t.sigma_s)
+                                                  : py::none();
                                d["message"] = r.job.time_offset_message;
                                return d;
                              })

@@ -48,6 +48,9 @@ def test_calibrate_dataset_same_as_cli(demo_run, tmp_path):
             s.pop(key)
         s.get("inputs", {}).pop("seconds", None)
     assert r.summary == cli_summary
+    t = r.time_offset
+    assert (t["offset_s"], t["sigma_s"]) == (r.summary["time_offset_s"], r.summary["time_offset_sigma_s"])
+    assert t["refined"] == r.summary["time_offset"]["refined"] and t["message"] == r.summary["time_offset"]["message"]
     assert calls[-1] == ("calibrate", 0, 0) and ("track", 93, 93) in calls
     assert r.observable and r.calibration.source == "refinement"
     assert r.covariance.shape == (3, 3)
