@@ -1,12 +1,16 @@
 // omnivert simulate: renders a catadioptric dataset with ground truth (docs/simulator.md).
 
+#include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "commands.hpp"
 #include "core/progress.hpp"
+#include "omnivert/core/angles.hpp"
+#include "omnivert/core/error.hpp"
 #include "omnivert/sim/simulator.hpp"
 
 namespace omnivert::cli {
@@ -25,12 +29,16 @@ struct SimulateArgs {
   std::vector<double> reflection;
   std::vector<double> reflection_radii;
   std::vector<double> laser_pose;
+  double light_azimuth_deg = 0.0;
 };
 
 // World, trajectory, output and frames.
 void add_run_options(CLI::App* cmd, SimulateArgs& a) {
   sim::SimConfig& c = a.cfg;
-  cmd->add_option("--world", a.world, "World: corridor, office, hall, or a YAML file")
+  cmd->add_option("--world",
+                  a.world,
+                  "World: corridor, office, hall, random (drawn from --seed), random:SEED, or a "
+                  "YAML file")
       ->capture_default_str();
   cmd->add_option(
          "--trajectory", a.trajectory, "Trajectory: paper, zigzag, straight, tour, or a YAML file")
@@ -124,6 +132,29 @@ void add_image_sensor_options(CLI::App* cmd, SimulateArgs& a) {
   cmd->add_option("--blur", c.image.blur_sigma, "Gaussian blur sigma [px]")
       ->capture_default_str()
       ->check(kNonNegative);
+  cmd->add_option(
+         "--exposure-time",
+         c.image.exposure_time,
+         "Motion blur: each image averaged over the robot's motion during this exposure [s]")
+      ->capture_default_str()
+      ->check(kNonNegative);
+  cmd->add_option("--jpeg-quality",
+                  c.image.jpeg_quality,
+                  "Write the images as JPEG at this quality (1-100); 0: PNG, lossless")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 100));
+  cmd->add_option("--vignetting", c.image.vignetting, "The lens's gain lost at the rim (0..1)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 0.99));
+  cmd->add_option("--light-gradient",
+                  c.image.light_gradient,
+                  "Light across the room: gain 1 + G cos(azimuth - light azimuth); 1/3 is a "
+                  "factor of 2")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 0.99));
+  cmd->add_option(
+         "--light-azimuth", a.light_azimuth_deg, "World direction of the brightest light [deg]")
+      ->capture_default_str();
 }
 
 // Struts, the robot's reflection and the ground-truth mask (docs/simulator.md).
@@ -203,6 +234,28 @@ void add_laser_options(CLI::App* cmd, SimulateArgs& a) {
       ->group(g);
 }
 
+// The world by name or file; `random` (the run's seed) or `random:SEED`: a room drawn around
+// the trajectory's path (sim::random_world).
+sim::World load_world_for(const std::string& name,
+                          const sim::Trajectory& trajectory,
+                          std::uint64_t run_seed) {
+  if (name != "random" && name.rfind("random:", 0) != 0) return sim::load_world(name);
+  std::uint64_t seed = run_seed;
+  if (name.size() > 7) {
+    const std::string n = name.substr(7);
+    char* end = nullptr;
+    seed = std::strtoull(n.c_str(), &end, 10);
+    if (n.empty() || *end != '\0' || n[0] == '-')
+      throw InputError("--world " + name + ": the seed after 'random:' must be a whole number");
+  }
+  const std::vector<sim::MotionPiece> motion = trajectory.pieces(sim::Pose2::Zero());
+  std::vector<Eigen::Vector2d> path;
+  const double end = sim::duration(motion);
+  for (double t = 0.0; t <= end + 0.05; t += 0.05)
+    path.push_back(sim::pose_at(motion, t).head<2>());
+  return sim::random_world(seed, path);
+}
+
 void run_simulate(SimulateArgs& a) {
   sim::SimConfig& cfg = a.cfg;
   cfg.wheel.ticks = a.wheel_unit == "ticks";
@@ -227,8 +280,9 @@ void run_simulate(SimulateArgs& a) {
     cfg.laser.y = a.laser_pose[1];
     cfg.laser.yaw = a.laser_pose[2];
   }
-  const sim::World world = sim::load_world(a.world);
+  cfg.image.light_azimuth = deg2rad(a.light_azimuth_deg);
   const sim::Trajectory trajectory = sim::load_trajectory(a.trajectory);
+  const sim::World world = load_world_for(a.world, trajectory, cfg.seed);
   std::unique_ptr<Progress> progress;
   const sim::SimSummary s =
       sim::simulate(world, trajectory, a.cfg, a.out, a.force, [&progress](int done, int total) {

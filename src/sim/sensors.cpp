@@ -1,5 +1,6 @@
 #include "omnivert/sim/sensors.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <opencv2/imgproc.hpp>
@@ -56,6 +57,39 @@ std::int64_t to_ticks(double meters, double ticks_per_meter, int counter_bits) {
     if (t < 0) t += mod;
   }
   return t;
+}
+
+std::string ImageSensor::validate() const {
+  if (!(exposure_time >= 0.0) || !std::isfinite(exposure_time))
+    return "the exposure time must be >= 0 [s]";
+  if (exposure_samples < 1 || exposure_samples > 64) return "exposure_samples must be in 1..64";
+  if (jpeg_quality < 0 || jpeg_quality > 100) return "the JPEG quality must be in 0..100 (0: PNG)";
+  if (!(vignetting >= 0.0 && vignetting < 1.0)) return "vignetting must be in [0, 1)";
+  if (!(light_gradient >= 0.0 && light_gradient < 1.0)) return "light_gradient must be in [0, 1)";
+  if (!std::isfinite(light_azimuth)) return "light_azimuth must be finite";
+  return {};
+}
+
+void apply_lighting(cv::Mat1f& image,
+                    const ImageSensor& s,
+                    double cx,
+                    double cy,
+                    double r_max,
+                    int bearing_sign,
+                    double camera_yaw) {
+  if (s.vignetting == 0.0 && s.light_gradient == 0.0) return;
+  for (int v = 0; v < image.rows; ++v) {
+    float* row = image[v];
+    for (int u = 0; u < image.cols; ++u) {
+      const double dx = u - cx, dy = v - cy;
+      double gain = 1.0 - s.vignetting * (dx * dx + dy * dy) / (r_max * r_max);
+      if (s.light_gradient != 0.0) {
+        const double bearing = bearing_sign * std::atan2(dy, dx);  // a = bearing_sign * beta
+        gain *= 1.0 + s.light_gradient * std::cos(camera_yaw + bearing - s.light_azimuth);
+      }
+      row[u] = static_cast<float>(row[u] * std::max(gain, 0.0));
+    }
+  }
 }
 
 void apply_image_sensor(const cv::Mat1f& clean,

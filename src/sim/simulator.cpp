@@ -235,6 +235,12 @@ void write_simulation_settings(const fs::path& path,
   y += "gain_flicker: " + fmt("%.9g", s.gain_flicker) + "\n";
   y += "exposure: " + fmt("%.9g", s.exposure) + "\n";
   y += "blur_sigma: " + fmt("%.9g", s.blur_sigma) + "\n";
+  y += "exposure_time: " + fmt("%.9g", s.exposure_time) + "\n";
+  y += "exposure_samples: " + std::to_string(s.exposure_samples) + "\n";
+  y += "jpeg_quality: " + std::to_string(s.jpeg_quality) + "\n";
+  y += "vignetting: " + fmt("%.9g", s.vignetting) + "\n";
+  y += "light_gradient: " + fmt("%.9g", s.light_gradient) + "\n";
+  y += "light_azimuth: " + fmt("%.9g", s.light_azimuth) + "\n";
   y += "min_line_px: " + fmt("%.9g", cfg.min_line_px) + "\n";
   const RobotOverlay& o = cfg.overlay;
   if (!o.strut_angles_deg.empty()) {
@@ -269,7 +275,33 @@ void write_simulation_settings(const fs::path& path,
   write_text(path, y);
 }
 
-// The frames: cam0/data/*.png and cam0/data.csv, with ground_truth/poses.csv and lines.csv.
+// The noise-free image of the frame at time t: one render, or with a motion blur
+// (ImageSensor::exposure_time) the mean of exposure_samples renders spread evenly over the
+// exposure, each at the robot's pose of its instant.
+void render_exposure(const Renderer& renderer,
+                     const std::vector<MotionPiece>& motion,
+                     double t,
+                     const SimConfig& cfg,
+                     cv::Mat1f& out) {
+  const ImageSensor& s = cfg.image;
+  if (!(s.exposure_time > 0.0) || s.exposure_samples <= 1) {
+    renderer.render(camera_pose(pose_at(motion, t), cfg.extrinsics, cfg.camera_height), out);
+    return;
+  }
+  cv::Mat1f one;
+  for (int i = 0; i < s.exposure_samples; ++i) {
+    const double ti = t + s.exposure_time * ((i + 0.5) / s.exposure_samples - 0.5);
+    renderer.render(camera_pose(pose_at(motion, ti), cfg.extrinsics, cfg.camera_height), one);
+    if (i == 0)
+      out = one.clone();
+    else
+      out += one;
+  }
+  out /= static_cast<float>(s.exposure_samples);
+}
+
+// The frames: cam0/data/*.png (or .jpg) and cam0/data.csv, with ground_truth/poses.csv and
+// lines.csv.
 void write_frames(const fs::path& dir,
                   Renderer& renderer,
                   const std::vector<MotionPiece>& motion,
@@ -303,11 +335,21 @@ void write_frames(const fs::path& dir,
     summary.distance += (robot.head<2>() - prev.head<2>()).norm();
     prev = robot;
     const CameraPose cam = camera_pose(robot, cfg.extrinsics, cfg.camera_height);
-    renderer.render(cam, clean);
+    render_exposure(renderer, motion, t, cfg, clean);
+    apply_lighting(clean,
+                   cfg.image,
+                   cfg.camera.cx,
+                   cfg.camera.cy,
+                   cfg.camera.r_max,
+                   cfg.camera.bearing_sign,
+                   cam.yaw);
     if (overlay) paint_overlay(picture, clean);
     apply_image_sensor(clean, cfg.image, image_rng, img);
-    const std::string name = std::to_string(ts) + ".png";
-    if (!cv::imwrite((dir / "cam0" / "data" / name).string(), img, png_params)) {
+    const bool jpeg = cfg.image.jpeg_quality > 0;
+    const std::string name = std::to_string(ts) + (jpeg ? ".jpg" : ".png");
+    const std::vector<int> jpeg_params = {cv::IMWRITE_JPEG_QUALITY, cfg.image.jpeg_quality};
+    if (!cv::imwrite(
+            (dir / "cam0" / "data" / name).string(), img, jpeg ? jpeg_params : png_params)) {
       throw InputError((dir / "cam0" / "data" / name).string(),
                        0,
                        "cannot write (disk full, or a folder that is not writable?)");
@@ -425,6 +467,8 @@ SimSummary simulate(const World& world,
   }
   if (!(cfg.frame_rate > 0) || !(cfg.wheel.rate_hz > 0)) throw InputError("rates must be positive");
   if (std::string why; !cfg.overlay.IsValid(&why)) throw InputError("overlay: " + why);
+  if (const std::string p = cfg.image.validate(); !p.empty())
+    throw InputError("image sensor: " + p);
   if (cfg.laser.enabled) {
     if (const std::string p = cfg.laser.validate(); !p.empty()) throw InputError("laser: " + p);
   }

@@ -285,7 +285,124 @@ World make_hall() {
   return world;
 }
 
+double world_top(const World& w) { return w.height - 0.1; }
+
+// A wall from a to b in pieces of 1.5-5 m, each its own paint, texture (coarse to fine) and
+// features: doors, windows, posters, paint strips, lattices of identical slats.
+void random_walls(PresetBuilder& b, const Eigen::Vector2d& a, const Eigen::Vector2d& e) {
+  const double len = (e - a).norm();
+  const Eigen::Vector2d dir = (e - a) / len;
+  for (double s = 0.0; s < len - 1e-9;) {
+    const double piece = std::min(len - s, b.uniform(1.5, 5.0));
+    Wall w = b.wall(a + s * dir, a + (s + piece) * dir, b.uniform(90, 215), b.uniform(1.0, 14.0));
+    w.texture_scale = b.uniform(0.005, 0.1);  // fine to coarse
+    for (double t = b.uniform(0.2, 0.8); t < piece - 0.6;) {
+      switch (b.pick(7)) {
+        case 0:
+          if (t + 1.1 > piece) {
+            t = piece;
+            break;
+          }
+          b.door(w, t, b.uniform(0.7, 1.0));
+          t += 1.1 + b.uniform(0.3, 1.2);
+          break;
+        case 1: {
+          const double width = b.uniform(0.3, std::min(1.2, piece - t)), z0 = b.uniform(0.6, 1.4);
+          b.poster(w, t, width, z0, z0 + b.uniform(0.3, 1.0));
+          t += width + b.uniform(0.3, 1.0);
+          break;
+        }
+        case 2: {
+          Strip st;
+          st.s0 = t;
+          st.s1 = std::min(piece, t + b.uniform(0.1, 0.8));
+          st.intensity = b.contrasting(w.intensity, 10, 70);
+          w.strips.push_back(st);
+          t = st.s1 + b.uniform(0.3, 1.0);
+          break;
+        }
+        case 3: {  // slats: many edges that look alike, side by side
+          const double pitch = b.uniform(0.15, 0.35), width = pitch * b.uniform(0.3, 0.6);
+          const double end = std::min(piece - 0.1, t + b.uniform(0.8, 2.5));
+          const double grey = b.contrasting(w.intensity, 20, 80);
+          for (; t + width < end; t += pitch) {
+            Panel p;
+            p.s0 = t;
+            p.s1 = t + width;
+            p.z1 = b.uniform(0.5, 1.0) < 0.75 ? 2.2 : 1.0;
+            p.intensity = grey;
+            w.panels.push_back(p);
+          }
+          t += b.uniform(0.3, 0.8);
+          break;
+        }
+        case 4: {  // a window: bright, with a faint pattern
+          Panel win;
+          win.s0 = t;
+          win.s1 = std::min(piece - 0.05, t + b.uniform(0.6, 1.6));
+          win.z0 = b.uniform(0.7, 1.1);
+          win.z1 = std::min(world_top(b.world), win.z0 + b.uniform(0.8, 1.6));
+          win.intensity = b.uniform(215, 248);
+          win.pattern = Pattern::kStripes;
+          win.period = b.uniform(0.2, 0.6);
+          win.amplitude = b.uniform(5, 20);
+          w.panels.push_back(win);
+          t = win.s1 + b.uniform(0.3, 1.0);
+          break;
+        }
+        default:
+          t += b.uniform(0.3, 1.0);
+      }
+    }
+    if (b.pick(3) != 0) b.skirting(w);
+    b.world.walls.push_back(w);
+    s += piece;
+  }
+}
+
 }  // namespace
+
+World random_world(std::uint64_t seed, const std::vector<Eigen::Vector2d>& path) {
+  World world;
+  world.name = "random-" + std::to_string(seed);
+  PresetBuilder b{world, std::mt19937_64(seed * 7919 + 101)};
+  world.seed = seed + 1000;
+  world.height = b.uniform(2.4, 4.5);
+  world.floor = {b.uniform(50, 160), b.uniform(5, 30), b.uniform(0.3, 1.2)};
+  world.ceiling = {b.uniform(150, 235), b.uniform(4, 18), b.uniform(0.4, 1.4)};
+  world.start = Eigen::Vector3d::Zero();
+  Eigen::Vector2d lo(0, 0), hi(0, 0);
+  for (const Eigen::Vector2d& p : path) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  // The room: the path's box and 0.9-3.5 m on each side (a corridor when both sides of an
+  // axis are narrow, a hall when they are wide).
+  const Eigen::Vector2d r0(lo.x() - b.uniform(0.9, 3.5), lo.y() - b.uniform(0.9, 3.5));
+  const Eigen::Vector2d r1(hi.x() + b.uniform(0.9, 3.5), hi.y() + b.uniform(0.9, 3.5));
+  const Eigen::Vector2d c[4] = {r0, {r1.x(), r0.y()}, r1, {r0.x(), r1.y()}};
+  for (int i = 0; i < 4; ++i) random_walls(b, c[i], c[(i + 1) % 4]);
+  // Pillars and furniture between the path (kept 0.6 m clear) and the walls.
+  const Eigen::Vector2d f0 = lo.array() - 0.6, f1 = hi.array() + 0.6;
+  const int boxes = b.pick(9);
+  for (int k = 0, tries = 0; k < boxes && tries < 200; ++tries) {
+    const Eigen::Vector2d size(b.uniform(0.25, 1.4), b.uniform(0.25, 1.0));
+    const Eigen::Vector2d at(b.uniform(r0.x() + 0.1, r1.x() - 0.1),
+                             b.uniform(r0.y() + 0.1, r1.y() - 0.1));
+    const double reach = 0.5 * size.norm();
+    const bool clear = at.x() + reach < f0.x() || at.x() - reach > f1.x() ||
+                       at.y() + reach < f0.y() || at.y() - reach > f1.y();
+    const bool inside = at.x() - reach > r0.x() && at.x() + reach < r1.x() &&
+                        at.y() - reach > r0.y() && at.y() + reach < r1.y();
+    if (!clear || !inside) continue;
+    const bool pillar = b.pick(3) == 0;
+    world.add_box(at,
+                  pillar ? Eigen::Vector2d(0.3, 0.3) : size,
+                  b.uniform(-0.5, 0.5),
+                  pillar ? world.height : b.uniform(0.5, 2.0),
+                  b.uniform(50, 220),
+                  b.uniform(2, 12));
+    ++k;
+  }
+  return world;
+}
 
 std::vector<std::string> world_presets() { return {"corridor", "office", "hall"}; }
 

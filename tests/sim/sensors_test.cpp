@@ -7,6 +7,9 @@
 
 #include <gtest/gtest.h>
 
+#include <opencv2/imgproc.hpp>
+
+#include "omnivert/core/angles.hpp"
 #include "omnivert/sim/sensors.hpp"
 #include "omnivert/sim/trajectory.hpp"
 
@@ -153,6 +156,42 @@ TEST(ImageSensor, SaturatesAndIsReproducible) {
   apply_image_sensor(img, n, r1, a);
   apply_image_sensor(img, n, r2, b);
   EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0.0);
+}
+
+TEST(ImageSensor, LightAndVignettingHaveTheStatedGains) {
+  // A uniform 100 about the centre (50.5, 40.25), rim at 40 px: at the centre the light's gain
+  // alone; on the rim towards the light 100 (1 - v)(1 + g), away from it 100 (1 - v)(1 - g).
+  ImageSensor s;
+  s.vignetting = 0.3;
+  s.light_gradient = 1.0 / 3.0;
+  s.light_azimuth = deg2rad(90.0);
+  const double cx = 50.5, cy = 40.25, yaw = deg2rad(60.0);
+  for (int sign : {1, -1}) {
+    cv::Mat1f img(81, 101, 100.0f);
+    apply_lighting(img, s, cx, cy, 40.0, sign, yaw);
+    // The pixel whose bearing points at the light: camera bearing 30 deg, image angle
+    // sign * 30 deg; the opposite one at bearing 210 deg.
+    const auto at = [&](double bearing_deg, double r) {
+      const double a = sign * deg2rad(bearing_deg);
+      const double u = cx + r * std::cos(a), v = cy + r * std::sin(a);
+      cv::Mat1f px;
+      cv::getRectSubPix(
+          img, cv::Size(1, 1), cv::Point2f(static_cast<float>(u), static_cast<float>(v)), px);
+      return static_cast<double>(px(0, 0));
+    };
+    EXPECT_NEAR(at(30.0, 40.0), 100 * 0.7 * (4.0 / 3.0), 0.6) << sign;
+    EXPECT_NEAR(at(210.0, 40.0), 100 * 0.7 * (2.0 / 3.0), 0.6) << sign;
+    EXPECT_NEAR(at(120.0, 20.0), 100 * (1 - 0.3 * 0.25), 0.6) << sign;  // across: cos 90 = 0
+  }
+  ImageSensor none;
+  cv::Mat1f img(10, 10, 100.0f);
+  apply_lighting(img, none, 5, 5, 4, 1, 0.3);
+  EXPECT_EQ(cv::norm(img - 100.0f, cv::NORM_INF), 0.0);
+  s.jpeg_quality = 101;
+  EXPECT_NE(s.validate(), "");
+  s.jpeg_quality = 75;
+  s.vignetting = 1.0;
+  EXPECT_NE(s.validate(), "");
 }
 
 }  // namespace

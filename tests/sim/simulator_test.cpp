@@ -12,6 +12,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -283,6 +284,29 @@ TEST(Presets, EveryTrajectoryPresetFitsEveryWorldPreset) {
       const auto motion = load_trajectory(tn).pieces(w.start);
       EXPECT_EQ(free_space_violation(w, motion, duration(motion), 0.25), "") << wn << " " << tn;
     }
+  }
+}
+
+TEST(Presets, RandomWorldsFitEveryTrajectoryAndDiffer) {
+  // 20 seeds x every trajectory: the room keeps the path clear (0.25 m from every wall and
+  // piece of furniture), validates, has vertical edges to see; the same seed is the same
+  // world, another seed another.
+  for (const std::string& tn : trajectory_presets()) {
+    const auto motion = load_trajectory(tn).pieces(Pose2::Zero());
+    std::vector<Eigen::Vector2d> path;
+    for (double t = 0.0; t <= duration(motion) + 0.05; t += 0.05)
+      path.push_back(pose_at(motion, t).head<2>());
+    std::set<std::size_t> edge_counts;
+    for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+      const World w = random_world(seed, path);
+      EXPECT_EQ(w.validate(), "") << tn << " seed " << seed;
+      EXPECT_EQ(free_space_violation(w, motion, duration(motion), 0.25), "")
+          << tn << " seed " << seed;
+      EXPECT_GE(w.edges().size(), 20u) << tn << " seed " << seed;
+      EXPECT_EQ(random_world(seed, path).edges().size(), w.edges().size());
+      edge_counts.insert(w.edges().size());
+    }
+    EXPECT_GE(edge_counts.size(), 10u) << tn;
   }
 }
 

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <random>
+#include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -60,6 +61,24 @@ struct ImageSensor {
   double gain_flicker = 0.03;  // per-frame gain ~ N(1, gain_flicker)
   double exposure = 1.0;       // mean gain; > 1 saturates bright walls and windows
   double blur_sigma = 0.0;     // Gaussian optical blur [px]; 0: none
+  // Motion blur: the image is the mean of exposure_samples renders spread evenly over
+  // [t - T / 2, t + T / 2] (T = exposure_time [s]) as the robot moves; 0: instantaneous.
+  double exposure_time = 0.0;
+  int exposure_samples = 8;
+  // 1..100: images written as JPEG at this quality (the artefacts of a compressing camera);
+  // 0: PNG, lossless.
+  int jpeg_quality = 0;
+  // Vignetting: the lens's gain falls to 1 - vignetting at the rim (r = r_max), as
+  // 1 - vignetting (r / r_max)^2.
+  double vignetting = 0.0;
+  // Light that varies across the room: each pixel's ray has the gain
+  // 1 + light_gradient cos(world azimuth - light_azimuth), brightest towards light_azimuth
+  // [rad] (a window wall); light_gradient 1/3 is a factor of 2 between the two sides.
+  double light_gradient = 0.0;
+  double light_azimuth = 0.0;
+
+  // Empty when usable; otherwise what is wrong.
+  std::string validate() const;
 };
 
 // Turns a noise-free rendering into the 8-bit image the camera delivers: gain (exposure and
@@ -68,5 +87,17 @@ void apply_image_sensor(const cv::Mat1f& clean,
                         const ImageSensor& sensor,
                         std::mt19937_64& rng,
                         cv::Mat1b& out);
+
+// Multiplies a rendering by the light across the room (ImageSensor::light_gradient, for a
+// camera whose x-axis points to world azimuth `camera_yaw` [rad]) and the lens's vignetting,
+// about the mirror centre (cx, cy) with the rim at r_max [px] and image angle
+// a = bearing_sign * bearing (docs/theory/conventions.md).
+void apply_lighting(cv::Mat1f& image,
+                    const ImageSensor& sensor,
+                    double cx,
+                    double cy,
+                    double r_max,
+                    int bearing_sign,
+                    double camera_yaw);
 
 }  // namespace omnivert::sim

@@ -99,6 +99,12 @@ struct World {
 std::vector<std::string> world_presets();
 // A built-in world by name; throws InputError for an unknown name.
 World world_preset(const std::string& name);
+// A room drawn from `seed` around a robot path (points of the robot centre [m], the path
+// starting at the origin heading along x: World::start is zero): its size (a narrow corridor to
+// a wide hall), height, floor and ceiling, wall pieces with their paint, noise texture (coarse
+// to fine), doors, windows, posters, paint strips and lattices of identical slats, and
+// pillars and furniture kept 0.6 m from the path (`simulate --world random[:SEED]`).
+World random_world(std::uint64_t seed, const std::vector<Eigen::Vector2d>& path);
 // A preset name or a YAML file. Throws InputError (file, line, problem) on bad input.
 World load_world(const std::string& name_or_file);
 // Writes a world as YAML (the format load_world reads).
