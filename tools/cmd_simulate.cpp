@@ -152,6 +152,9 @@ void add_image_sensor_options(CLI::App* cmd, SimulateArgs& a) {
                   "factor of 2")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 0.99));
+  cmd->add_option("--people", c.people, "People walking through the scene (moving occluders)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 50));
   cmd->add_option(
          "--light-azimuth", a.light_azimuth_deg, "World direction of the brightest light [deg]")
       ->capture_default_str();

@@ -14,6 +14,7 @@
 #include "omnivert/core/error.hpp"
 #include "omnivert/dataset/writer.hpp"
 #include "omnivert/sim/map_picture.hpp"
+#include "omnivert/sim/people.hpp"
 
 namespace omnivert::sim {
 
@@ -241,6 +242,7 @@ void write_simulation_settings(const fs::path& path,
   y += "vignetting: " + fmt("%.9g", s.vignetting) + "\n";
   y += "light_gradient: " + fmt("%.9g", s.light_gradient) + "\n";
   y += "light_azimuth: " + fmt("%.9g", s.light_azimuth) + "\n";
+  y += "people: " + std::to_string(cfg.people) + "\n";
   y += "min_line_px: " + fmt("%.9g", cfg.min_line_px) + "\n";
   const RobotOverlay& o = cfg.overlay;
   if (!o.strut_angles_deg.empty()) {
@@ -280,18 +282,23 @@ void write_simulation_settings(const fs::path& path,
 // exposure, each at the robot's pose of its instant.
 void render_exposure(const Renderer& renderer,
                      const std::vector<MotionPiece>& motion,
+                     const std::vector<Person>& people,
                      double t,
                      const SimConfig& cfg,
                      cv::Mat1f& out) {
   const ImageSensor& s = cfg.image;
+  const auto render_at = [&](double ti, cv::Mat1f& img) {
+    const CameraPose cam = camera_pose(pose_at(motion, ti), cfg.extrinsics, cfg.camera_height);
+    renderer.render(cam, img);
+    if (!people.empty()) paint_people(people, ti, cfg.camera, cam, img);
+  };
   if (!(s.exposure_time > 0.0) || s.exposure_samples <= 1) {
-    renderer.render(camera_pose(pose_at(motion, t), cfg.extrinsics, cfg.camera_height), out);
+    render_at(t, out);
     return;
   }
   cv::Mat1f one;
   for (int i = 0; i < s.exposure_samples; ++i) {
-    const double ti = t + s.exposure_time * ((i + 0.5) / s.exposure_samples - 0.5);
-    renderer.render(camera_pose(pose_at(motion, ti), cfg.extrinsics, cfg.camera_height), one);
+    render_at(t + s.exposure_time * ((i + 0.5) / s.exposure_samples - 0.5), one);
     if (i == 0)
       out = one.clone();
     else
@@ -327,6 +334,7 @@ void write_frames(const fs::path& dir,
   const bool overlay = !cfg.overlay.empty();
   const OverlayPicture picture =
       overlay ? overlay_picture(cfg.overlay, cfg.camera) : OverlayPicture{};
+  const std::vector<Person> people = draw_people(cfg.people, cfg.seed, renderer.world());
   Pose2 prev = pose_at(motion, times.time(0));
   for (int k = 0; k < n_frames; ++k) {
     const double t = times.time(k);
@@ -335,7 +343,7 @@ void write_frames(const fs::path& dir,
     summary.distance += (robot.head<2>() - prev.head<2>()).norm();
     prev = robot;
     const CameraPose cam = camera_pose(robot, cfg.extrinsics, cfg.camera_height);
-    render_exposure(renderer, motion, t, cfg, clean);
+    render_exposure(renderer, motion, people, t, cfg, clean);
     apply_lighting(clean,
                    cfg.image,
                    cfg.camera.cx,
@@ -467,6 +475,7 @@ SimSummary simulate(const World& world,
   }
   if (!(cfg.frame_rate > 0) || !(cfg.wheel.rate_hz > 0)) throw InputError("rates must be positive");
   if (std::string why; !cfg.overlay.IsValid(&why)) throw InputError("overlay: " + why);
+  if (cfg.people < 0 || cfg.people > 50) throw InputError("people must be in 0..50");
   if (const std::string p = cfg.image.validate(); !p.empty())
     throw InputError("image sensor: " + p);
   if (cfg.laser.enabled) {

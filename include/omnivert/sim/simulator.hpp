@@ -48,6 +48,7 @@ struct SimConfig {
   LaserConfig laser;           // a 2D laser scanner (laser0/); off by default
   double min_clearance = 0.2;  // the robot centre keeps this far from every wall [m]
   double min_line_px = 2.0;    // ground-truth lines shorter than this (radially) are left out
+  int people = 0;              // people walking through the scene (sim/people.hpp), from the seed
 };
 
 // The camera pose for a robot pose (docs/theory/conventions.md).
