@@ -32,7 +32,8 @@ TEST(People, PaintedWhereTheCylinderProjects) {
   CameraPose pose;
   pose.x = 1.0, pose.y = -0.5, pose.yaw = deg2rad(20.0), pose.height = 0.9;
   Person p;
-  p.a = p.b = Eigen::Vector2d(pose.x + 2.0 * std::cos(deg2rad(60.0)), pose.y + 2.0 * std::sin(deg2rad(60.0)));
+  p.a = p.b = Eigen::Vector2d(pose.x + 2.0 * std::cos(deg2rad(60.0)),
+                              pose.y + 2.0 * std::sin(deg2rad(60.0)));
   p.width = 0.5, p.height = 1.7, p.grey = 30.0;
   const double r_feet = cam.radius_of_elevation(std::atan2(-0.9, 2.0));
   const double r_head = cam.radius_of_elevation(std::atan2(0.8, 2.0));

@@ -20,7 +20,7 @@ namespace omnivert::sim {
 
 struct Person {
   Eigen::Vector2d a = Eigen::Vector2d::Zero(), b = Eigen::Vector2d::UnitX();  // path ends [m]
-  double speed = 1.2;    // [m/s]
+  double speed = 1.2;                                                         // [m/s]
   double phase = 0.0;    // where on the walk at t = 0: fraction of a return trip
   double width = 0.45;   // [m]
   double height = 1.75;  // [m]
