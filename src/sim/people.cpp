@@ -46,14 +46,19 @@ Eigen::Vector2d person_position(const Person& p, double t) {
   return p.a + f * (p.b - p.a);
 }
 
-void paint_people(const std::vector<Person>& people,
-                  double t,
-                  const CatadioptricCamera& camera,
-                  const CameraPose& pose,
-                  cv::Mat1f& image) {
-  struct Seen {
-    double d, azimuth, half_width, r_bottom, r_top, grey;
-  };
+namespace {
+
+// A person as the camera sees them: distance, world azimuth and half width [rad], the image
+// radii of their feet and head [px].
+struct Seen {
+  double d, azimuth, half_width, r_bottom, r_top, grey;
+};
+
+// The people at time t seen from `pose`, far ones first.
+std::vector<Seen> seen_people(const std::vector<Person>& people,
+                              double t,
+                              const CatadioptricCamera& camera,
+                              const CameraPose& pose) {
   std::vector<Seen> seen;
   const double el_max = std::asin(camera.xi) - 1e-6;
   for (const Person& p : people) {
@@ -70,8 +75,50 @@ void paint_people(const std::vector<Person>& people,
     s.grey = p.grey;
     seen.push_back(s);
   }
-  if (seen.empty()) return;
   std::sort(seen.begin(), seen.end(), [](const Seen& a, const Seen& b) { return a.d > b.d; });
+  return seen;
+}
+
+}  // namespace
+
+void hide_lines(const std::vector<Person>& people,
+                double t,
+                const CatadioptricCamera& camera,
+                const CameraPose& pose,
+                double min_line_px,
+                std::vector<VisibleLine>& lines) {
+  const std::vector<Seen> seen = seen_people(people, t, camera, pose);
+  if (seen.empty()) return;
+  std::vector<VisibleLine> kept;
+  for (VisibleLine l : lines) {
+    const double azimuth = pose.yaw + l.bearing;
+    bool gone = false;
+    for (const Seen& s : seen) {
+      if (!(s.d < l.distance) || std::abs(angle_diff(azimuth, s.azimuth)) > s.half_width) continue;
+      // What the person leaves of [r_inner, r_outer]: the longer piece beside [r_bottom, r_top].
+      const double below = std::min(l.r_outer, s.r_bottom) - l.r_inner;
+      const double above = l.r_outer - std::max(l.r_inner, s.r_top);
+      if (below <= 0.0 && above <= 0.0) {
+        if (l.r_outer > s.r_bottom && l.r_inner < s.r_top) gone = true;
+        continue;
+      }
+      if (below >= above)
+        l.r_outer = std::min(l.r_outer, s.r_bottom);
+      else
+        l.r_inner = std::max(l.r_inner, s.r_top);
+    }
+    if (!gone && l.r_outer - l.r_inner >= min_line_px) kept.push_back(l);
+  }
+  lines = std::move(kept);
+}
+
+void paint_people(const std::vector<Person>& people,
+                  double t,
+                  const CatadioptricCamera& camera,
+                  const CameraPose& pose,
+                  cv::Mat1f& image) {
+  const std::vector<Seen> seen = seen_people(people, t, camera, pose);
+  if (seen.empty()) return;
   const double r_rim = camera.rim_radius(), r_out = r_rim + 1.0;
   const int v0 = std::max(0, static_cast<int>(camera.cy - r_out)),
             v1 = std::min(image.rows - 1, static_cast<int>(camera.cy + r_out) + 1);

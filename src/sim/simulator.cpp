@@ -365,7 +365,9 @@ void write_frames(const fs::path& dir,
     fcam.add(ts, name);
     std::fprintf(
         fpose, "%" PRId64 ",%.9f,%.9f,%.9f\n", ts, robot.x(), robot.y(), wrap_angle(robot.z()));
-    for (const VisibleLine& l : renderer.visible_lines(cam, cfg.min_line_px)) {
+    std::vector<VisibleLine> lines = renderer.visible_lines(cam, cfg.min_line_px);
+    hide_lines(people, t, cfg.camera, cam, cfg.min_line_px, lines);
+    for (const VisibleLine& l : lines) {
       std::fprintf(flines,
                    "%" PRId64 ",%d,%d,%.9f,%.3f,%.3f\n",
                    ts,

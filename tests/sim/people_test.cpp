@@ -1,7 +1,9 @@
 // People walking through the scene (sim/people.hpp): they walk back and forth along their
 // path; painted where an upright cylinder of their width and height projects (eq. 16-17 for
 // its azimuth, the camera model's radius of elevation for its feet and head), nowhere else.
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -55,6 +57,32 @@ TEST(People, PaintedWhereTheCylinderProjects) {
     EXPECT_NEAR(at(b, r_feet - 3.0), 200.0, 1e-3) << sign;  // below the feet
     EXPECT_LT(at(b + 0.8 * half, mid), 200.0) << sign;      // inside, near the side
   }
+}
+
+TEST(People, TheGroundTruthLeavesOutWhatTheyHide) {
+  // A person 2 m away at world azimuth 0 (camera yaw 0): a line behind them at the same
+  // bearing spanning the annulus keeps its longer piece above or below them; one spanning only
+  // their height is gone; one in front of them, or beside them, is kept whole.
+  CatadioptricCamera cam;
+  CameraPose pose;
+  Person p;
+  p.a = p.b = Eigen::Vector2d(2.0, 0.0);
+  p.width = 0.5, p.height = 1.7;
+  const double r_feet = cam.radius_of_elevation(std::atan2(-0.9, 2.0));
+  const double r_head = cam.radius_of_elevation(std::atan2(0.8, 2.0));
+  std::vector<VisibleLine> lines(4);
+  lines[0] = {1, 0.01, cam.r_min, cam.r_max, 5.0};     // behind, the whole annulus
+  lines[1] = {2, -0.02, r_feet + 2, r_head - 2, 4.0};  // behind, within their height
+  lines[2] = {3, 0.0, cam.r_min, cam.r_max, 1.0};      // in front
+  lines[3] = {4, 0.3, cam.r_min, cam.r_max, 5.0};      // beside
+  hide_lines({p}, 0.0, cam, pose, 2.0, lines);
+  ASSERT_EQ(lines.size(), 3u);
+  EXPECT_EQ(lines[0].line_id, 1);
+  const double below = r_feet - cam.r_min, above = cam.r_max - r_head;
+  EXPECT_NEAR(lines[0].r_outer - lines[0].r_inner, std::max(below, above), 1e-9);
+  EXPECT_EQ(lines[1].line_id, 3);
+  EXPECT_EQ(lines[1].r_outer - lines[1].r_inner, cam.r_max - cam.r_min);
+  EXPECT_EQ(lines[2].line_id, 4);
 }
 
 TEST(People, DrawnInsideTheRoomAndReproducible) {

@@ -3,8 +3,8 @@
 // back and forth along a straight segment inside the room at walking speed; in the image a
 // person is an upright cylinder from the floor to their height, painted over the rendering
 // with sub-pixel coverage, so the lines behind are hidden and the person's own two sides are
-// vertical edges of no world line. The ground truth (lines.csv) still lists the lines a person
-// hides.
+// vertical edges of no world line. The ground truth (lines.csv) leaves out what they hide
+// (hide_lines).
 
 #include <cstdint>
 #include <vector>
@@ -33,6 +33,16 @@ std::vector<Person> draw_people(int count, std::uint64_t seed, const World& worl
 
 // Where a person is at time t [s].
 Eigen::Vector2d person_position(const Person& p, double t);
+
+// The ground truth without what the people hide at time t: a line behind a person (further
+// than they are, within their width) keeps the longer piece of its radial extent above or below
+// them, and is left out when that is shorter than min_line_px or nothing is left.
+void hide_lines(const std::vector<Person>& people,
+                double t,
+                const CatadioptricCamera& camera,
+                const CameraPose& pose,
+                double min_line_px,
+                std::vector<VisibleLine>& lines);
 
 // Paints the people at time t, seen from `pose`, over a rendering (upright camera; far people
 // first, so that nearer ones hide them).
