@@ -1,5 +1,9 @@
 #include "omnivert/dataset/writer.hpp"
 
+#include <signal.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cinttypes>
 #include <fstream>
 #include <stdexcept>
@@ -102,6 +106,42 @@ void check_replaceable(const std::filesystem::path& out) {
   throw InputError(out.string(),
                    0,
                    "is not a dataset folder (no cam0/data.csv): --force replaces only a dataset");
+}
+
+void remove_stale_temporaries(const std::filesystem::path& parent, const std::string& prefix) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  for (fs::directory_iterator it(parent, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.rfind(prefix, 0) != 0) continue;
+    const std::string pid = name.substr(prefix.size());
+    if (pid.empty() || pid.size() > 9 || pid.find_first_not_of("0123456789") != std::string::npos)
+      continue;
+    std::error_code rm;
+    if (::kill(std::stoi(pid), 0) == -1 && errno == ESRCH) fs::remove_all(it->path(), rm);
+  }
+}
+
+void replace_folder(const std::filesystem::path& tmp, const std::filesystem::path& out) {
+  namespace fs = std::filesystem;
+  fs::path parent = out.parent_path();
+  if (parent.empty()) parent = ".";
+  std::string prefix = ".";  // built in steps: GCC 12 warns falsely on "." + string + "..."
+  prefix += out.filename().string();
+  prefix += ".replaced-";
+  remove_stale_temporaries(parent, prefix);
+  std::error_code ec;
+  if (!fs::exists(out, ec)) {
+    fs::rename(tmp, out);
+    return;
+  }
+  // Removing `out` in place would leave, when killed, a folder that is neither the old dataset
+  // nor the new one (and that a rerun's --force then refuses as not a dataset).
+  const fs::path old = parent / (prefix + std::to_string(::getpid()));
+  fs::remove_all(old, ec);
+  fs::rename(out, old);
+  fs::rename(tmp, out);
+  fs::remove_all(old, ec);
 }
 
 }  // namespace omnivert::dataset

@@ -1,11 +1,9 @@
 #include "omnivert/recording/import.hpp"
 #include "omnivert/recording/laser_scan.hpp"
 
-#include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -61,21 +59,6 @@ struct TempDir {
     if (!keep && !path.empty()) fs::remove_all(path, ec);
   }
 };
-
-// The temporary folders `prefix`<pid> beside `out` of imports that were killed (no process
-// has their pid any more): removed, so that a killed run leaves nothing after the next one.
-void remove_stale_temporaries(const fs::path& parent, const std::string& prefix) {
-  std::error_code ec;
-  for (fs::directory_iterator it(parent, ec), end; !ec && it != end; it.increment(ec)) {
-    const std::string name = it->path().filename().string();
-    if (name.rfind(prefix, 0) != 0) continue;
-    const std::string pid = name.substr(prefix.size());
-    if (pid.empty() || pid.size() > 9 || pid.find_first_not_of("0123456789") != std::string::npos)
-      continue;
-    std::error_code rm;
-    if (::kill(std::stoi(pid), 0) == -1 && errno == ESRCH) fs::remove_all(it->path(), rm);
-  }
-}
 
 // The wheel base and the radius may come from /robot_description (use_description): they are
 // checked once it has been read (check_wheels).
@@ -136,7 +119,7 @@ ImportSummary import_recording(Recording& rec, const ImportOptions& options) {
   std::string hidden = ".";
   hidden += out.filename().string();
   hidden += ".import-";
-  remove_stale_temporaries(out.parent_path(), hidden);
+  dataset::remove_stale_temporaries(out.parent_path(), hidden);
   hidden += std::to_string(getpid());
   TempDir tmp{out.parent_path() / hidden};
   fs::remove_all(tmp.path, ec);
@@ -193,8 +176,7 @@ ImportSummary import_recording(Recording& rec, const ImportOptions& options) {
   if (!o.laser_topic.empty())
     s.laser_scans = import_laser_scans(rec, o.laser_topic, *o.laser_pose, tmp.path);
 
-  if (fs::exists(out, ec)) fs::remove_all(out);
-  fs::rename(tmp.path, out);
+  dataset::replace_folder(tmp.path, out);
   tmp.keep = true;
   return s;
 }

@@ -515,8 +515,7 @@ SimSummary simulate(const World& world,
   SimSummary summary;
   try {
     write_dataset(world, trajectory, cfg, tmp, summary, progress);
-    if (fs::exists(out)) fs::remove_all(out);
-    fs::rename(tmp, out);
+    dataset::replace_folder(tmp, out);
   } catch (...) {
     fs::remove_all(tmp, ec);
     throw;

@@ -71,4 +71,14 @@ void write_text_file(const std::string& path, const std::string& text);
 // of the user's.
 void check_replaceable(const std::filesystem::path& out);
 
+// Removes the siblings in `parent` named `prefix` followed by the process id of a process that
+// no longer runs: the temporaries a killed writer left behind.
+void remove_stale_temporaries(const std::filesystem::path& parent, const std::string& prefix);
+
+// Puts the finished folder `tmp` in the place of `out` so that a kill at any moment leaves
+// `out` either absent, the old dataset whole, or the new one whole: the old folder is first
+// renamed to the hidden sibling `.NAME.replaced-PID` (removed afterwards, or by the next run
+// when killed), then `tmp` is renamed to `out`.
+void replace_folder(const std::filesystem::path& tmp, const std::filesystem::path& out);
+
 }  // namespace omnivert::dataset
