@@ -30,6 +30,8 @@ struct TrackerFlags {
   std::optional<double> look_back_f1;
   std::string heads_only = "default";  // on|off|default
   std::optional<double> confirm_f1, confirm_deg;
+  std::string triangulate = "default";  // on|off|default
+  std::optional<double> predict_f1, camera_yaw_deg;
 
   // The options these flags select (the wheel base is filled in from the dataset).
   TrackerOptions options() const {
@@ -54,6 +56,9 @@ struct TrackerFlags {
     if (confirm_f1) o.confirm_f1 = *confirm_f1;
     if (confirm_deg) o.confirm_tolerance = deg2rad(*confirm_deg);
     if (same_polarity != "default") o.same_polarity = same_polarity == "on";
+    if (triangulate != "default") o.triangulate = triangulate == "on";
+    if (predict_f1) o.predict_f1 = *predict_f1;
+    if (camera_yaw_deg) o.camera_yaw = deg2rad(*camera_yaw_deg);
     if (gate_min_distance) o.gate.min_feature_distance = *gate_min_distance;
     if (gate_tolerance_deg) o.gate.bearing_tolerance = deg2rad(*gate_tolerance_deg);
     return o;
@@ -62,6 +67,31 @@ struct TrackerFlags {
 
 // The help group of these options.
 inline constexpr const char* kTrackingGroup = "Tracking (Sec. 4, 9.1)";
+
+// The triangulated prediction's options (TrackerOptions::triangulate, predict_f1, camera_yaw).
+inline void add_prediction_options(CLI::App* cmd, TrackerFlags& t, const std::string& g) {
+  cmd->add_option("--triangulate",
+                  t.triangulate,
+                  "on: predict a track's bearing from its line's position, triangulated from its "
+                  "bearings and the wheels during straight travel (needs track continuity, track "
+                  "model; default: the rule set's)")
+      ->check(CLI::IsMember({"on", "off", "default"}))
+      ->capture_default_str()
+      ->group(g);
+  cmd->add_option("--predict-f1",
+                  t.predict_f1,
+                  "Links by prediction: a line left unmatched joins the track whose triangulated "
+                  "prediction it alone meets within --confirm-tolerance, up to this descriptor "
+                  "distance (needs --triangulate on; 0: off; default: the rule set's)")
+      ->check(kNonNegative)
+      ->group(g);
+  cmd->add_option("--camera-yaw",
+                  t.camera_yaw_deg,
+                  "The camera's yaw on the robot, phi + psi [degrees], for the triangulated "
+                  "prediction (default: estimated from the tracks' parallax)")
+      ->check(CLI::Range(-360.0, 360.0))
+      ->group(g);
+}
 
 inline void add_tracker_options(CLI::App* cmd, TrackerFlags& t) {
   const std::string g = kTrackingGroup;
@@ -143,6 +173,7 @@ inline void add_tracker_options(CLI::App* cmd, TrackerFlags& t) {
                   "(default: the rule set's: recommended 0.3)")
       ->check(CLI::Range(0.0, 179.0))
       ->group(g);
+  add_prediction_options(cmd, t, g);
   cmd->add_option("--heads-only",
                   t.heads_only,
                   "on: a look-back link only to a track's latest observation (no forks) "

@@ -31,9 +31,13 @@ bool OdometryGateOptions::IsValid(std::string* error) const {
 }
 
 void OdometryAccumulator::add(const WheelIncrement& inc, double wheel_base) {
-  // Eq. (15).
-  theta += (inc.d_right - inc.d_left) / wheel_base;
-  path_length += std::abs(0.5 * (inc.d_right + inc.d_left));
+  // Eqs. (14)-(15): the travel along the heading midway through the increment.
+  const double d_theta = (inc.d_right - inc.d_left) / wheel_base;
+  const double d_rho = 0.5 * (inc.d_right + inc.d_left);
+  x += d_rho * std::cos(theta + 0.5 * d_theta);
+  y += d_rho * std::sin(theta + 0.5 * d_theta);
+  theta += d_theta;
+  path_length += std::abs(d_rho);
   wheel_travel += std::abs(inc.d_right) + std::abs(inc.d_left);
 }
 

@@ -23,6 +23,7 @@ Tracker::TrackPrediction Tracker::predict_track(int k, int j) const {
   const double swing = 2.0 * options_.gate.max_camera_offset * std::abs(std::sin(0.5 * d_theta));
   const double swing_bound = swing < d_min ? std::asin(swing / d_min) : kPi;
   if (options_.continuity_model == TrackerOptions::ContinuityModel::kTrack) {
+    if (predict_from_position(s1, j, &p)) return p;
     const double turn_rate = s1.turn_rates[static_cast<std::size_t>(j)];
     // Translation: the parallax the rate predicts, and what it cannot (curvature), at most the
     // sound bound asin(path / D_min) (which is all there is without a rate).

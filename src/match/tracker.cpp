@@ -44,6 +44,10 @@ bool TrackerOptions::IsValid(std::string* error) const {
     if (error) *error = "confirmed F1 must be >= 0 (0: off) and its tolerance in [0, pi) radians";
     return false;
   }
+  if (!(predict_f1 >= 0.0 && std::isfinite(predict_f1)) || std::isinf(camera_yaw)) {
+    if (error) *error = "prediction F1 must be >= 0 (0: off) and the camera yaw finite or NaN";
+    return false;
+  }
   if (!(look_back_f1 >= 0.0 && std::isfinite(look_back_f1))) {
     if (error) *error = "look-back F1 must be >= 0 (0: F1)";
     return false;
@@ -118,6 +122,7 @@ std::string TrackerStats::BriefReport() const {
     << ", test3 " << rejected_test3 << ", mutual " << rejected_mutual << ", claimed "
     << rejected_claimed << ", odometry gate " << rejected_gate << ", continuity "
     << rejected_continuity << ", fork " << rejected_fork;
+  if (linked_by_prediction > 0) s << "; linked by prediction " << linked_by_prediction;
   return s.str();
 }
 
@@ -161,6 +166,7 @@ void Tracker::add_frame(const FrameFeatures& frame,
     const CandidateSearch c = search_candidates(frame, k);
     link_lines(frame, c, out);
   }
+  link_by_prediction(frame, out);
   start_new_tracks(out);
   store_frame(frame, *out);
   ++stats_.frames;
@@ -191,11 +197,15 @@ void Tracker::begin_frame(const FrameFeatures& frame,
   }
   out->assign(static_cast<std::size_t>(n), TrackAssignment{});
   claimed_.clear();
+  if (options_.triangulate) {
+    camera_yaw_ = std::isfinite(options_.camera_yaw) ? options_.camera_yaw : yaw_votes_.estimate();
+  }
   if (static_cast<Eigen::Index>(unmatched_.capacity()) < n) {
     const auto cap = static_cast<std::size_t>(line_capacity(n));
     unmatched_.reserve(cap);
     rates_.reserve(cap);
     turn_rates_.reserve(cap);
+    geometry_.reserve(cap);
     still_unmatched_.reserve(cap);
     claimed_.reserve(cap);
   }
@@ -500,6 +510,7 @@ bool Tracker::observed_since(std::int64_t id, int k) {
 void Tracker::store_frame(const FrameFeatures& frame, const std::vector<TrackAssignment>& out) {
   const int n = static_cast<int>(frame.lines.size());
   measure_track_rates(frame, out);
+  measure_track_geometry(frame, out);
   // The slot of frame t replaces that of frame t - look_back, which is no longer needed.
   Slot& slot = ring_[static_cast<std::size_t>(frame_count_ % options_.look_back)];
   const Eigen::Index cols = frame.descriptors.cols();
@@ -510,6 +521,7 @@ void Tracker::store_frame(const FrameFeatures& frame, const std::vector<TrackAss
     slot.polarities.reserve(static_cast<std::size_t>(slot.descriptors.rows()));
     slot.parallax_rates.reserve(static_cast<std::size_t>(slot.descriptors.rows()));
     slot.turn_rates.reserve(static_cast<std::size_t>(slot.descriptors.rows()));
+    slot.geometry.reserve(static_cast<std::size_t>(slot.descriptors.rows()));
     slot.track_ids.reserve(static_cast<std::size_t>(slot.descriptors.rows()));
   }
   if (n > 0) slot.descriptors.topRows(n) = frame.descriptors;
@@ -517,6 +529,7 @@ void Tracker::store_frame(const FrameFeatures& frame, const std::vector<TrackAss
   slot.polarities.resize(static_cast<std::size_t>(n));
   slot.parallax_rates.assign(rates_.begin(), rates_.end());
   slot.turn_rates.assign(turn_rates_.begin(), turn_rates_.end());
+  slot.geometry.assign(geometry_.begin(), geometry_.end());
   slot.track_ids.resize(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) {
     slot.bearings[static_cast<std::size_t>(i)] = frame.lines[static_cast<std::size_t>(i)].bearing;

@@ -70,15 +70,6 @@ TEST(Tracker, ContinuityRefusesAJumpToTheNeighbourEdge) {
   }
 }
 
-// A unit vector at distance `dist` from the unit vector d, in the direction of q (made
-// orthogonal to d): |p - d| = 2 sin(a / 2).
-Eigen::RowVectorXf at_distance(const Eigen::RowVectorXf& d, Eigen::RowVectorXf q, double dist) {
-  q -= q.dot(d) * d;
-  q.normalize();
-  const double a = 2.0 * std::asin(dist / 2.0);
-  return (static_cast<float>(std::cos(a)) * d + static_cast<float>(std::sin(a)) * q).normalized();
-}
-
 // Turning on the spot (0.1 rad a frame), line 2 drifts by 0.2 degree a frame beyond the
 // rotation (the camera swings around the axle); in frame 4 extraction finds its neighbour edge
 // instead, 2 degrees off. The link model of continuity takes no rate from a turn and allows the

@@ -36,6 +36,17 @@ inline Eigen::RowVectorXf perturb(const Eigen::RowVectorXf& d, float sigma, std:
   return p;
 }
 
+// A unit vector at distance `dist` from the unit vector d, in the direction of q (made
+// orthogonal to d): |p - d| = 2 sin(a / 2).
+inline Eigen::RowVectorXf at_distance(const Eigen::RowVectorXf& d,
+                                      Eigen::RowVectorXf q,
+                                      double dist) {
+  q -= q.dot(d) * d;
+  q.normalize();
+  const double a = 2.0 * std::asin(dist / 2.0);
+  return (static_cast<float>(std::cos(a)) * d + static_cast<float>(std::sin(a)) * q).normalized();
+}
+
 // A world line of a synthetic sequence: its appearance, its bearing over time, and the frames
 // in which it is seen.
 struct SynthLine {

@@ -59,6 +59,7 @@ struct OdometryAccumulator {
   double theta = 0.0;         // sum of d_theta (radians), not wrapped
   double path_length = 0.0;   // sum of |d_rho| (metres)
   double wheel_travel = 0.0;  // sum of |d_R| + |d_L| (metres)
+  double x = 0.0, y = 0.0;    // the axle midpoint's position (metres), eq. (14)
 
   void add(const WheelIncrement& inc, double wheel_base);
 };

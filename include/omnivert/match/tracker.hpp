@@ -30,12 +30,14 @@
 // allocation per frame in steady state.
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "omnivert/describe/frame_features.hpp"
 #include "omnivert/match/matcher.hpp"
 #include "omnivert/match/odometry_gate.hpp"
+#include "omnivert/match/track_geometry.hpp"
 
 namespace omnivert {
 
@@ -96,6 +98,22 @@ struct TrackerOptions {
   // geometry is most telling (docs/theory/matching.md).
   double confirm_f1 = 0.0;
   double confirm_tolerance = 0.0;  // radians
+  // Triangulated prediction (needs track continuity with the track model): each track's line is
+  // located from two of its bearings during straight travel and the wheels' travel in between
+  // (track_geometry.hpp), and the track's bearing in the new frame is predicted from that
+  // position instead of from its rates while the robot has not turned since. The camera's yaw
+  // on the robot (phi + psi) is `camera_yaw` when given (finite), else estimated from the sign
+  // of the tracks' parallax (CameraYawVotes).
+  bool triangulate = false;
+  double camera_yaw = std::numeric_limits<double>::quiet_NaN();
+  // Links by prediction (needs `triangulate`; 0 = off): a line still unmatched after the
+  // descriptor's look-back is linked to the latest observation, in frames t-1 .. t-3, of a track
+  // whose triangulated prediction it meets within confirm_tolerance (plus the prediction's
+  // spread), when no other line of that edge polarity lies within continuity_tolerance of the
+  // prediction, no other track predicts the line that closely, and their descriptor distance is
+  // at most predict_f1. Far apart frames change a near line's descriptor beyond test 1 and make
+  // tests 2 and 3 pick look-alikes; the wheels still say where the line is.
+  double predict_f1 = 0.0;
 
   bool IsValid(std::string* error) const;
 };
@@ -164,6 +182,7 @@ struct TrackerStats {
   std::int64_t rejected_gate = 0;        // odometry gate veto
   std::int64_t rejected_continuity = 0;  // track continuity veto
   std::int64_t rejected_fork = 0;        // heads_only: track observed since that frame
+  std::int64_t linked_by_prediction = 0;
   std::string BriefReport() const;
 };
 
@@ -189,12 +208,22 @@ class Tracker {
   std::int64_t tracks_created() const { return next_track_id_; }
 
  private:
+  // TrackerOptions::triangulate: where a line's track began its current straight stretch (the
+  // anchor: the axle's position, the rotation-free bearing u = beta + theta and the heading) and
+  // the line's position triangulated from the anchor, with the heading it was found at (NaN:
+  // unknown).
+  struct LineGeometry {
+    static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+    double ax = kNaN, ay = kNaN, au = kNaN, a_theta = kNaN;
+    double px = kNaN, py = kNaN, p_theta = kNaN;
+  };
   struct Slot {
     DescriptorMatrix descriptors;  // capacity rows; the first `num_lines` are live
     std::vector<double> bearings;
     std::vector<int> polarities;
     std::vector<double> parallax_rates;  // continuity: rad per metre driven, NaN = unknown
     std::vector<double> turn_rates;      // continuity (kTrack): rad per rad turned, NaN = unknown
+    std::vector<LineGeometry> geometry;  // TrackerOptions::triangulate
     std::vector<std::int64_t> track_ids;
     int num_lines = 0;
     OdometryAccumulator odometry;
@@ -286,8 +315,11 @@ class Tracker {
   struct TrackPrediction {
     double u = 0.0;
     double spread = 0.0;
-    bool rates_known = true;  // the motion since frame t-k is covered by measured rates
+    bool rates_known = true;    // the motion since frame t-k is covered by measured rates
+    bool triangulated = false;  // predicted from the line's position (TrackerOptions::triangulate)
   };
+  // The prediction from the line's triangulated position, when there is one.
+  bool predict_from_position(const Slot& s, int j, TrackPrediction* p) const;
   TrackPrediction predict_track(int k, int j) const;
   // TrackerOptions::continuity_tolerance: may line `bearing` of the new frame continue the
   // track predicted by p?
@@ -301,6 +333,19 @@ class Tracker {
   // of the new frame, into rates_ and turn_rates_, before its slot is stored.
   void measure_track_rates(const FrameFeatures& frame, const std::vector<TrackAssignment>& out);
   std::vector<double> rates_, turn_rates_;  // work space of store_frame
+  // TrackerOptions::triangulate: each line's anchor and position, into geometry_, and the votes
+  // on the camera's yaw, before its slot is stored.
+  void measure_track_geometry(const FrameFeatures& frame, const std::vector<TrackAssignment>& out);
+  std::vector<LineGeometry> geometry_;
+  CameraYawVotes yaw_votes_;
+  double camera_yaw_ = std::numeric_limits<double>::quiet_NaN();  // given or estimated
+  // TrackerOptions::predict_f1: links by prediction of the lines still unmatched.
+  void link_by_prediction(const FrameFeatures& frame, std::vector<TrackAssignment>* out);
+  struct Head {
+    int k = 0, j = 0;
+    double u = 0.0, tight = 0.0, wide = 0.0;
+  };
+  std::vector<Head> heads_;
 
   TrackerOptions options_;
   Matcher matcher_;
