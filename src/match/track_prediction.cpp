@@ -3,6 +3,7 @@
 // its bearings and the wheels, and the links that position makes certain.
 #include <algorithm>
 #include <cmath>
+#include <tuple>
 
 #include "omnivert/core/angles.hpp"
 #include "omnivert/match/tracker.hpp"
@@ -18,7 +19,7 @@ constexpr double kStraight = 0.03;
 constexpr double kMinParallax = 0.0087;
 // Fraction of the predicted bearing change allowed as error (the position's error).
 constexpr double kChangeError = 0.1;
-// Links between frames at most this many apart.
+// Votes on the camera's yaw from links between frames at most this many apart.
 constexpr int kPredictBack = 3;
 
 }  // namespace
@@ -89,28 +90,35 @@ void Tracker::measure_track_geometry(const FrameFeatures& frame,
       g.au = u;
       g.a_theta = odometry_.theta;
     }
+    g.fresh = a.frames_back == 0;
     geometry_[static_cast<std::size_t>(i)] = g;
   }
 }
 
 void Tracker::link_by_prediction(const FrameFeatures& frame, std::vector<TrackAssignment>* out) {
   if (!(options_.predict_f1 > 0.0) || unmatched_.empty()) return;
-  const int held = static_cast<int>(std::min<std::int64_t>(frame_count_, kPredictBack));
+  // The latest observation of each track not yet continued in this frame, over the look-back.
+  const int held = static_cast<int>(std::min<std::int64_t>(frame_count_, options_.look_back));
   heads_.clear();
+  latest_.clear();
   for (int k = 1; k <= held; ++k) {
     const Slot& s = slot_back(k);
-    for (int j = 0; j < s.num_lines; ++j) {
-      const std::int64_t id = s.track_ids[static_cast<std::size_t>(j)];
-      if (track_claimed(id) || (k > 1 && observed_since(id, k))) continue;
-      TrackPrediction p;
-      if (!predict_from_position(s, j, &p)) continue;
-      heads_.push_back({k,
-                        j,
-                        p.u,
-                        options_.confirm_tolerance + p.spread,
-                        options_.continuity_tolerance + p.spread});
-    }
+    for (int j = 0; j < s.num_lines; ++j)
+      latest_.push_back({s.track_ids[static_cast<std::size_t>(j)], k, j});
   }
+  std::sort(latest_.begin(), latest_.end());  // by track, then most recent first
+  for (std::size_t n = 0; n < latest_.size(); ++n) {
+    const auto [id, k, j] = latest_[n];
+    if ((n > 0 && std::get<0>(latest_[n - 1]) == id) || track_claimed(id)) continue;
+    TrackPrediction p;
+    if (!predict_from_position(slot_back(k), j, &p)) continue;
+    heads_.push_back({k,
+                      j,
+                      p.u,
+                      options_.confirm_tolerance + p.spread,
+                      options_.continuity_tolerance + p.spread});
+  }
+  if (held >= 2) add_pair_heads();
   auto u_of = [&](int a) {
     return frame.lines[static_cast<std::size_t>(a)].bearing + odometry_.theta;
   };
@@ -158,6 +166,47 @@ void Tracker::link_by_prediction(const FrameFeatures& frame, std::vector<TrackAs
     ++(match->k == 1 ? stats_.matched_previous : stats_.matched_look_back);
   }
   unmatched_.swap(still_unmatched_);
+}
+
+void Tracker::add_pair_heads() {
+  // A near line passed fast changes its descriptor beyond every test from frame to frame and
+  // starts a new track in each; three rays that meet in one point link it again.
+  const Slot& s1 = slot_back(1);
+  const Slot& s2 = slot_back(2);
+  if (std::isnan(camera_yaw_) || std::abs(odometry_.theta - s2.odometry.theta) > kStraight ||
+      std::hypot(s1.odometry.x - s2.odometry.x, s1.odometry.y - s2.odometry.y) <= 0.01) {
+    return;
+  }
+  const BearingGate gate = make_bearing_gate(options_.gate, s2.odometry, s1.odometry);
+  for (int j1 = 0; j1 < s1.num_lines; ++j1) {
+    const auto i1 = static_cast<std::size_t>(j1);
+    if (!s1.geometry[i1].fresh || track_claimed(s1.track_ids[i1])) continue;
+    const double u1 = s1.bearings[i1] + s1.odometry.theta;
+    for (std::size_t n = 0; n < latest_.size(); ++n) {
+      const auto [id, k, j2] = latest_[n];
+      if (k != 2 || (n > 0 && std::get<0>(latest_[n - 1]) == id) || track_claimed(id)) continue;
+      const auto i2 = static_cast<std::size_t>(j2);
+      const int p1 = s1.polarities[i1], p2 = s2.polarities[i2];
+      if ((p1 != 0 && p2 != 0 && p1 != p2) || !gate.admits(s2.bearings[i2], s1.bearings[i1]))
+        continue;
+      double px = 0.0, py = 0.0;
+      if (!intersect_rays(s2.odometry.x,
+                          s2.odometry.y,
+                          s2.bearings[i2] + s2.odometry.theta + camera_yaw_,
+                          s1.odometry.x,
+                          s1.odometry.y,
+                          u1 + camera_yaw_,
+                          kMinParallax,
+                          &px,
+                          &py)) {
+        continue;
+      }
+      const double u = std::atan2(py - odometry_.y, px - odometry_.x) - camera_yaw_;
+      const double spread = kChangeError * std::abs(angle_diff(u, u1));
+      heads_.push_back(
+          {1, j1, u, options_.confirm_tolerance + spread, options_.continuity_tolerance + spread});
+    }
+  }
 }
 
 }  // namespace omnivert

@@ -135,5 +135,57 @@ TEST(Tracker, LinkByPredictionFollowsANearLineWhoseDescriptorChanged) {
   }
 }
 
+// The same near line with a descriptor that changes by 0.9 in every frame: it begins a new track
+// in frames 0 and 1. In frame 2 the rays of frames 0 and 1 meet at the line and predict it: it
+// continues frame 1's track, and in frame 3 that track's triangulated position links it again.
+// Without links by prediction each frame begins a new track.
+TEST(Tracker, ThreeRaysThatMeetLinkANearLineAgain) {
+  for (const double predict_f1 : {0.0, 1.05}) {
+    std::mt19937 rng(23);
+    const std::vector<std::pair<double, double>> points = {
+        {0.6, 0.35}, {6.0, 3.0}, {-5.0, 4.0}, {-4.0, -6.0}, {7.0, -2.0}, {0.5, -8.0}};
+    std::vector<Eigen::RowVectorXf> d;
+    for (std::size_t k = 0; k < points.size(); ++k) d.push_back(random_descriptor(rng));
+    std::vector<Eigen::RowVectorXf> near = {d[0]};
+    for (int f = 1; f <= 3; ++f)
+      near.push_back(at_distance(near.back(), random_descriptor(rng), 0.9));
+    const double yaw = -1.2;
+    auto frame = [&](int f) {
+      FrameFeatures fr;
+      fr.descriptors.resize(static_cast<Eigen::Index>(points.size()), kPaperDescriptorSize);
+      for (std::size_t k = 0; k < points.size(); ++k) {
+        VerticalLine v;
+        v.bearing = wrap_angle(std::atan2(points[k].second, points[k].first - 0.1 * f) - yaw);
+        v.polarity = -1;
+        fr.lines.push_back(v);
+        fr.descriptors.row(static_cast<Eigen::Index>(k)) =
+            k == 0 ? near[static_cast<std::size_t>(f)] : perturb(d[k], 0.004f, rng);
+      }
+      return fr;
+    };
+    TrackerOptions o = recommended_tracker_options(0.4);
+    o.triangulate = true;
+    o.predict_f1 = predict_f1;
+    o.camera_yaw = yaw;
+    Tracker tracker(o);
+    std::vector<std::vector<TrackAssignment>> out(4);
+    tracker.add_frame(frame(0), WheelIncrement{}, &out[0]);
+    for (int f = 1; f <= 3; ++f) tracker.add_frame(frame(f), WheelIncrement{0.1, 0.1}, &out[f]);
+    SCOPED_TRACE(testing::Message() << "predict F1 " << predict_f1);
+    for (int f = 1; f <= 3; ++f)
+      for (std::size_t k = 1; k < points.size(); ++k)
+        EXPECT_EQ(out[f][k].track_id, out[0][k].track_id);
+    EXPECT_TRUE(out[1][0].is_new());
+    if (predict_f1 > 0) {
+      EXPECT_EQ(out[2][0].track_id, out[1][0].track_id);
+      EXPECT_EQ(out[3][0].track_id, out[1][0].track_id);
+      EXPECT_EQ(tracker.stats().linked_by_prediction, 2);
+    } else {
+      EXPECT_TRUE(out[2][0].is_new());
+      EXPECT_TRUE(out[3][0].is_new());
+    }
+  }
+}
+
 }  // namespace
 }  // namespace omnivert

@@ -32,6 +32,7 @@
 #include <cstdint>
 #include <limits>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "omnivert/describe/frame_features.hpp"
@@ -107,7 +108,7 @@ struct TrackerOptions {
   bool triangulate = false;
   double camera_yaw = std::numeric_limits<double>::quiet_NaN();
   // Links by prediction (needs `triangulate`; 0 = off): a line still unmatched after the
-  // descriptor's look-back is linked to the latest observation, in frames t-1 .. t-3, of a track
+  // descriptor's look-back is linked to the latest observation, within the look-back, of a track
   // whose triangulated prediction it meets within confirm_tolerance (plus the prediction's
   // spread), when no other line of that edge polarity lies within continuity_tolerance of the
   // prediction, no other track predicts the line that closely, and their descriptor distance is
@@ -216,6 +217,7 @@ class Tracker {
     static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
     double ax = kNaN, ay = kNaN, au = kNaN, a_theta = kNaN;
     double px = kNaN, py = kNaN, p_theta = kNaN;
+    bool fresh = false;  // the observation began its track
   };
   struct Slot {
     DescriptorMatrix descriptors;  // capacity rows; the first `num_lines` are live
@@ -346,6 +348,11 @@ class Tracker {
     double u = 0.0, tight = 0.0, wide = 0.0;
   };
   std::vector<Head> heads_;
+  // Heads from pairs: a track begun in frame t-1 and the latest observation, in frame t-2, of
+  // another, whose rays meet (link_by_prediction).
+  void add_pair_heads();
+  std::vector<std::tuple<std::int64_t, int, int>>
+      latest_;  // (track, k, line) of link_by_prediction
 
   TrackerOptions options_;
   Matcher matcher_;
