@@ -71,6 +71,11 @@ TrackerOptions recommended_tracker_options(double wheel_base) {
   // the corridor's false new entries under target at little cost in false matches.
   o.confirm_f1 = 1.05;
   o.confirm_tolerance = deg2rad(0.3);
+  // Triangulated prediction and links by prediction up to the paper's F1
+  // (docs/theory/matching.md#triangulated-prediction): they keep the tracks of near lines whose
+  // descriptor changes beyond the tests between frames far apart.
+  o.triangulate = true;
+  o.predict_f1 = 1.05;
   if (wheel_base > 0.0) {
     o.gate.enabled = true;
     o.gate.wheel_base = wheel_base;

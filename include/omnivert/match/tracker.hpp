@@ -123,9 +123,9 @@ struct TrackerOptions {
 TrackerOptions paper_tracker_options();
 // What we recommend (docs/theory/matching.md, measured there): the paper's rules with F1 = 0.6 and
 // 0.5 across a look-back gap, plus the mutual constraint, same edge polarity, and the odometry
-// gate with track continuity (track model, 0.8 degree) and confirmed F1 (1.05 where the track
-// predicts the line to 0.3 degree) when the wheel base is known (wheel_base > 0; pass 0 when
-// there is no odometry).
+// gate with track continuity (track model, 0.8 degree), confirmed F1 (1.05 where the track
+// predicts the line to 0.3 degree), the triangulated prediction and links by prediction up to
+// F1 1.05, when the wheel base is known (wheel_base > 0; pass 0 when there is no odometry).
 TrackerOptions recommended_tracker_options(double wheel_base);
 // The recommended set for a whole dataset (track_dataset, pipeline::calibrate_dataset, the
 // CLI): the odometry gate on, its wheel base filled in from wheel0/sensor.yaml by
