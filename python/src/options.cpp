@@ -179,6 +179,18 @@ const OptionTable<TO>& tracker_table() {
           "confirm_tolerance",
           "confirmed F1: deviation from the prediction [deg]",
           [](TO & o) -> auto& { return o.confirm_tolerance; }),
+      field<bool, TO>(
+          "triangulate",
+          "predict a track's bearing from its line's triangulated position",
+          [](TO & o) -> auto& { return o.triangulate; }),
+      field<double, TO>(
+          "predict_f1",
+          "links by prediction: largest descriptor distance (0: off)",
+          [](TO & o) -> auto& { return o.predict_f1; }),
+      degrees<TO>(
+          "camera_yaw",
+          "the camera's yaw on the robot, phi + psi [deg] (NaN: estimated)",
+          [](TO & o) -> auto& { return o.camera_yaw; }),
       {"gate_min_distance",
        "odometry gate: nearest line distance from the camera [m]",
        [](TO& o) { return py::cast(o.gate.min_feature_distance); },
