@@ -51,7 +51,9 @@ void add_evaluate_command(CLI::App& app) {
     o.annulus_r_min = *cam.r_min;
     o.annulus_r_max = *cam.r_max;
     o.num_frames = static_cast<std::int64_t>(data.size());
-    const auto ev = eval::evaluate_tracking(rows, truth, o);
+    std::vector<eval::OccluderBearing> occluders;  // the people the simulator drew, if any
+    for (const auto& e : gt->occluders) occluders.push_back({e.frame, e.bearing});
+    const auto ev = eval::evaluate_tracking(rows, truth, o, occluders);
     const std::string table = eval::format_tracking_table(ev);
     std::printf("%s", table.c_str());
     const fs::path txt = fs::path(a->dir) / "evaluation.txt";

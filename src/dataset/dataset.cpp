@@ -359,6 +359,24 @@ GroundTruth load_ground_truth(const std::string& dir,
     for (std::size_t k = 1; k < gt.line_offsets.size(); ++k)
       gt.line_offsets[k] += gt.line_offsets[k - 1];
   }
+  const std::string occluders = rel(dir, "occluders.csv");
+  if (fs::exists(occluders, ec)) {
+    for (const CsvRow& r :
+         read_csv(occluders, 4, "timestamp [ns], frame, occluder, bearing [rad]", nullptr, notes)) {
+      OccluderEdge o;
+      o.timestamp_ns = parse_timestamp(r.fields[0], occluders, r.line);
+      o.frame = parse_int(r.fields[1], "frame", occluders, r.line);
+      o.occluder = parse_int(r.fields[2], "occluder", occluders, r.line);
+      o.bearing = parse_double(r.fields[3], "bearing", occluders, r.line);
+      if (o.frame < 0 || static_cast<std::size_t>(o.frame) >= images.size()) {
+        throw InputError(occluders,
+                         r.line,
+                         "frame " + std::to_string(o.frame) + " is not an image index (0.." +
+                             std::to_string(static_cast<long>(images.size()) - 1) + ")");
+      }
+      gt.occluders.push_back(o);
+    }
+  }
   return gt;
 }
 

@@ -66,13 +66,17 @@ struct Association {
   // closer than the tolerance (crossings, lines far ahead), where the nearest is noise.
   std::vector<std::vector<std::int64_t>> within;
   std::vector<char> gt_detected;  // per ground-truth row
+  std::vector<char> occluder;     // per detection: on an occluder's side (rule 9)
 };
 
 // Rule 1 and rule 7 (bearing RMS).
 Association associate_detections(const std::vector<TrackRow>& tracks,
                                  const std::vector<GroundTruthLine>& ground_truth,
+                                 const std::vector<OccluderBearing>& occluders,
                                  const TrackingEvalOptions& options,
                                  TrackingEvaluation& ev) {
+  std::unordered_map<std::int64_t, std::vector<double>> occluders_by_frame;
+  for (const OccluderBearing& o : occluders) occluders_by_frame[o.frame].push_back(o.bearing);
   // Ground truth by frame.
   std::unordered_map<std::int64_t, std::vector<std::size_t>> gt_by_frame;
   for (std::size_t k = 0; k < ground_truth.size(); ++k) {
@@ -83,20 +87,36 @@ Association associate_detections(const std::vector<TrackRow>& tracks,
   a.line.assign(n, -1);
   a.within.resize(n);
   a.gt_detected.assign(ground_truth.size(), 0);
+  a.occluder.assign(n, 0);
   double sq_sum = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
+    // Rule 9: the nearest occluder side within the tolerance, if nearer than every true line.
+    double occluder_d = options.association_tolerance;
+    bool near_occluder = false;
+    if (const auto o = occluders_by_frame.find(tracks[i].frame); o != occluders_by_frame.end()) {
+      for (double b : o->second) {
+        const double d = std::abs(angle_diff(tracks[i].bearing, b));
+        if (d <= occluder_d) occluder_d = d, near_occluder = true;
+      }
+    }
     const auto it = gt_by_frame.find(tracks[i].frame);
-    if (it == gt_by_frame.end()) continue;
     double best = options.association_tolerance;
     std::size_t best_k = ground_truth.size();
     std::vector<std::int64_t>& within = a.within[i];
-    for (std::size_t k : it->second) {
+    static const std::vector<std::size_t> kNone;
+    for (std::size_t k : it == gt_by_frame.end() ? kNone : it->second) {
       const double d = std::abs(angle_diff(tracks[i].bearing, ground_truth[k].bearing));
       if (d <= options.association_tolerance) within.push_back(ground_truth[k].line_id);
       if (d <= best) {
         best = d;
         best_k = k;
       }
+    }
+    if (near_occluder && (best_k == ground_truth.size() || occluder_d < best)) {
+      a.occluder[i] = 1;
+      within.clear();
+      ++ev.occluder_detections;
+      continue;
     }
     std::sort(within.begin(), within.end());
     within.erase(std::unique(within.begin(), within.end()), within.end());
@@ -237,6 +257,14 @@ void evaluate_track(const std::vector<TrackRow>& tracks,
     const TrackRow& d = tracks[i];
     const std::vector<std::int64_t>& within = assoc.within[i];
     if (k > 0 && tracks[dets[k - 1]].frame == d.frame) ++ev.duplicate_ids;
+    if (assoc.occluder[i]) {  // rule 9: neither a new entry nor a link
+      if (d.frame == start_frame) {
+        ++ev.occluder_new_tracks;
+      } else {
+        ++ev.occluder_links;
+      }
+      continue;
+    }
     if (d.frame == start_frame) {
       identity[i] = within;
       // Rule 2: the first detection(s) of a track id are new entries. Rule 4.
@@ -253,6 +281,11 @@ void evaluate_track(const std::vector<TrackRow>& tracks,
       continue;
     }
     const std::size_t pred = find_predecessor(tracks, dets, k);
+    if (assoc.occluder[pred]) {  // rule 9: a link from an occluder's side is left out
+      ++ev.occluder_links;
+      identity[i] = within;
+      continue;
+    }
     // Rule 3.
     TrackingCounts& c = interval_of(ev, options, d.frame);
     ++c.matches;
@@ -300,12 +333,13 @@ std::int64_t count_off_majority(const std::map<std::int64_t, std::vector<std::si
 
 TrackingEvaluation evaluate_tracking(const std::vector<TrackRow>& tracks,
                                      const std::vector<GroundTruthLine>& ground_truth,
-                                     const TrackingEvalOptions& options) {
+                                     const TrackingEvalOptions& options,
+                                     const std::vector<OccluderBearing>& occluders) {
   std::string error;
   if (!options.IsValid(&error)) throw InputError("evaluation options: " + error);
   TrackingEvaluation ev;
   const std::int64_t num_frames = count_frames(tracks, ground_truth, options);
-  const Association assoc = associate_detections(tracks, ground_truth, options, ev);
+  const Association assoc = associate_detections(tracks, ground_truth, occluders, options, ev);
   count_long_lines(ground_truth, assoc.gt_detected, options, ev);
   const DetectedLines detected(tracks, assoc.line);
 
@@ -379,6 +413,16 @@ std::string format_tracking_table(const TrackingEvaluation& ev, const std::strin
                     ? 100.0 * ev.off_majority_detections / ev.associated_detections
                     : 0.0);
   s += buf;
+  if (ev.occluder_detections > 0) {
+    std::snprintf(buf,
+                  sizeof(buf),
+                  "Detections on an occluder's side (left out): %lld, with %lld links and %lld "
+                  "new tracks\n",
+                  static_cast<long long>(ev.occluder_detections),
+                  static_cast<long long>(ev.occluder_links),
+                  static_cast<long long>(ev.occluder_new_tracks));
+    s += buf;
+  }
   std::snprintf(buf,
                 sizeof(buf),
                 "Recall of long lines: %.2f%% (%lld of %lld)\nBearing RMS error: %.3f deg\n",

@@ -52,6 +52,7 @@ namespace {
 // radii of their feet and head [px].
 struct Seen {
   double d, azimuth, half_width, r_bottom, r_top, grey;
+  int index;
 };
 
 // The people at time t seen from `pose`, far ones first.
@@ -61,7 +62,8 @@ std::vector<Seen> seen_people(const std::vector<Person>& people,
                               const CameraPose& pose) {
   std::vector<Seen> seen;
   const double el_max = std::asin(camera.xi) - 1e-6;
-  for (const Person& p : people) {
+  for (std::size_t k = 0; k < people.size(); ++k) {
+    const Person& p = people[k];
     const Eigen::Vector2d rel = person_position(p, t) - Eigen::Vector2d(pose.x, pose.y);
     const double d = rel.norm();
     if (d < 0.5 * p.width + 0.05) continue;  // walked through the camera: not drawn
@@ -73,6 +75,7 @@ std::vector<Seen> seen_people(const std::vector<Person>& people,
     s.r_bottom = camera.radius_of_elevation(std::atan2(-pose.height, d));
     s.r_top = camera.radius_of_elevation(std::min(el_max, std::atan2(p.height - pose.height, d)));
     s.grey = p.grey;
+    s.index = static_cast<int>(k);
     seen.push_back(s);
   }
   std::sort(seen.begin(), seen.end(), [](const Seen& a, const Seen& b) { return a.d > b.d; });
@@ -110,6 +113,19 @@ void hide_lines(const std::vector<Person>& people,
     if (!gone && l.r_outer - l.r_inner >= min_line_px) kept.push_back(l);
   }
   lines = std::move(kept);
+}
+
+std::vector<std::pair<int, double>> occluder_edges(const std::vector<Person>& people,
+                                                   double t,
+                                                   const CatadioptricCamera& camera,
+                                                   const CameraPose& pose) {
+  std::vector<std::pair<int, double>> edges;
+  for (const Seen& s : seen_people(people, t, camera, pose)) {
+    // As hide_lines: a world azimuth a is seen at the camera bearing a - yaw.
+    edges.emplace_back(s.index, wrap_angle(s.azimuth - s.half_width - pose.yaw));
+    edges.emplace_back(s.index, wrap_angle(s.azimuth + s.half_width - pose.yaw));
+  }
+  return edges;
 }
 
 void paint_people(const std::vector<Person>& people,

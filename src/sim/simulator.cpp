@@ -335,6 +335,11 @@ void write_frames(const fs::path& dir,
   const OverlayPicture picture =
       overlay ? overlay_picture(cfg.overlay, cfg.camera) : OverlayPicture{};
   const std::vector<Person> people = draw_people(cfg.people, cfg.seed, renderer.world());
+  // The people's sides: edges of no world line, for the evaluation (docs/dataset-format.md).
+  FILE* foccluders =
+      people.empty() ? nullptr : open_or_throw(dir / "ground_truth" / "occluders.csv");
+  FileCloser coccluders{foccluders};
+  if (foccluders) std::fprintf(foccluders, "#timestamp [ns],frame,occluder,bearing [rad]\n");
   Pose2 prev = pose_at(motion, times.time(0));
   for (int k = 0; k < n_frames; ++k) {
     const double t = times.time(k);
@@ -367,6 +372,10 @@ void write_frames(const fs::path& dir,
         fpose, "%" PRId64 ",%.9f,%.9f,%.9f\n", ts, robot.x(), robot.y(), wrap_angle(robot.z()));
     std::vector<VisibleLine> lines = renderer.visible_lines(cam, cfg.min_line_px);
     hide_lines(people, t, cfg.camera, cam, cfg.min_line_px, lines);
+    if (foccluders) {
+      for (const auto& [person, bearing] : occluder_edges(people, t, cfg.camera, cam))
+        std::fprintf(foccluders, "%" PRId64 ",%d,%d,%.9f\n", ts, k, person, bearing);
+    }
     for (const VisibleLine& l : lines) {
       std::fprintf(flines,
                    "%" PRId64 ",%d,%d,%.9f,%.3f,%.3f\n",
@@ -382,8 +391,8 @@ void write_frames(const fs::path& dir,
   }
   summary.mean_lines = static_cast<double>(total_lines) / n_frames;
   fcam.close();
-  for (FILE* f : {fpose, flines}) {
-    if (std::ferror(f)) throw InputError(dir.string(), 0, "write error (disk full?)");
+  for (FILE* f : {fpose, flines, foccluders}) {
+    if (f && std::ferror(f)) throw InputError(dir.string(), 0, "write error (disk full?)");
   }
 }
 

@@ -157,6 +157,37 @@ TEST(TrackingEval, FalseNewEntryNeedsRecentDetection) {
   EXPECT_EQ(eval::evaluate_tracking(c.tracks, c.truth, o).total.false_new_entries, 1);
 }
 
+// Rule 9: a person's side at 0.3 deg from line A (0.2 deg from the side) in frames 1-3 and a
+// new track on it in each frame. Without the occluders each new track is taken for A, seen the
+// frame before: three false new entries (and the side's links false matches when linked to
+// A's track). With them the side's detections are left out: none.
+TEST(TrackingEval, OccluderSidesAreLeftOut) {
+  std::vector<eval::GroundTruthLine> truth;
+  std::vector<eval::OccluderBearing> occluders;
+  std::vector<TrackRow> tracks;
+  const double side = deg2rad(0.5), a = deg2rad(0.2);
+  for (int f = 0; f < 4; ++f) {
+    truth.push_back(gt(f, 100, 0.0));
+    tracks.push_back(det(f, 0, 0.0, f > 0 ? f - 1 : -1));
+    if (f > 0) {
+      occluders.push_back({f, side});
+      tracks.push_back(det(f, 10 + f, side - a));  // a new track on the side every frame
+    }
+  }
+  const eval::TrackingEvaluation without = eval::evaluate_tracking(tracks, truth, options());
+  EXPECT_EQ(without.total.false_new_entries, 3);
+  const eval::TrackingEvaluation with =
+      eval::evaluate_tracking(tracks, truth, options(), occluders);
+  EXPECT_EQ(with.total.false_new_entries, 0);
+  EXPECT_EQ(with.total.matches, 3);
+  EXPECT_EQ(with.total.correct, 3);
+  EXPECT_EQ(with.occluder_detections, 3);
+  EXPECT_EQ(with.occluder_new_tracks, 3);
+  // A detection nearer to the line than to the side stays the line's.
+  std::vector<TrackRow> on_line = {det(1, 0, deg2rad(0.1))};
+  EXPECT_EQ(eval::evaluate_tracking(on_line, truth, options(), occluders).occluder_detections, 0);
+}
+
 TEST(TrackingEval, AssociationToleranceAndWrap) {
   std::vector<eval::GroundTruthLine> truth = {gt(0, 1, 3.14), gt(0, 2, 1.0)};
   // -3.14 is 0.0032 rad from 3.14 across the wrap: associated. 1.0 + 1.1 deg: not.

@@ -85,6 +85,25 @@ TEST(People, TheGroundTruthLeavesOutWhatTheyHide) {
   EXPECT_EQ(lines[2].line_id, 4);
 }
 
+TEST(People, TheirSidesAreWrittenAsOccluderEdges) {
+  // The person of PaintedWhereTheCylinderProjects: sides at 40 -+ asin(0.25 / 2) degrees.
+  CatadioptricCamera cam;
+  CameraPose pose;
+  pose.x = 1.0, pose.y = -0.5, pose.yaw = deg2rad(20.0), pose.height = 0.9;
+  Person p;
+  p.a = p.b = Eigen::Vector2d(pose.x + 2.0 * std::cos(deg2rad(60.0)),
+                              pose.y + 2.0 * std::sin(deg2rad(60.0)));
+  p.width = 0.5;
+  Person behind = p;  // walked through the camera: not seen, no edges
+  behind.a = behind.b = Eigen::Vector2d(pose.x, pose.y);
+  const auto edges = occluder_edges({behind, p}, 0.0, cam, pose);
+  ASSERT_EQ(edges.size(), 2u);
+  const double half = std::asin(0.25 / 2.0);
+  EXPECT_EQ(edges[0].first, 1);
+  EXPECT_NEAR(edges[0].second, deg2rad(40.0) - half, 1e-12);
+  EXPECT_NEAR(edges[1].second, deg2rad(40.0) + half, 1e-12);
+}
+
 TEST(People, DrawnInsideTheRoomAndReproducible) {
   const World w = world_preset("office");
   const auto a = draw_people(5, 3, w), b = draw_people(5, 3, w);

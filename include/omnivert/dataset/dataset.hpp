@@ -86,10 +86,20 @@ struct LineRecord {
   double r_inner = 0, r_outer = 0;
 };
 
+// A side of a moving occluder (a person the simulator drew) in one frame: a vertical edge that
+// belongs to no world line (ground_truth/occluders.csv, optional).
+struct OccluderEdge {
+  std::int64_t timestamp_ns = 0;
+  int frame = 0;
+  int occluder = 0;
+  double bearing = 0;  // camera bearing [rad]
+};
+
 struct GroundTruth {
   std::optional<Extrinsics> extrinsics;
-  std::vector<PoseRecord> poses;  // empty when poses.csv is absent
-  std::vector<LineRecord> lines;  // empty when lines.csv is absent
+  std::vector<OccluderEdge> occluders;  // empty when occluders.csv is absent
+  std::vector<PoseRecord> poses;        // empty when poses.csv is absent
+  std::vector<LineRecord> lines;        // empty when lines.csv is absent
   bool has_poses = false;
   bool has_lines = false;
   // lines[line_offsets[k] .. line_offsets[k + 1]) are the lines of frame k (size: images + 1).

@@ -54,6 +54,13 @@ struct GroundTruthLine {
   double r_outer = 0.0;
 };
 
+// A side of a moving occluder in one frame (ground_truth/occluders.csv): a vertical edge of no
+// world line.
+struct OccluderBearing {
+  std::int64_t frame = 0;
+  double bearing = 0.0;  // camera bearing, radians
+};
+
 struct TrackingEvalOptions {
   double association_tolerance = deg2rad(1.0);  // radians
   int look_back = 20;                           // frames, for false new entries
@@ -103,13 +110,19 @@ struct TrackingEvaluation {
   }
   double bearing_rms = 0.0;                  // radians, over associated detections
   std::int64_t off_majority_detections = 0;  // rule 8
+  // Rule 9: detections on an occluder's side (nearer to it than to every true line, within the
+  // tolerance), left out with the links and new tracks they make.
+  std::int64_t occluder_detections = 0;
+  std::int64_t occluder_links = 0;
+  std::int64_t occluder_new_tracks = 0;
 };
 
 // Evaluates `tracks` against `ground_truth`. Throws InputError with the reason when the
 // options are not valid (e.g. the annulus is missing).
 TrackingEvaluation evaluate_tracking(const std::vector<TrackRow>& tracks,
                                      const std::vector<GroundTruthLine>& ground_truth,
-                                     const TrackingEvalOptions& options);
+                                     const TrackingEvalOptions& options,
+                                     const std::vector<OccluderBearing>& occluders = {});
 
 // The paper's Table 3 as text, with the total, the recall of long lines and the bearing RMS.
 std::string format_tracking_table(const TrackingEvaluation& evaluation,

@@ -7,6 +7,7 @@
 // (hide_lines).
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -43,6 +44,13 @@ void hide_lines(const std::vector<Person>& people,
                 const CameraPose& pose,
                 double min_line_px,
                 std::vector<VisibleLine>& lines);
+
+// The bearings (radians, the camera's) of the two sides of each person seen at time t, with the
+// person's index: vertical edges of no world line (ground_truth/occluders.csv).
+std::vector<std::pair<int, double>> occluder_edges(const std::vector<Person>& people,
+                                                   double t,
+                                                   const CatadioptricCamera& camera,
+                                                   const CameraPose& pose);
 
 // Paints the people at time t, seen from `pose`, over a rendering (upright camera; far people
 // first, so that nearer ones hide them).
