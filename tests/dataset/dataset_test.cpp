@@ -394,5 +394,34 @@ TEST_F(DatasetTest, GroundTruthIsReadAndChecked) {
   ASSERT_EQ(d.notes().size(), 1u);
 }
 
+TEST_F(DatasetTest, OccluderEdgesAreReadAndChecked) {
+  fs::create_directories(root / "ground_truth");
+  write("ground_truth/occluders.csv",
+        "#timestamp [ns],frame,occluder,bearing [rad]\n1000000000,0,1,0.25\n1000000000,0,1,0.5\n");
+  {
+    const Dataset d = Dataset::load(root.string());
+    ASSERT_TRUE(d.ground_truth().has_value());
+    const auto& o = d.ground_truth()->occluders;
+    ASSERT_EQ(o.size(), 2u);
+    EXPECT_EQ(o[1].frame, 0);
+    EXPECT_EQ(o[1].occluder, 1);
+    EXPECT_DOUBLE_EQ(o[1].bearing, 0.5);
+  }
+  write("ground_truth/occluders.csv",
+        "#timestamp [ns],frame,occluder,bearing [rad]\n1000000000,9,1,0.25\n");
+  {
+    const Dataset d = Dataset::load(root.string());
+    EXPECT_FALSE(d.ground_truth().has_value());
+    EXPECT_EQ(d.ground_truth_error(),
+              p("ground_truth/occluders.csv") + ":2: frame 9 is not an image index (0..2)");
+  }
+  write("ground_truth/occluders.csv",
+        "#timestamp [ns],frame,occluder,bearing [rad]\n1000000000,0,1,nan-ish\n");
+  const Dataset d = Dataset::load(root.string());
+  EXPECT_FALSE(d.ground_truth().has_value());
+  EXPECT_NE(d.ground_truth_error().find(p("ground_truth/occluders.csv") + ":2:"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace omnivert::dataset
