@@ -290,6 +290,16 @@ std::vector<WheelRecord> load_wheel_data(const std::string& path,
   return out;
 }
 
+// A ground-truth row's frame must index cam0/data.csv.
+void check_frame_index(int frame, std::size_t images, const std::string& path, int line) {
+  if (frame < 0 || static_cast<std::size_t>(frame) >= images) {
+    throw InputError(path,
+                     line,
+                     "frame " + std::to_string(frame) + " is not an image index (0.." +
+                         std::to_string(static_cast<long>(images) - 1) + ")");
+  }
+}
+
 GroundTruth load_ground_truth(const std::string& dir,
                               const std::vector<ImageRecord>& images,
                               std::vector<std::string>* notes) {
@@ -337,12 +347,7 @@ GroundTruth load_ground_truth(const std::string& dir,
       l.bearing = parse_double(r.fields[3], "bearing", lines, r.line);
       l.r_inner = parse_double(r.fields[4], "r_inner", lines, r.line);
       l.r_outer = parse_double(r.fields[5], "r_outer", lines, r.line);
-      if (l.frame < 0 || static_cast<std::size_t>(l.frame) >= images.size()) {
-        throw InputError(lines,
-                         r.line,
-                         "frame " + std::to_string(l.frame) + " is not an image index (0.." +
-                             std::to_string(static_cast<long>(images.size()) - 1) + ")");
-      }
+      check_frame_index(l.frame, images.size(), lines, r.line);
       if (images[static_cast<std::size_t>(l.frame)].timestamp_ns != l.timestamp_ns) {
         throw InputError(lines,
                          r.line,
@@ -368,12 +373,7 @@ GroundTruth load_ground_truth(const std::string& dir,
       o.frame = parse_int(r.fields[1], "frame", occluders, r.line);
       o.occluder = parse_int(r.fields[2], "occluder", occluders, r.line);
       o.bearing = parse_double(r.fields[3], "bearing", occluders, r.line);
-      if (o.frame < 0 || static_cast<std::size_t>(o.frame) >= images.size()) {
-        throw InputError(occluders,
-                         r.line,
-                         "frame " + std::to_string(o.frame) + " is not an image index (0.." +
-                             std::to_string(static_cast<long>(images.size()) - 1) + ")");
-      }
+      check_frame_index(o.frame, images.size(), occluders, r.line);
       gt.occluders.push_back(o);
     }
   }

@@ -20,7 +20,7 @@ constexpr double kMinParallax = 0.0087;
 // Fraction of the predicted bearing change allowed as error (the position's error).
 constexpr double kChangeError = 0.1;
 // Votes on the camera's yaw from links between frames at most this many apart.
-constexpr int kPredictBack = 3;
+constexpr int kVoteBack = 3;
 
 }  // namespace
 
@@ -59,7 +59,7 @@ void Tracker::measure_track_geometry(const FrameFeatures& frame,
       const double d_theta = odometry_.theta - s0.odometry.theta;
       const double path = odometry_.path_length - s0.odometry.path_length;
       // The sign of the parallax on a straight link votes on the camera's yaw.
-      if (a.frames_back <= kPredictBack && path > 0.01 && std::abs(d_theta) <= 0.02) {
+      if (a.frames_back <= kVoteBack && path > 0.01 && std::abs(d_theta) <= 0.02) {
         const double beta0 = s0.bearings[j];
         yaw_votes_.add(beta0 + 0.5 * angle_diff(beta, beta0),
                        angle_diff(u, beta0 + s0.odometry.theta));

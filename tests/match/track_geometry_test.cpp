@@ -4,6 +4,7 @@
 #include "omnivert/match/track_geometry.hpp"
 
 #include <cmath>
+#include <functional>
 #include <random>
 #include <vector>
 
@@ -75,6 +76,28 @@ TEST(TrackGeometry, CameraYawFromTheSignOfTheParallax) {
   }
 }
 
+// Where the lines of the two tracker tests stand: a near one first, the others far.
+const std::vector<std::pair<double, double>> kPoints = {
+    {0.6, 0.35}, {6.0, 3.0}, {-5.0, 4.0}, {-4.0, -6.0}, {7.0, -2.0}, {0.5, -8.0}};
+
+// Frame f of a robot driving 0.1 m a frame along x from the origin, its camera at the axle with
+// yaw `yaw`: one line of each of kPoints, of `polarity`, with the descriptor `descriptor(k)`.
+FrameFeatures driven_past(int f,
+                          double yaw,
+                          int polarity,
+                          const std::function<Eigen::RowVectorXf(std::size_t)>& descriptor) {
+  FrameFeatures fr;
+  fr.descriptors.resize(static_cast<Eigen::Index>(kPoints.size()), kPaperDescriptorSize);
+  for (std::size_t k = 0; k < kPoints.size(); ++k) {
+    VerticalLine v;
+    v.bearing = wrap_angle(std::atan2(kPoints[k].second, kPoints[k].first - 0.1 * f) - yaw);
+    v.polarity = polarity;
+    fr.lines.push_back(v);
+    fr.descriptors.row(static_cast<Eigen::Index>(k)) = descriptor(k);
+  }
+  return fr;
+}
+
 // A near line (0.6 m ahead, 0.35 m to the left) passed at 10 cm a frame: its bearing turns by
 // 4.7, 6.2, then 8.2 degrees. In the last frame its descriptor has changed by 0.9 (beyond F1 and
 // the confirmed F1's tests). The rates of its last link predict it 2 degrees short, beyond track
@@ -88,24 +111,15 @@ TEST(Tracker, LinkByPredictionFollowsANearLineWhoseDescriptorChanged) {
   };
   for (const Case c : {Case{false, 0.0, false}, Case{true, 1.05, true}, Case{true, 0.5, false}}) {
     std::mt19937 rng(17);
-    const std::vector<std::pair<double, double>> points = {
-        {0.6, 0.35}, {6.0, 3.0}, {-5.0, 4.0}, {-4.0, -6.0}, {7.0, -2.0}, {0.5, -8.0}};
+    const auto& points = kPoints;
     std::vector<Eigen::RowVectorXf> d;
     for (std::size_t k = 0; k < points.size(); ++k) d.push_back(random_descriptor(rng));
     const Eigen::RowVectorXf changed = at_distance(d[0], random_descriptor(rng), 0.9);
     const double yaw = 0.3;
     auto frame = [&](int f) {
-      FrameFeatures fr;
-      fr.descriptors.resize(static_cast<Eigen::Index>(points.size()), kPaperDescriptorSize);
-      for (std::size_t k = 0; k < points.size(); ++k) {
-        VerticalLine v;
-        v.bearing = wrap_angle(std::atan2(points[k].second, points[k].first - 0.1 * f) - yaw);
-        v.polarity = 1;
-        fr.lines.push_back(v);
-        fr.descriptors.row(static_cast<Eigen::Index>(k)) =
-            k == 0 && f == 3 ? changed : perturb(d[k], 0.004f, rng);
-      }
-      return fr;
+      return driven_past(f, yaw, 1, [&](std::size_t k) -> Eigen::RowVectorXf {
+        return k == 0 && f == 3 ? changed : perturb(d[k], 0.004f, rng);
+      });
     };
     TrackerOptions o = recommended_tracker_options(0.4);
     o.triangulate = c.triangulate;
@@ -142,8 +156,7 @@ TEST(Tracker, LinkByPredictionFollowsANearLineWhoseDescriptorChanged) {
 TEST(Tracker, ThreeRaysThatMeetLinkANearLineAgain) {
   for (const double predict_f1 : {0.0, 1.05}) {
     std::mt19937 rng(23);
-    const std::vector<std::pair<double, double>> points = {
-        {0.6, 0.35}, {6.0, 3.0}, {-5.0, 4.0}, {-4.0, -6.0}, {7.0, -2.0}, {0.5, -8.0}};
+    const auto& points = kPoints;
     std::vector<Eigen::RowVectorXf> d;
     for (std::size_t k = 0; k < points.size(); ++k) d.push_back(random_descriptor(rng));
     std::vector<Eigen::RowVectorXf> near = {d[0]};
@@ -151,17 +164,9 @@ TEST(Tracker, ThreeRaysThatMeetLinkANearLineAgain) {
       near.push_back(at_distance(near.back(), random_descriptor(rng), 0.9));
     const double yaw = -1.2;
     auto frame = [&](int f) {
-      FrameFeatures fr;
-      fr.descriptors.resize(static_cast<Eigen::Index>(points.size()), kPaperDescriptorSize);
-      for (std::size_t k = 0; k < points.size(); ++k) {
-        VerticalLine v;
-        v.bearing = wrap_angle(std::atan2(points[k].second, points[k].first - 0.1 * f) - yaw);
-        v.polarity = -1;
-        fr.lines.push_back(v);
-        fr.descriptors.row(static_cast<Eigen::Index>(k)) =
-            k == 0 ? near[static_cast<std::size_t>(f)] : perturb(d[k], 0.004f, rng);
-      }
-      return fr;
+      return driven_past(f, yaw, -1, [&](std::size_t k) -> Eigen::RowVectorXf {
+        return k == 0 ? near[static_cast<std::size_t>(f)] : perturb(d[k], 0.004f, rng);
+      });
     };
     TrackerOptions o = recommended_tracker_options(0.4);
     o.triangulate = true;

@@ -26,17 +26,27 @@ TEST(People, WalkBackAndForth) {
   EXPECT_NEAR(person_position(p, 0.0).x(), 1.0, 1e-12);
 }
 
+// A person 0.5 m wide and 1.7 m tall, 2 m from the camera at world azimuth 60 degrees; the
+// camera at (1, -0.5), 0.9 m high, yaw 20 degrees.
+struct Scene {
+  CatadioptricCamera cam;
+  CameraPose pose;
+  Person person;
+};
+Scene person_2m_at_60_degrees() {
+  Scene s;
+  s.pose.x = 1.0, s.pose.y = -0.5, s.pose.yaw = deg2rad(20.0), s.pose.height = 0.9;
+  s.person.a = s.person.b = Eigen::Vector2d(s.pose.x + 2.0 * std::cos(deg2rad(60.0)),
+                                            s.pose.y + 2.0 * std::sin(deg2rad(60.0)));
+  s.person.width = 0.5, s.person.height = 1.7, s.person.grey = 30.0;
+  return s;
+}
+
 TEST(People, PaintedWhereTheCylinderProjects) {
   // A person 2 m from the camera at world azimuth 60 degrees, the camera yaw 20 degrees: at
   // camera bearing 40 degrees (image angle sign * 40), between the radii of the feet and the
   // head; not 1.5 half-widths to the side, nor beyond the head.
-  CatadioptricCamera cam;
-  CameraPose pose;
-  pose.x = 1.0, pose.y = -0.5, pose.yaw = deg2rad(20.0), pose.height = 0.9;
-  Person p;
-  p.a = p.b = Eigen::Vector2d(pose.x + 2.0 * std::cos(deg2rad(60.0)),
-                              pose.y + 2.0 * std::sin(deg2rad(60.0)));
-  p.width = 0.5, p.height = 1.7, p.grey = 30.0;
+  auto [cam, pose, p] = person_2m_at_60_degrees();
   const double r_feet = cam.radius_of_elevation(std::atan2(-0.9, 2.0));
   const double r_head = cam.radius_of_elevation(std::atan2(0.8, 2.0));
   const double half = std::asin(0.25 / 2.0);
@@ -87,13 +97,7 @@ TEST(People, TheGroundTruthLeavesOutWhatTheyHide) {
 
 TEST(People, TheirSidesAreWrittenAsOccluderEdges) {
   // The person of PaintedWhereTheCylinderProjects: sides at 40 -+ asin(0.25 / 2) degrees.
-  CatadioptricCamera cam;
-  CameraPose pose;
-  pose.x = 1.0, pose.y = -0.5, pose.yaw = deg2rad(20.0), pose.height = 0.9;
-  Person p;
-  p.a = p.b = Eigen::Vector2d(pose.x + 2.0 * std::cos(deg2rad(60.0)),
-                              pose.y + 2.0 * std::sin(deg2rad(60.0)));
-  p.width = 0.5;
+  const auto [cam, pose, p] = person_2m_at_60_degrees();
   Person behind = p;  // walked through the camera: not seen, no edges
   behind.a = behind.b = Eigen::Vector2d(pose.x, pose.y);
   const auto edges = occluder_edges({behind, p}, 0.0, cam, pose);
