@@ -25,13 +25,13 @@ constexpr int kVoteBack = 3;
 }  // namespace
 
 bool Tracker::predict_from_position(const Slot& s, int j, TrackPrediction* p) const {
-  if (!options_.triangulate || std::isnan(camera_yaw_)) return false;
+  if (!options_.triangulate) return false;
   const LineGeometry& g = s.geometry[static_cast<std::size_t>(j)];
   if (std::isnan(g.px) || std::abs(odometry_.theta - g.p_theta) > kStraight) return false;
   const double dx = g.px - odometry_.x, dy = g.py - odometry_.y;
   const double distance = std::hypot(dx, dy);
   // Eq. (16) with the camera at the axle: u = beta + theta = atan2(...) - (phi + psi).
-  p->u = std::atan2(dy, dx) - camera_yaw_;
+  p->u = std::atan2(dy, dx) - g.p_yaw;
   const double u_before = s.bearings[static_cast<std::size_t>(j)] + s.odometry.theta;
   const double d_theta = odometry_.theta - g.p_theta;
   const double swing = 2.0 * options_.gate.max_camera_offset * std::abs(std::sin(0.5 * d_theta));
@@ -82,6 +82,7 @@ void Tracker::measure_track_geometry(const FrameFeatures& frame,
         g.px = px;
         g.py = py;
         g.p_theta = odometry_.theta;
+        g.p_yaw = camera_yaw_;
       }
     }
     if (!straight) {

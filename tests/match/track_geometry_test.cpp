@@ -192,5 +192,40 @@ TEST(Tracker, ThreeRaysThatMeetLinkANearLineAgain) {
   }
 }
 
+// A new value of the camera's yaw (a later estimate, here 1.15 degrees from the last) must not
+// turn the predictions of the lines already located: they were triangulated with the old yaw
+// and are predicted with it. Otherwise every prediction moves by the change, beyond track
+// continuity's 0.8 degree, and every track breaks at once. The near line's descriptor changes by
+// 0.9 in that frame, so that only its prediction can keep its track.
+TEST(Tracker, ANewCameraYawDoesNotTurnTheLinesAlreadyLocated) {
+  std::mt19937 rng(29);
+  std::vector<Eigen::RowVectorXf> d;
+  for (std::size_t k = 0; k < kPoints.size(); ++k) d.push_back(random_descriptor(rng));
+  const Eigen::RowVectorXf changed = at_distance(d[0], random_descriptor(rng), 0.9);
+  const double yaw = 0.3;
+  auto frame = [&](int f) {
+    return driven_past(f, yaw, 1, [&](std::size_t k) -> Eigen::RowVectorXf {
+      return k == 0 && f == 3 ? changed : perturb(d[k], 0.004f, rng);
+    });
+  };
+  TrackerOptions o = recommended_tracker_options(0.4);
+  o.triangulate = true;
+  o.predict_f1 = 1.05;
+  o.camera_yaw = yaw;
+  Tracker tracker(o);
+  std::vector<TrackAssignment> out0, out;
+  tracker.add_frame(frame(0), WheelIncrement{}, &out0);
+  for (int f = 1; f <= 3; ++f) {
+    if (f == 3) tracker.set_camera_yaw(yaw + 0.02);
+    tracker.add_frame(frame(f), WheelIncrement{0.1, 0.1}, &out);
+    SCOPED_TRACE(testing::Message() << "frame " << f);
+    for (std::size_t k = 0; k < kPoints.size(); ++k) {
+      EXPECT_EQ(out[k].track_id, out0[k].track_id) << "line " << k;
+      EXPECT_EQ(out[k].frames_back, 1) << "line " << k;
+    }
+  }
+  EXPECT_EQ(tracker.stats().linked_by_prediction, 1);
+}
+
 }  // namespace
 }  // namespace omnivert

@@ -203,6 +203,11 @@ class Tracker {
   // Same, without odometry (the gate must be off; std::invalid_argument otherwise).
   void add_frame(const FrameFeatures& frame, std::vector<TrackAssignment>* out);
 
+  // The camera's yaw on the robot (phi + psi, radians) from the next frame on, e.g. a running
+  // calibration's estimate; NaN: estimated by the tracker again (TrackerOptions::camera_yaw).
+  // The lines already located keep the yaw they were located with (Sec. 9.1's prediction).
+  void set_camera_yaw(double yaw) { options_.camera_yaw = yaw; }
+
   const TrackerOptions& options() const { return options_; }
   const TrackerStats& stats() const { return stats_; }
   std::int64_t frames_seen() const { return frame_count_; }
@@ -216,7 +221,10 @@ class Tracker {
   struct LineGeometry {
     static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
     double ax = kNaN, ay = kNaN, au = kNaN, a_theta = kNaN;
-    double px = kNaN, py = kNaN, p_theta = kNaN;
+    // The line's position (world), triangulated at heading p_theta with the camera's yaw
+    // p_yaw: the prediction uses that same yaw, so that a later estimate of the yaw does not
+    // turn every predicted bearing by its change.
+    double px = kNaN, py = kNaN, p_theta = kNaN, p_yaw = kNaN;
     bool fresh = false;  // the observation began its track
   };
   struct Slot {
