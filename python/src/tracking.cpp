@@ -122,6 +122,13 @@ void bind_tracker(py::module_& m) {
            py::arg("d_left") = 0.0,
            "The next frame's FrameFeatures (None: a frame that could not be read) and the wheel "
            "travel [m] since the previous frame; returns TrackAssignments.")
+      .def(
+          "set_camera_yaw",
+          [](PyTracker& t, double yaw) { t.tracker.set_camera_yaw(yaw); },
+          py::arg("yaw"),
+          "The camera's yaw on the robot (phi + psi) [rad] from the next frame on, e.g. a "
+          "running calibration's; nan: estimated by the tracker again. Lines already located "
+          "keep the yaw they were located with.")
       .def_property_readonly("stats",
                              [](const PyTracker& t) { return stats_dict(t.tracker.stats()); })
       .def_property_readonly("frames_seen",

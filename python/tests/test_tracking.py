@@ -45,6 +45,17 @@ def test_frame_by_frame_tracking_same_as_cli(short_run, tmp_path):
     # tracks.csv prints bearings with 9 decimals.
     assert [f"{b:.9f}" for _, _, b in got] == [e for _, _, e in expected]
     assert tracker.frames_seen == 12 and tracker.stats["lines"] == len(expected)
+    # The camera's yaw given from the start, as `track --camera-yaw`.
+    cli("track", short_run, "--out", tmp_path / "yaw", "--camera-yaw", "0.2")
+    with open(tmp_path / "yaw" / "tracks.csv", newline="") as f:
+        given = [(int(r["frame"]), int(r["track_id"])) for r in csv.DictReader(f)]
+    told = omnivert.Tracker(wheel_base=ds.wheel_base)
+    told.set_camera_yaw(0.2)
+    got = []
+    for i, (d_right, d_left) in enumerate(ds.increments):
+        ids = told.add_frame(pipe.process(ds.image(i)), d_right, d_left).track_ids
+        got += [(i, int(t)) for t in ids]
+    assert got == given
     # Without the wheel base the gate is off and the ids can differ, but every line is tracked.
     plain = omnivert.Tracker()
     assert len(plain.add_frame(pipe.process(ds.image(0)))) > 0
