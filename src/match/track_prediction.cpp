@@ -25,7 +25,7 @@ constexpr int kVoteBack = 3;
 }  // namespace
 
 bool Tracker::predict_from_position(const Slot& s, int j, TrackPrediction* p) const {
-  if (!options_.triangulate) return false;
+  if (!options_.triangulate || std::isnan(camera_yaw_)) return false;
   const LineGeometry& g = s.geometry[static_cast<std::size_t>(j)];
   if (std::isnan(g.px) || std::abs(odometry_.theta - g.p_theta) > kStraight) return false;
   const double dx = g.px - odometry_.x, dy = g.py - odometry_.y;
