@@ -121,10 +121,22 @@ Eigen::MatrixXd track_leverage(const InverseInformation& inv,
       for (int c2 = 0; c2 < ns; ++c2) Fs(a, c2) = inv.Finv(cols[a], cols[c2]);
     return Jc * Fs * Jc.transpose();
   }
-  Eigen::MatrixXd JcT = Eigen::MatrixXd::Zero(Jr.cols(), nc);
+  // P F P^T = L D L^T, so J_c F^-1 J_c^T = Y^T D^-1 Y with Y = L^-1 P J_c^T: the forward
+  // substitution alone. Y's rows before the first row P J_c^T touches are zero (L is lower
+  // triangular), and Eigen's sparse triangular solve skips the zero entries it meets.
+  const auto& P = inv.ldlt.permutationP();
+  Eigen::MatrixXd Y = Eigen::MatrixXd::Zero(Jr.cols(), nc);
+  Eigen::Index first = Y.rows();
   for (int k = 0; k < nc; ++k)
-    for (RowMajorJacobian::InnerIterator it(Jr, rows[k]); it; ++it) JcT(it.col(), k) = it.value();
-  return JcT.transpose() * inv.ldlt.solve(JcT);
+    for (RowMajorJacobian::InnerIterator it(Jr, rows[k]); it; ++it) {
+      const Eigen::Index r = P.indices()(it.col());
+      Y(r, k) = it.value();
+      first = std::min(first, r);
+    }
+  inv.ldlt.matrixL().solveInPlace(Y);
+  const Eigen::Index tail = Y.rows() - first;
+  const auto Yt = Y.bottomRows(tail);
+  return Yt.transpose() * inv.ldlt.vectorD().tail(tail).cwiseInverse().asDiagonal() * Yt;
 }
 
 // A track's share of the extrinsics' error, A J_c^T e_c, with its errors e_c estimated from
