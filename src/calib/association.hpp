@@ -31,9 +31,15 @@ bool share_a_frame(const std::vector<int>& a, const std::vector<int>& c);
 // of reject_crossings (`cache`), the columns of each feature once.
 struct FeatureCovariance {
   bool ready = false, ok = false;
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
-  std::map<int, int> column;              // track id -> first column
-  std::map<int, Eigen::MatrixXd> solved;  // track id -> F^-1 (:, its two columns)
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;  // P F P^T = L D L^T
+  std::map<int, int> column;                                // track id -> first column
+  // Track id -> L^-1 P E (E: its two columns of the identity) from row `first` on; the rows
+  // before are zero (L lower triangular). Cov(f_a - f_c) = (Y_a - Y_c)^T D^-1 (Y_a - Y_c).
+  struct Forward {
+    Eigen::Index first = 0;
+    Eigen::MatrixXd rows;
+  };
+  std::map<int, Forward> solved;
 };
 
 // The statistic itself (infinity when it cannot be computed).

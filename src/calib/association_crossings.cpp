@@ -44,18 +44,28 @@ double one_line_statistic(Built* b, int a, int c, FeatureCovariance* cache) {
     }
   }
   if (!cache->ok) return kNone;
-  auto columns = [cache](int id) -> const Eigen::MatrixXd& {
+  // The forward substitution alone (FeatureCovariance::Forward), each feature's once.
+  auto forward = [cache](int id) -> const FeatureCovariance::Forward& {
     auto it = cache->solved.find(id);
     if (it != cache->solved.end()) return it->second;
-    Eigen::MatrixXd E = Eigen::MatrixXd::Zero(cache->ldlt.rows(), 2);
-    E(cache->column.at(id), 0) = E(cache->column.at(id) + 1, 1) = 1.0;
-    return cache->solved[id] = cache->ldlt.solve(E);
+    const Eigen::Index n = cache->ldlt.rows();
+    const auto& P = cache->ldlt.permutationP();
+    const int col = cache->column.at(id);
+    const Eigen::Index r0 = P.indices()(col), r1 = P.indices()(col + 1);
+    Eigen::MatrixXd Y = Eigen::MatrixXd::Zero(n, 2);
+    Y(r0, 0) = Y(r1, 1) = 1.0;
+    cache->ldlt.matrixL().solveInPlace(Y);
+    const Eigen::Index first = std::min(r0, r1);
+    return cache->solved[id] = {first, Y.bottomRows(n - first)};
   };
-  const Eigen::MatrixXd& Xa = columns(a);
-  const Eigen::MatrixXd& Xc = columns(c);
-  const int ia = cache->column.at(a), ic = cache->column.at(c);
+  const FeatureCovariance::Forward& Ya = forward(a);
+  const FeatureCovariance::Forward& Yc = forward(c);
+  const Eigen::Index n = cache->ldlt.rows(), first = std::min(Ya.first, Yc.first);
+  Eigen::MatrixXd Yd = Eigen::MatrixXd::Zero(n - first, 2);
+  Yd.bottomRows(n - Ya.first) += Ya.rows;
+  Yd.bottomRows(n - Yc.first) -= Yc.rows;
   const Eigen::Matrix2d C =
-      Xa.middleRows<2>(ia) + Xc.middleRows<2>(ic) - Xa.middleRows<2>(ic) - Xc.middleRows<2>(ia);
+      Yd.transpose() * cache->ldlt.vectorD().tail(n - first).cwiseInverse().asDiagonal() * Yd;
   const std::array<double, 2>& fa = b->features.at(a);
   const std::array<double, 2>& fc = b->features.at(c);
   const Eigen::Vector2d d(fa[0] - fc[0], fa[1] - fc[1]);

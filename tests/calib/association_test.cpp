@@ -14,7 +14,9 @@
 
 #include <Eigen/Dense>
 
+#include "calib/association.hpp"
 #include "calib/batch_point.hpp"
+#include "calib/batch_problem.hpp"
 #include "calib/synthetic_run.hpp"
 #include "omnivert/calib/calibrate.hpp"
 #include "omnivert/calib/calibration_filter.hpp"
@@ -377,6 +379,51 @@ TEST(PiecesOfOneLine, AreJoinedOnlyWithTheirOwnLine) {
     EXPECT_EQ(m, n);
     EXPECT_EQ(r.num_bearings + static_cast<int>(r.guarded.size() + r.rejected.size()), n);
   }
+}
+
+// The one-line statistic from the forward substitution (FeatureCovariance) against the plain
+// computation: the dense inverse of the same information, d^T [F^-1]_dd^-1 d.
+TEST(OneLine, StatisticEqualsTheDenseInverse) {
+  using namespace internal;
+  SyntheticRunOptions so;
+  so.seed = 4;
+  so.bearing_sigma = deg2rad(0.03);
+  so.break_probability = 0.1;
+  const SyntheticRun run = make_synthetic_run(so);
+  Built b = build(run.run, options_for(so), truth_point(run), false);
+  ceres::Problem::EvaluateOptions eo;
+  eo.parameter_blocks = variable_blocks(b);
+  eo.apply_loss_function = false;
+  ceres::CRSMatrix crs;
+  ASSERT_TRUE(b.problem->Evaluate(eo, nullptr, nullptr, nullptr, &crs));
+  const Eigen::MatrixXd F(information_with_ridge(sparse_jacobian(crs)));
+  const Eigen::MatrixXd Finv = F.ldlt().solve(Eigen::MatrixXd::Identity(F.rows(), F.cols()));
+  std::map<int, int> column;
+  int col = 3 * (static_cast<int>(b.poses.size()) - 1);
+  for (const auto& [id, f] : b.features) {
+    column[id] = col;
+    col += 2;
+  }
+  ASSERT_GT(column.size(), 20u);
+  FeatureCovariance cache;
+  int compared = 0;
+  for (auto a = column.begin(); a != column.end(); ++a) {
+    auto c = a;
+    for (int k = 0; k < 3 && ++c != column.end(); ++k) {
+      const double got = one_line_statistic(&b, a->first, c->first, &cache);
+      const int ia = a->second, ic = c->second;
+      const Eigen::Matrix2d C = Finv.block<2, 2>(ia, ia) + Finv.block<2, 2>(ic, ic) -
+                                Finv.block<2, 2>(ia, ic) - Finv.block<2, 2>(ic, ia);
+      const auto& fa = b.features.at(a->first);
+      const auto& fc = b.features.at(c->first);
+      const Eigen::Vector2d d(fa[0] - fc[0], fa[1] - fc[1]);
+      const double want = d.dot(C.ldlt().solve(d));
+      ASSERT_TRUE(std::isfinite(want));
+      EXPECT_NEAR(got, want, 1e-6 * want) << a->first << " " << c->first;
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 60);
 }
 
 }  // namespace
