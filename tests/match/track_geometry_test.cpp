@@ -98,6 +98,24 @@ FrameFeatures driven_past(int f,
   return fr;
 }
 
+// The frames of the first test's scene at yaw 0.3 rad: every descriptor perturbed a little in
+// each frame, the near line's changed by 0.9 in frame 3.
+struct NearLineChangesInFrame3 {
+  static constexpr double kYaw = 0.3;
+  explicit NearLineChangesInFrame3(unsigned seed) : rng(seed) {
+    for (std::size_t k = 0; k < kPoints.size(); ++k) d.push_back(random_descriptor(rng));
+    changed = at_distance(d[0], random_descriptor(rng), 0.9);
+  }
+  FrameFeatures frame(int f) {
+    return driven_past(f, kYaw, 1, [&](std::size_t k) -> Eigen::RowVectorXf {
+      return k == 0 && f == 3 ? changed : perturb(d[k], 0.004f, rng);
+    });
+  }
+  std::mt19937 rng;
+  std::vector<Eigen::RowVectorXf> d;
+  Eigen::RowVectorXf changed;
+};
+
 // A near line (0.6 m ahead, 0.35 m to the left) passed at 10 cm a frame: its bearing turns by
 // 4.7, 6.2, then 8.2 degrees. In the last frame its descriptor has changed by 0.9 (beyond F1 and
 // the confirmed F1's tests). The rates of its last link predict it 2 degrees short, beyond track
@@ -110,17 +128,10 @@ TEST(Tracker, LinkByPredictionFollowsANearLineWhoseDescriptorChanged) {
     bool linked;
   };
   for (const Case c : {Case{false, 0.0, false}, Case{true, 1.05, true}, Case{true, 0.5, false}}) {
-    std::mt19937 rng(17);
+    NearLineChangesInFrame3 scene(17);
     const auto& points = kPoints;
-    std::vector<Eigen::RowVectorXf> d;
-    for (std::size_t k = 0; k < points.size(); ++k) d.push_back(random_descriptor(rng));
-    const Eigen::RowVectorXf changed = at_distance(d[0], random_descriptor(rng), 0.9);
-    const double yaw = 0.3;
-    auto frame = [&](int f) {
-      return driven_past(f, yaw, 1, [&](std::size_t k) -> Eigen::RowVectorXf {
-        return k == 0 && f == 3 ? changed : perturb(d[k], 0.004f, rng);
-      });
-    };
+    const double yaw = NearLineChangesInFrame3::kYaw;
+    auto frame = [&](int f) { return scene.frame(f); };
     TrackerOptions o = recommended_tracker_options(0.4);
     o.triangulate = c.triangulate;
     o.predict_f1 = c.predict_f1;
@@ -198,16 +209,9 @@ TEST(Tracker, ThreeRaysThatMeetLinkANearLineAgain) {
 // continuity's 0.8 degree, and every track breaks at once. The near line's descriptor changes by
 // 0.9 in that frame, so that only its prediction can keep its track.
 TEST(Tracker, ANewCameraYawDoesNotTurnTheLinesAlreadyLocated) {
-  std::mt19937 rng(29);
-  std::vector<Eigen::RowVectorXf> d;
-  for (std::size_t k = 0; k < kPoints.size(); ++k) d.push_back(random_descriptor(rng));
-  const Eigen::RowVectorXf changed = at_distance(d[0], random_descriptor(rng), 0.9);
-  const double yaw = 0.3;
-  auto frame = [&](int f) {
-    return driven_past(f, yaw, 1, [&](std::size_t k) -> Eigen::RowVectorXf {
-      return k == 0 && f == 3 ? changed : perturb(d[k], 0.004f, rng);
-    });
-  };
+  NearLineChangesInFrame3 scene(29);
+  const double yaw = NearLineChangesInFrame3::kYaw;
+  auto frame = [&](int f) { return scene.frame(f); };
   TrackerOptions o = recommended_tracker_options(0.4);
   o.triangulate = true;
   o.predict_f1 = 1.05;
