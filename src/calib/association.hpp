@@ -8,11 +8,13 @@
 #include <cstddef>
 #include <functional>
 #include <map>
+#include <memory>
 #include <utility>
 #include <vector>
 
 #include "calib/batch_point.hpp"
 #include "calib/batch_problem.hpp"
+#include "calib/factor_paths.hpp"
 #include "omnivert/calib/types.hpp"
 
 namespace omnivert::calib::internal {
@@ -33,13 +35,10 @@ struct FeatureCovariance {
   bool ready = false, ok = false;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;  // P F P^T = L D L^T
   std::map<int, int> column;                                // track id -> first column
-  // Track id -> L^-1 P E (E: its two columns of the identity) from row `first` on; the rows
-  // before are zero (L lower triangular). Cov(f_a - f_c) = (Y_a - Y_c)^T D^-1 (Y_a - Y_c).
-  struct Forward {
-    Eigen::Index first = 0;
-    Eigen::MatrixXd rows;
-  };
-  std::map<int, Forward> solved;
+  // Track id -> L^-1 P E (E: its two columns of the identity) on the rows it reaches.
+  // Cov(f_a - f_c) = (Y_a - Y_c)^T D^-1 (Y_a - Y_c).
+  std::unique_ptr<FactorPaths> paths;  // on `ldlt`
+  std::map<int, FactorPaths::Forward> solved;
 };
 
 // The statistic itself (infinity when it cannot be computed).

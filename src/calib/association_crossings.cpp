@@ -44,28 +44,20 @@ double one_line_statistic(Built* b, int a, int c, FeatureCovariance* cache) {
     }
   }
   if (!cache->ok) return kNone;
-  // The forward substitution alone (FeatureCovariance::Forward), each feature's once.
-  auto forward = [cache](int id) -> const FeatureCovariance::Forward& {
+  if (!cache->paths) cache->paths = std::make_unique<FactorPaths>(cache->ldlt);
+  // The forward substitution alone (FeatureCovariance::solved), each feature's once.
+  auto forward = [cache](int id) -> const FactorPaths::Forward& {
     auto it = cache->solved.find(id);
     if (it != cache->solved.end()) return it->second;
-    const Eigen::Index n = cache->ldlt.rows();
-    const auto& P = cache->ldlt.permutationP();
     const int col = cache->column.at(id);
-    const Eigen::Index r0 = P.indices()(col), r1 = P.indices()(col + 1);
-    Eigen::MatrixXd Y = Eigen::MatrixXd::Zero(n, 2);
-    Y(r0, 0) = Y(r1, 1) = 1.0;
-    cache->ldlt.matrixL().solveInPlace(Y);
-    const Eigen::Index first = std::min(r0, r1);
-    return cache->solved[id] = {first, Y.bottomRows(n - first)};
+    return cache->solved[id] = cache->paths->solve({{{col, 1.0}}, {{col + 1, 1.0}}});
   };
-  const FeatureCovariance::Forward& Ya = forward(a);
-  const FeatureCovariance::Forward& Yc = forward(c);
-  const Eigen::Index n = cache->ldlt.rows(), first = std::min(Ya.first, Yc.first);
-  Eigen::MatrixXd Yd = Eigen::MatrixXd::Zero(n - first, 2);
-  Yd.bottomRows(n - Ya.first) += Ya.rows;
-  Yd.bottomRows(n - Yc.first) -= Yc.rows;
+  const FactorPaths::Forward& Ya = forward(a);
+  const FactorPaths::Forward& Yc = forward(c);
+  // Cov(f_a - f_c) = Ya^T D^-1 Ya + Yc^T D^-1 Yc - (Ya^T D^-1 Yc + its transpose).
+  const Eigen::Matrix2d ac = cache->paths->gram(Ya, Yc);
   const Eigen::Matrix2d C =
-      Yd.transpose() * cache->ldlt.vectorD().tail(n - first).cwiseInverse().asDiagonal() * Yd;
+      cache->paths->gram(Ya, Ya) + cache->paths->gram(Yc, Yc) - ac - ac.transpose();
   const std::array<double, 2>& fa = b->features.at(a);
   const std::array<double, 2>& fc = b->features.at(c);
   const Eigen::Vector2d d(fa[0] - fc[0], fa[1] - fc[1]);

@@ -1,6 +1,8 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Cholesky>
@@ -8,6 +10,7 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
+#include "calib/factor_paths.hpp"
 #include "calib/noise_check.hpp"
 
 namespace omnivert::calib::internal {
@@ -97,6 +100,7 @@ bool invert_information(const Eigen::SparseMatrix<double>& F,
 
 // Leverage of a track (its rows): H_cc = J_c F^-1 J_c^T (nc x nc).
 Eigen::MatrixXd track_leverage(const InverseInformation& inv,
+                               FactorPaths* paths,
                                const RowMajorJacobian& Jr,
                                const std::vector<int>& rows) {
   const int nc = static_cast<int>(rows.size());
@@ -122,21 +126,13 @@ Eigen::MatrixXd track_leverage(const InverseInformation& inv,
     return Jc * Fs * Jc.transpose();
   }
   // P F P^T = L D L^T, so J_c F^-1 J_c^T = Y^T D^-1 Y with Y = L^-1 P J_c^T: the forward
-  // substitution alone. Y's rows before the first row P J_c^T touches are zero (L is lower
-  // triangular), and Eigen's sparse triangular solve skips the zero entries it meets.
-  const auto& P = inv.ldlt.permutationP();
-  Eigen::MatrixXd Y = Eigen::MatrixXd::Zero(Jr.cols(), nc);
-  Eigen::Index first = Y.rows();
+  // substitution alone, over the rows it reaches (factor_paths.hpp).
+  std::vector<std::vector<std::pair<int, double>>> columns(nc);
   for (int k = 0; k < nc; ++k)
-    for (RowMajorJacobian::InnerIterator it(Jr, rows[k]); it; ++it) {
-      const Eigen::Index r = P.indices()(it.col());
-      Y(r, k) = it.value();
-      first = std::min(first, r);
-    }
-  inv.ldlt.matrixL().solveInPlace(Y);
-  const Eigen::Index tail = Y.rows() - first;
-  const auto Yt = Y.bottomRows(tail);
-  return Yt.transpose() * inv.ldlt.vectorD().tail(tail).cwiseInverse().asDiagonal() * Yt;
+    for (RowMajorJacobian::InnerIterator it(Jr, rows[k]); it; ++it)
+      columns[k].emplace_back(static_cast<int>(it.col()), it.value());
+  const FactorPaths::Forward y = paths->solve(columns);
+  return paths->gram(y, y);
 }
 
 // A track's share of the extrinsics' error, A J_c^T e_c, with its errors e_c estimated from
@@ -167,6 +163,8 @@ BatchNoiseCheck noise_check(Built& b, int dense_limit) {
   const Eigen::SparseMatrix<double> F = information_with_ridge(J);
   InverseInformation inv;
   if (!invert_information(F, dense_limit, &inv)) return out;
+  std::optional<FactorPaths> paths;
+  if (!inv.dense) paths.emplace(inv.ldlt);
   const Eigen::Matrix3d model = inv.At.bottomRows<3>();
   const Eigen::MatrixXd U = J * inv.At;  // m x 3: row i is A J_i^T
   const int next = static_cast<int>(rows.rows_of.size());
@@ -182,7 +180,7 @@ BatchNoiseCheck noise_check(Built& b, int dense_limit) {
     // errors (Bell and McCaffrey's bias-reduced sandwich, "CR2": unbiased when the model is
     // right; the jackknife's (I - H_cc)^-1 gives 2.8 times the model's covariance on white
     // bearings with 10 tracks).
-    const Eigen::MatrixXd H = track_leverage(inv, Jr, of_c);
+    const Eigen::MatrixXd H = track_leverage(inv, paths ? &*paths : nullptr, Jr, of_c);
     Eigen::VectorXd rc(nc);
     Eigen::MatrixXd Uc(nc, 3);
     for (int k = 0; k < nc; ++k) {
