@@ -11,6 +11,7 @@
 #include <Eigen/SparseCore>
 
 #include "calib/factor_paths.hpp"
+#include "calib/lanczos.hpp"
 #include "calib/noise_check.hpp"
 
 namespace omnivert::calib::internal {
@@ -153,16 +154,44 @@ Eigen::Vector3d track_score(const Eigen::MatrixXd& H,
   return Uc.transpose() * e;
 }
 
+// track_score without H_cc: (I - H_cc)^-1/2 r_c by the Lanczos iteration on products
+// (I - H_cc) v = v - J_c F^-1 J_c^T v, each a solve with the whole factor; its cost grows with
+// the track's length, not with its cube. Empty when the iteration did not converge.
+std::optional<Eigen::Vector3d> long_track_score(const InverseInformation& inv,
+                                                const RowMajorJacobian& Jr,
+                                                const std::vector<int>& rows,
+                                                const Eigen::VectorXd& rc,
+                                                const Eigen::MatrixXd& Uc) {
+  const int nc = static_cast<int>(rows.size());
+  auto apply = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd {
+    Eigen::VectorXd g = Eigen::VectorXd::Zero(Jr.cols());
+    for (int k = 0; k < nc; ++k)
+      for (RowMajorJacobian::InnerIterator it(Jr, rows[k]); it; ++it)
+        g(it.col()) += it.value() * v(k);
+    const Eigen::VectorXd x =
+        inv.dense ? Eigen::VectorXd(inv.Finv * g) : Eigen::VectorXd(inv.ldlt.solve(g));
+    Eigen::VectorXd out = v;
+    for (int k = 0; k < nc; ++k)
+      for (RowMajorJacobian::InnerIterator it(Jr, rows[k]); it; ++it)
+        out(k) -= it.value() * x(it.col());
+    return out;
+  };
+  // The floor and the null directions as in track_score.
+  const LanczosResult e = lanczos_inverse_sqrt(apply, rc, 1e-6, 1e-10, 400);
+  if (!e.converged || !e.x.allFinite()) return std::nullopt;
+  return Eigen::Vector3d(Uc.transpose() * e.x);
+}
+
 }  // namespace
 
-BatchNoiseCheck noise_check(Built& b, int dense_limit) {
+BatchNoiseCheck noise_check(Built& b, const NoiseCheckOptions& options) {
   BatchNoiseCheck out;
   ClusteredRows rows;
   if (!evaluate_clusters(b, &rows)) return out;
   const Eigen::SparseMatrix<double> J = sparse_jacobian(rows.crs);
   const Eigen::SparseMatrix<double> F = information_with_ridge(J);
   InverseInformation inv;
-  if (!invert_information(F, dense_limit, &inv)) return out;
+  if (!invert_information(F, options.dense_limit, &inv)) return out;
   std::optional<FactorPaths> paths;
   if (!inv.dense) paths.emplace(inv.ldlt);
   const Eigen::Matrix3d model = inv.At.bottomRows<3>();
@@ -173,14 +202,13 @@ BatchNoiseCheck noise_check(Built& b, int dense_limit) {
   const RowMajorJacobian Jr(J);
   for (int c = rows.first_track; c < next; ++c) {
     const std::vector<int>& of_c = rows.rows_of[c];
-    const int nc = static_cast<int>(of_c.size());
     // The fitted residuals are (I - H) e, and the shared variables (poses, extrinsics) take
     // up a good part of a track's errors (on white synthetic bearings the plain sum gives a
     // tenth of the model's covariance), so (I - H_cc)^-1/2 r_c stands in for the track's
     // errors (Bell and McCaffrey's bias-reduced sandwich, "CR2": unbiased when the model is
     // right; the jackknife's (I - H_cc)^-1 gives 2.8 times the model's covariance on white
     // bearings with 10 tracks).
-    const Eigen::MatrixXd H = track_leverage(inv, paths ? &*paths : nullptr, Jr, of_c);
+    const int nc = static_cast<int>(of_c.size());
     Eigen::VectorXd rc(nc);
     Eigen::MatrixXd Uc(nc, 3);
     for (int k = 0; k < nc; ++k) {
@@ -188,8 +216,10 @@ BatchNoiseCheck noise_check(Built& b, int dense_limit) {
       Uc.row(k) = U.row(of_c[k]);
     }
     bearing_model += Uc.transpose() * Uc;
-    const Eigen::Vector3d sc = track_score(H, rc, Uc);
-    clustered += sc * sc.transpose();
+    std::optional<Eigen::Vector3d> sc;
+    if (nc > options.dense_track_limit) sc = long_track_score(inv, Jr, of_c, rc, Uc);
+    if (!sc) sc = track_score(track_leverage(inv, paths ? &*paths : nullptr, Jr, of_c), rc, Uc);
+    clustered += *sc * sc->transpose();
   }
   const Eigen::LDLT<Eigen::Matrix3d> bi(bearing_model);
   if (bi.info() != Eigen::Success || !(bearing_model.trace() > 0.0)) return out;

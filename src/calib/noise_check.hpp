@@ -28,6 +28,7 @@ WheelCheck wheel_check(const Built& b,
 // factor). A track's own feature point absorbs the part of its errors along its own columns
 // of J, and that part does not reach the extrinsics (A F_{:,f} = 0), so the fitted residuals
 // stand in for the true errors up to the leverage of the shared variables.
-BatchNoiseCheck noise_check(Built& b, int dense_limit);
+// options: dense_limit and leverage_block (NoiseCheckOptions).
+BatchNoiseCheck noise_check(Built& b, const NoiseCheckOptions& options);
 
 }  // namespace omnivert::calib::internal

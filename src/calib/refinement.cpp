@@ -240,7 +240,7 @@ RefinementResult refine_batch(const CalibrationRun& run,
   res.num_features = static_cast<int>(b.features.size());
   res.bearing_residual_sigma =
       bearing_residual_sigma(b, res.num_features, options.noise.bearing_sigma);
-  res.noise = noise_check(b, options.noise_check.dense_limit);
+  res.noise = noise_check(b, options.noise_check);
   res.noise.wheels = wheel_check(b, run, options);
   res.converged = summary.termination_type == ceres::CONVERGENCE;
   res.initial_cost = summary.initial_cost;

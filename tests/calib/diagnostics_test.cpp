@@ -267,6 +267,33 @@ TEST(NoiseCheck, DenseAndSparseLeverageAgree) {
         d.noise.covariance(i, i), s.noise.covariance(i, i), 1e-6 * d.noise.covariance(i, i));
 }
 
+// A long track's (I - H_cc)^-1/2 r_c by the Lanczos iteration (NoiseCheckOptions::
+// dense_track_limit) against the eigen-decomposition of H_cc: 10 lines each seen over the
+// whole ~170-frame run, every track taken the long way; dense and sparse inverses.
+TEST(NoiseCheck, LongTracksByLanczosEqualTheDecomposition) {
+  for (const std::uint64_t seed : {3u, 9u}) {
+    SyntheticRunOptions so;
+    so.bearing_sigma = deg2rad(0.05);
+    so.bearing_correlation = 0.5;
+    so.seed = seed;
+    const SyntheticRun run = make_synthetic_run(so);
+    const RefinementResult exact = refine_batch(run.run, options_for(so), truth_point(run));
+    ASSERT_TRUE(exact.noise.ok);
+    for (const int dense_limit : {3000, 0}) {
+      CalibrationOptions o = options_for(so);
+      o.noise_check.dense_track_limit = 0;
+      o.noise_check.dense_limit = dense_limit;
+      const RefinementResult l = refine_batch(run.run, o, truth_point(run));
+      ASSERT_TRUE(l.noise.ok);
+      EXPECT_EQ(l.noise.clusters, exact.noise.clusters);
+      EXPECT_NEAR(l.noise.scale, exact.noise.scale, 1e-8 * exact.noise.scale)
+          << "seed " << seed << " dense_limit " << dense_limit;
+      EXPECT_LT((l.noise.bearing_clustered - exact.noise.bearing_clustered).norm(),
+                1e-8 * exact.noise.bearing_clustered.norm());
+    }
+  }
+}
+
 // Bearings twice as noisy as assumed: the variance is four times the model's. Without the
 // outlier gate and the track splitting, whose thresholds are in assumed sigmas: at the
 // default gate (3.3 sigmas) a tenth of these bearings would be cut off and the rest would
