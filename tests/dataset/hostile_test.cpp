@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <string>
 #include <vector>
@@ -344,6 +345,39 @@ TEST_F(HostileTest, FileOfNoImageFormatIsRefusedBeforeDecoding) {
   EXPECT_EQ(read_image(p("ok.png")).cols, 5);
   cv::imwrite(p("ok.pgm"), cv::Mat(4, 5, CV_8UC1, cv::Scalar(7)));
   EXPECT_EQ(read_image(p("ok.pgm")).rows, 4);
+}
+
+// The second file the image harness found starts "P55": PNM-like to a two-byte test, refused
+// by OpenCV's PNM decoder, and then claimed by the DICOM reader ("DICM" at byte 128), which
+// aborts. Every start that read_image lets through must be claimed by its own decoder: the
+// file's DICOM tail behind each accepted signature is refused with an InputError (an abort
+// here ends the test program).
+TEST_F(HostileTest, NoAcceptedSignatureLetsAFileThroughToTheDicomReader) {
+  const std::string found = OMNIVERT_FUZZ_DIR "/regressions/image/gdcm-assertion-pnm-like.bin";
+  std::ifstream in(found, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(bytes.size(), 132u);
+  ASSERT_EQ(bytes.substr(128, 4), "DICM");
+  EXPECT_THAT(error_of([&] { return read_image(found); }),
+              ::testing::HasSubstr("not a readable image (it does not start with the signature"));
+  const std::vector<std::string> starts = {std::string("\x89PNG\r\n\x1a\n", 8),
+                                           "\xff\xd8\xff",
+                                           std::string("II*\0", 4),
+                                           std::string("MM\0*", 4),
+                                           "BM",
+                                           "P5 ",
+                                           "P6\n",
+                                           "P1\t"};
+  for (const std::string& start : starts) {
+    std::string file = bytes;
+    file.replace(0, start.size(), start);
+    const std::string path = p("hostile.img");
+    {
+      std::ofstream out(path, std::ios::binary);
+      out << file;
+    }
+    EXPECT_NE(error_of([&] { return read_image(path); }), "(no error)") << start;
+  }
 }
 
 }  // namespace
