@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -38,6 +39,10 @@ ceres::Solver::Options solver_options(const RefinementOptions& refinement) {
   so.logging_type = ceres::SILENT;
   so.minimizer_progress_to_stdout = false;
   return so;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
 // One solve of the batch problem, logged at debug level (iterations, cost, time).
@@ -240,8 +245,10 @@ RefinementResult refine_batch(const CalibrationRun& run,
   res.num_features = static_cast<int>(b.features.size());
   res.bearing_residual_sigma =
       bearing_residual_sigma(b, res.num_features, options.noise.bearing_sigma);
+  const auto t_check = std::chrono::steady_clock::now();
   res.noise = noise_check(b, options.noise_check);
   res.noise.wheels = wheel_check(b, run, options);
+  spdlog::debug("refinement noise check: {:.2f} s", seconds_since(t_check));
   res.converged = summary.termination_type == ceres::CONVERGENCE;
   res.initial_cost = summary.initial_cost;
   res.final_cost = summary.final_cost;
@@ -251,8 +258,10 @@ RefinementResult refine_batch(const CalibrationRun& run,
   res.solution = point_of(b);
   res.extrinsics = res.solution.extrinsics;
   double time_offset_variance = std::numeric_limits<double>::quiet_NaN();
-  if (extrinsics_covariance(&b, &res.covariance, &time_offset_variance))
-    res.covariance_ok = res.covariance.allFinite();
+  const auto t_covariance = std::chrono::steady_clock::now();
+  const bool covariance = extrinsics_covariance(&b, &res.covariance, &time_offset_variance);
+  spdlog::debug("refinement covariance: {:.2f} s", seconds_since(t_covariance));
+  if (covariance) res.covariance_ok = res.covariance.allFinite();
   if (!res.covariance_ok && !b.time_offset.empty() &&
       marginal_with_time_offset(&b, &res.covariance, &time_offset_variance)) {
     res.covariance_ok = true;
