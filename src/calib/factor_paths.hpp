@@ -40,8 +40,6 @@ class FactorPaths {
   // Y_a^T D^-1 Y_c over the rows both have (the others contribute zero).
   Eigen::MatrixXd gram(const Forward& a, const Forward& c) const;
 
-  int size() const { return static_cast<int>(parent_.size()); }
-
  private:
   const Factor& factor_;
   std::vector<int> parent_;  // elimination tree; -1 at a root

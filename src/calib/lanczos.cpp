@@ -38,12 +38,9 @@ LanczosResult lanczos_inverse_sqrt(
     alpha.push_back(a);
     const double b_next = w.norm();
     // x_j = ||b|| Q_j f(T_j) e_1, T_j the tridiagonal (alpha, beta) of order j + 1.
-    Eigen::MatrixXd T = Eigen::MatrixXd::Zero(j + 1, j + 1);
-    for (int i = 0; i <= j; ++i) {
-      T(i, i) = alpha[i];
-      if (i < j) T(i, i + 1) = T(i + 1, i) = beta[i];
-    }
-    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(T);
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es;
+    es.computeFromTridiagonal(Eigen::Map<const Eigen::VectorXd>(alpha.data(), j + 1),
+                              Eigen::Map<const Eigen::VectorXd>(beta.data(), j));
     Eigen::VectorXd f(j + 1);
     for (int i = 0; i <= j; ++i) {
       const double theta = es.eigenvalues()(i);

@@ -28,7 +28,7 @@ WheelCheck wheel_check(const Built& b,
 // factor). A track's own feature point absorbs the part of its errors along its own columns
 // of J, and that part does not reach the extrinsics (A F_{:,f} = 0), so the fitted residuals
 // stand in for the true errors up to the leverage of the shared variables.
-// options: dense_limit and leverage_block (NoiseCheckOptions).
+// options: dense_limit and dense_track_limit (NoiseCheckOptions).
 BatchNoiseCheck noise_check(Built& b, const NoiseCheckOptions& options);
 
 }  // namespace omnivert::calib::internal
