@@ -227,7 +227,7 @@ void TiltRectifier::apply(const cv::Mat& gray, const MirrorCircle& circle, cv::M
       }
     }
   }
-  cv::remap(gray, out, mx_, my_, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  cv::remap(gray, out, mx_, my_, cv::INTER_CUBIC, cv::BORDER_REPLICATE);
 }
 
 double upright_bearing(const CameraGeometry& g,

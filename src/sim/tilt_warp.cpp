@@ -55,7 +55,7 @@ TiltWarp::TiltWarp(const CatadioptricCamera& camera,
 void TiltWarp::render(const CameraPose& pose, const cv::Mat1f& background, cv::Mat1f& image) const {
   cv::Mat1f src, warped;
   upright_->render(pose, src);
-  cv::remap(src, warped, map_x_, map_y_, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  cv::remap(src, warped, map_x_, map_y_, cv::INTER_CUBIC, cv::BORDER_REPLICATE);
   background.copyTo(image);
   for (std::size_t k = 0; k < px_index_.size(); ++k) {
     const int idx = px_index_[k];

@@ -2,7 +2,7 @@
 // Rendering with a tilted mirror axis (docs/simulator.md#tilt, docs/theory/tilt.md). The
 // world is rendered by an upright camera of the same model (mirror axis vertical, the
 // renderer's exact method) over a slightly wider annulus; each pixel of the tilted camera
-// then takes the upright image's value (bilinear) at the pixel of its own viewing
+// then takes the upright image's value (bicubic) at the pixel of its own viewing
 // direction rotated into the upright frame: d_V = R_VC d_C (core/tilt.hpp).
 
 #include <memory>

@@ -99,7 +99,7 @@ class TiltEstimator {
   int frames_ = 0;
 };
 
-// The upright image of a tilted camera: each pixel of the output takes the value (bilinear)
+// The upright image of a tilted camera: each pixel of the output takes the value (bicubic)
 // of the input at the pixel of its viewing direction rotated into the camera frame, s_C =
 // R_VC(x)^T s_V. Pixels outside r_min - 4 .. r_max + 4 are copied. Needs has_projection().
 // The pixel maps are kept while the circle stays the same (a centre given in sensor.yaml).
