@@ -175,9 +175,8 @@ void run_calibrate(CLI::App* cmd, const CalibrateArgs& a) {
                    o.calibration.refinement.enabled ? " and refinement" : "");
   };
   const pipeline::CalibrateDatasetResult r = pipeline::calibrate_dataset(dataset, a.out, o);
-  if (r.tilt.valid) {
-    std::printf("%s%s\n", r.tilt.describe().c_str(), r.tilt_corrected ? "; frames rectified" : "");
-  }
+  if (const std::string t = pipeline::tilt_line(r.tilt, r.tilt_corrected); !t.empty())
+    std::printf("%s\n", t.c_str());
   std::printf("%s", r.BriefReport().c_str());
   if (!r.streaming_message.empty()) std::printf("%s\n", r.streaming_message.c_str());
   if (o.tracks_file.empty() && tracking_s > 0 && !o.streaming)

@@ -75,9 +75,8 @@ void run_track(CLI::App* cmd, const TrackArgs& a) {
               r.rows.size(),
               static_cast<long long>(r.stats.new_tracks),
               r.stats.BriefReport().c_str());
-  if (r.tilt.valid) {
-    std::printf("%s%s\n", r.tilt.describe().c_str(), r.tilt_corrected ? "; frames rectified" : "");
-  }
+  if (const std::string t = pipeline::tilt_line(r.tilt, r.tilt_corrected); !t.empty())
+    std::printf("%s\n", t.c_str());
   std::printf("%s\n", throughput(r.frames, took.count(), resolve_threads(a.threads)).c_str());
   std::printf("wrote %s and %s\n", csv.c_str(), png.c_str());
 }

@@ -65,6 +65,17 @@ inline void add_tilt_options(CLI::App* cmd, pipeline::TiltCheckOptions& o) {
                   "Rectify the frames when the measured tilt exceeds this [deg] (90: never)")
       ->capture_default_str()
       ->group(g);
+  cmd->add_option("--tilt-deg",
+                  o.given_deg,
+                  "The mirror axis's tilt when known [deg]: the frames are rectified with it and "
+                  "it is not measured (0: measure it)")
+      ->check(CLI::Range(0.0, 29.9))
+      ->group(g);
+  cmd->add_option("--tilt-direction-deg",
+                  o.given_direction_deg,
+                  "The camera bearing the given tilt leans towards [deg]")
+      ->check(CLI::Range(-360.0, 360.0))
+      ->group(g);
 }
 
 inline void add_pipeline_options(CLI::App* cmd, FeaturePipelineOptions& o) {

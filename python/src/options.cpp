@@ -328,6 +328,14 @@ const OptionTable<DO>& dataset_job_table() {
           "tilt_correct_above", "rectify the frames above this tilt [deg]", [](DO & o) -> auto& {
             return o.tilt.correct_deg;
           }),
+      field<double, DO>(
+          "tilt_deg",
+          "the tilt when known [deg]: rectified with it, not measured (0: measure)",
+          [](DO & o) -> auto& { return o.tilt.given_deg; }),
+      field<double, DO>(
+          "tilt_direction_deg",
+          "the camera bearing the given tilt leans towards [deg]",
+          [](DO & o) -> auto& { return o.tilt.given_direction_deg; }),
       field<std::string, DO>(
           "base_frame", "the robot's frame in the robot-format files", [](DO & o) -> auto& {
             return o.frames.base;
@@ -364,6 +372,14 @@ const OptionTable<pipeline::TrackDatasetOptions>& track_job_table() {
           "tilt_correct_above", "rectify the frames above this tilt [deg]", [](TD & o) -> auto& {
             return o.tilt.correct_deg;
           }),
+      field<double, TD>(
+          "tilt_deg",
+          "the tilt when known [deg]: rectified with it, not measured (0: measure)",
+          [](TD & o) -> auto& { return o.tilt.given_deg; }),
+      field<double, TD>(
+          "tilt_direction_deg",
+          "the camera bearing the given tilt leans towards [deg]",
+          [](TD & o) -> auto& { return o.tilt.given_direction_deg; }),
   };
   return t;
 }

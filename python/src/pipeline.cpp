@@ -249,7 +249,8 @@ void bind_pipeline(py::module_& m) {
         "The lines of a dataset tracked, as `omnivert track DATASET --out OUT` (tracks.csv and "
         "tracks.png written into out when given): a dict with tracks (tracks.csv's columns as "
         "arrays), stats, frames, frames_skipped, warnings. Keyword options: the extraction's, "
-        "rules and the tracker's, mask, tilt_check, tilt_correct_above (as calibrate_dataset).");
+        "rules and the tracker's, mask, tilt_check, tilt_correct_above, tilt_deg, "
+        "tilt_direction_deg (as calibrate_dataset).");
   m.def("simulate",
         &simulate,
         py::arg("out"),

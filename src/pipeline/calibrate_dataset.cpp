@@ -357,6 +357,8 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
   r.time_offset_message =
       time_offset_line(r.time_offset, r.time_offset_given, r.time_offset_applied, o.time_offset);
   ri.time_offset = time_offset_report(r);
+  ri.tilt = r.tilt;
+  ri.tilt_rectified = r.tilt_corrected;
   reprojection_check(data, tracked.rows, opt.prior.mean, result.extrinsics, o, ri, r);
   if (streamed) {
     internal::write_streaming_csv((out / "streaming.csv").string(), streamed->estimates);

@@ -224,6 +224,20 @@ json inputs_json(const calib::CalibrationResult& r, const ReportInputs& in) {
     inputs["frames_dropped_for_wheel_gaps"] = in.run->frames_dropped_for_gaps;
     inputs["frames_with_too_few_lines"] = in.run->starved_frames;
   }
+  {
+    const TiltEstimate& t = in.tilt;
+    const bool given = in.tilt_rectified && !t.valid;
+    inputs["tilt"] = {{"source",
+                       t.valid ? "measured"
+                       : given ? "given"
+                               : "not measured"},
+                      {"tilt_deg", t.valid || given ? num(t.tilt_deg()) : json(nullptr)},
+                      {"direction_deg", t.valid || given ? num(t.direction_deg()) : json(nullptr)},
+                      {"sigma_deg", t.valid ? num(rad2deg(t.sigma)) : json(nullptr)},
+                      {"lines", t.lines},
+                      {"frames", t.frames},
+                      {"rectified", in.tilt_rectified}};
+  }
   inputs["wheel_base_m"] = num(in.options.robot.wheel_base);
   inputs["odometry_K_m"] = num(in.options.robot.odometry_K);
   inputs["odometry_inflation"] = num(in.options.filter.odometry_inflation);

@@ -1,28 +1,35 @@
 #include "omnivert/pipeline/tilt_check.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 
 #include "omnivert/core/error.hpp"
+#include "omnivert/core/tilt.hpp"
 
 namespace omnivert::pipeline {
 
 bool TiltCheckOptions::IsValid(std::string* why) const {
-  if (frames < 1 || !(correct_deg >= 0.0) || !(lateral_tolerance_px > 0.0)) {
-    if (why) *why = "tilt check: need frames >= 1, correct_deg >= 0, lateral_tolerance_px > 0";
+  if (frames < 1 || passes < 1 || !(given_deg >= 0.0 && given_deg < 30.0) ||
+      !std::isfinite(given_direction_deg) || !(correct_deg >= 0.0) ||
+      !(lateral_tolerance_px > 0.0)) {
+    if (why)
+      *why =
+          "tilt check: need frames >= 1, passes >= 1, correct_deg >= 0, "
+          "lateral_tolerance_px > 0 and a given tilt in [0, 30) deg";
     return false;
   }
   return estimator.IsValid(why);
 }
 
-TiltEstimate measure_tilt(const dataset::Dataset& data,
-                          const FeaturePipelineOptions& pipeline,
+namespace {
+
+// One pass: the tilt left on `options.frames` frames spread over the dataset after the
+// pipeline's own rectification (po.tilt; zero: the frames as they are).
+TiltEstimate measure_once(const dataset::Dataset& data,
+                          const FeaturePipelineOptions& po,
                           const TiltCheckOptions& options) {
   TiltEstimator estimator(data.camera(), options.estimator);
-  if (!data.camera().has_projection() || data.size() == 0) return estimator.estimate();
-  FeaturePipelineOptions po = pipeline;
-  po.tilt.setZero();
-  po.lines.lateral_tolerance_px =
-      std::max(po.lines.lateral_tolerance_px, options.lateral_tolerance_px);
   FeaturePipeline pipe(data.camera(), po);
   const std::size_t n =
       std::min<std::size_t>(static_cast<std::size_t>(options.frames), data.size());
@@ -37,6 +44,56 @@ TiltEstimate measure_tilt(const dataset::Dataset& data,
     estimator.add_frame(pipe.line_extractor().last_edge_points(), f.circle, f.lines);
   }
   return estimator.estimate();
+}
+
+// The tilt vector of R(second) R(first): the first rectification, then what was left.
+Eigen::Vector2d compose(const Eigen::Vector2d& first, const Eigen::Vector2d& second) {
+  const Eigen::Vector3d axis =
+      tilt_rotation_of_vector(second) * tilt_rotation_of_vector(first) * Eigen::Vector3d::UnitZ();
+  const double h = std::hypot(axis.x(), axis.y());
+  if (h == 0.0) return Eigen::Vector2d::Zero();
+  return std::atan2(h, axis.z()) / h * Eigen::Vector2d(axis.x(), axis.y());
+}
+
+}  // namespace
+
+Eigen::Vector2d TiltCheckOptions::given_vector() const {
+  if (!(given_deg > 0.0)) return Eigen::Vector2d::Zero();
+  const double t = given_deg * M_PI / 180.0, d = given_direction_deg * M_PI / 180.0;
+  return t * Eigen::Vector2d(std::cos(d), std::sin(d));
+}
+
+TiltEstimate measure_tilt(const dataset::Dataset& data,
+                          const FeaturePipelineOptions& pipeline,
+                          const TiltCheckOptions& options) {
+  if (!data.camera().has_projection() || data.size() == 0)
+    return TiltEstimator(data.camera(), options.estimator).estimate();
+  // Pass 1: a wider line support keeps a curved vertical whole (docs/theory/tilt.md).
+  FeaturePipelineOptions po = pipeline;
+  po.tilt.setZero();
+  po.lines.lateral_tolerance_px =
+      std::max(po.lines.lateral_tolerance_px, options.lateral_tolerance_px);
+  TiltEstimate tilt = measure_once(data, po, options);
+  // Pass 2, when the frames will be rectified: what is left on them, with the usual support.
+  if (options.passes < 2 || !tilt.valid || tilt.tilt_deg() <= options.correct_deg) return tilt;
+  po = pipeline;
+  po.tilt = tilt.vector;
+  TiltEstimate rest = measure_once(data, po, options);
+  if (!rest.valid) return tilt;
+  rest.vector = compose(tilt.vector, rest.vector);
+  return rest;
+}
+
+std::string tilt_line(const TiltEstimate& tilt, bool rectified) {
+  if (tilt.valid) return tilt.describe() + (rectified ? "; frames rectified" : "");
+  if (!rectified) return {};
+  char buf[128];
+  std::snprintf(buf,
+                sizeof buf,
+                "frames rectified with the given tilt, %.2f deg towards bearing %.1f deg",
+                tilt.tilt_deg(),
+                tilt.direction_deg());
+  return buf;
 }
 
 std::string tilt_warning(const TiltEstimate& tilt,

@@ -28,7 +28,11 @@ TrackDatasetResult track_dataset(const dataset::Dataset& data,
   if (!options.mask.empty()) camera.mask = options.mask;
   TrackDatasetResult out;
   FeaturePipelineOptions po = options.pipeline;
-  if (options.tilt.enabled && po.tilt.isZero()) {
+  if (po.tilt.isZero() && options.tilt.given_deg > 0.0) {
+    po.tilt = options.tilt.given_vector();  // known: rectified with it, not measured
+    out.tilt.vector = po.tilt;              // (not valid: not a measurement)
+    out.tilt_corrected = true;
+  } else if (options.tilt.enabled && po.tilt.isZero()) {
     out.tilt = measure_tilt(data, po, options.tilt);
     if (out.tilt.valid && out.tilt.tilt_deg() > options.tilt.correct_deg) {
       po.tilt = out.tilt.vector;

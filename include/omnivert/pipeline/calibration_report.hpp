@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "omnivert/calib/calibrate.hpp"
+#include "omnivert/extract/tilt_estimator.hpp"
 #include "omnivert/pipeline/calibration_input.hpp"
 
 namespace omnivert::pipeline {
@@ -66,6 +67,10 @@ struct ReportInputs {
   // A streaming run (pipeline/streaming.hpp), when it was one: summary.json's "streaming"
   // object (JSON text) and report.html's section.
   std::string streaming_json, streaming_html;
+  // The tilt of the mirror axis (pipeline/tilt_check.hpp): measured when tilt.valid, given
+  // (--tilt-deg) when the frames were rectified with an estimate that is not valid.
+  TiltEstimate tilt;
+  bool tilt_rectified = false;
 };
 
 // One line on the noise check (docs/theory/noise-check.md), for the terminal and the

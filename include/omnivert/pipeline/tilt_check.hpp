@@ -21,7 +21,19 @@ struct TiltCheckOptions {
   // The line support of the measuring pass [px]: wide enough for a curved vertical
   // (up to 3.4 px off its best radial line at 3 degrees, docs/theory/tilt.md).
   double lateral_tolerance_px = 3.5;
+  // Passes of the measurement: the second measures what is left on the frames rectified with
+  // the first, with the ordinary line support, and adds it (the curved verticals of the first
+  // pass give a slightly short estimate, docs/theory/tilt.md#estimate). 1: the first alone.
+  int passes = 2;
+  // The tilt when it is known (e.g. measured once with `omnivert extract` on still frames):
+  // above zero the frames are rectified with given_deg towards given_direction_deg and
+  // nothing is measured.
+  double given_deg = 0.0;
+  double given_direction_deg = 0.0;
   TiltEstimatorOptions estimator;
+
+  // The given tilt as a vector t (cos d, sin d) [rad] (zero when none is given).
+  Eigen::Vector2d given_vector() const;
 
   bool IsValid(std::string* why) const;
 };
@@ -31,6 +43,10 @@ struct TiltCheckOptions {
 TiltEstimate measure_tilt(const dataset::Dataset& data,
                           const FeaturePipelineOptions& pipeline,
                           const TiltCheckOptions& options);
+
+// One line for the terminal: the measured tilt and whether the frames were rectified, or the
+// given tilt they were rectified with; empty when the tilt was neither measured nor given.
+std::string tilt_line(const TiltEstimate& tilt, bool rectified);
 
 // The warning for an estimate above options.estimator.warn_deg, else an empty string.
 std::string tilt_warning(const TiltEstimate& tilt, const TiltCheckOptions& options, bool corrected);
