@@ -32,6 +32,11 @@ bool share_a_frame(const std::vector<int>& a, const std::vector<int>& c);
 // below `chi2` (chi-square, 2 degrees of freedom). The factorisation is made once per call
 // of reject_crossings (`cache`), the columns of each feature once.
 struct FeatureCovariance {
+  FeatureCovariance() = default;
+  // `paths` refers to `ldlt`: neither copied nor moved (a moved one would refer to the old).
+  FeatureCovariance(const FeatureCovariance&) = delete;
+  FeatureCovariance& operator=(const FeatureCovariance&) = delete;
+
   bool ready = false, ok = false;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;  // P F P^T = L D L^T
   std::map<int, int> column;                                // track id -> first column
