@@ -38,25 +38,6 @@ struct ExtractArgs {
   FeaturePipelineOptions pipeline;
 };
 
-// The tilt of the mirror axis measured on this image (docs/extraction.md, "Tilt"): one pass
-// with the wider line support of the dataset check.
-TiltEstimate measure_image_tilt(const cv::Mat& image,
-                                const CameraGeometry& geometry,
-                                const FeaturePipelineOptions& pipeline) {
-  const pipeline::TiltCheckOptions check;
-  TiltEstimator estimator(geometry, check.estimator);
-  if (!geometry.has_projection()) return estimator.estimate();
-  FeaturePipelineOptions po = pipeline;
-  po.lines.lateral_tolerance_px =
-      std::max(po.lines.lateral_tolerance_px, check.lateral_tolerance_px);
-  FeaturePipeline pipe(geometry, po);
-  FrameFeatures f;
-  if (pipe.process(image, f)) {
-    estimator.add_frame(pipe.line_extractor().last_edge_points(), f.circle, f.lines);
-  }
-  return estimator.estimate();
-}
-
 void run_extract(const ExtractArgs& a) {
   std::string why;
   if (!a.pipeline.IsValid(&why)) throw InputError("invalid options: " + why);
@@ -82,8 +63,8 @@ void run_extract(const ExtractArgs& a) {
   }
   if (a.xi > 0.0) geometry.xi = a.xi;
   if (a.gamma > 0.0) geometry.gamma = a.gamma;
-  const TiltEstimate tilt = measure_image_tilt(image, geometry, a.pipeline);
   const pipeline::TiltCheckOptions check;
+  const TiltEstimate tilt = pipeline::measure_image_tilt(image, geometry, a.pipeline, check);
   FeaturePipelineOptions po = a.pipeline;
   const bool corrected = a.correct_tilt && tilt.valid && tilt.tilt_deg() > check.correct_deg;
   if (corrected) po.tilt = tilt.vector;

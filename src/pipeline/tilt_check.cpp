@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 
 #include "omnivert/core/error.hpp"
 #include "omnivert/core/tilt.hpp"
@@ -24,20 +25,24 @@ bool TiltCheckOptions::IsValid(std::string* why) const {
 
 namespace {
 
-// One pass: the tilt left on `options.frames` frames spread over the dataset after the
-// pipeline's own rectification (po.tilt; zero: the frames as they are).
-TiltEstimate measure_once(const dataset::Dataset& data,
+// The images a measurement looks at: `count` of them, image(k) the k-th (may throw InputError).
+struct ImageSet {
+  CameraGeometry camera;
+  std::size_t count = 0;
+  std::function<cv::Mat(std::size_t)> image;
+};
+
+// One pass: the tilt left on the images after the pipeline's own rectification (po.tilt;
+// zero: the images as they are).
+TiltEstimate measure_once(const ImageSet& set,
                           const FeaturePipelineOptions& po,
                           const TiltCheckOptions& options) {
-  TiltEstimator estimator(data.camera(), options.estimator);
-  FeaturePipeline pipe(data.camera(), po);
-  const std::size_t n =
-      std::min<std::size_t>(static_cast<std::size_t>(options.frames), data.size());
+  TiltEstimator estimator(set.camera, options.estimator);
+  FeaturePipeline pipe(set.camera, po);
   FrameFeatures f;
-  for (std::size_t k = 0; k < n; ++k) {
-    const std::size_t i = n == 1 ? 0 : k * (data.size() - 1) / (n - 1);
+  for (std::size_t k = 0; k < set.count; ++k) {
     try {
-      if (!pipe.process(data.image(i), f)) continue;
+      if (!pipe.process(set.image(k), f)) continue;
     } catch (const InputError&) {
       continue;  // tracking reports the frames it cannot read
     }
@@ -63,25 +68,53 @@ Eigen::Vector2d TiltCheckOptions::given_vector() const {
   return t * Eigen::Vector2d(std::cos(d), std::sin(d));
 }
 
-TiltEstimate measure_tilt(const dataset::Dataset& data,
+namespace {
+
+TiltEstimate measure_tilt(const ImageSet& set,
                           const FeaturePipelineOptions& pipeline,
                           const TiltCheckOptions& options) {
-  if (!data.camera().has_projection() || data.size() == 0)
-    return TiltEstimator(data.camera(), options.estimator).estimate();
+  if (!set.camera.has_projection() || set.count == 0)
+    return TiltEstimator(set.camera, options.estimator).estimate();
   // Pass 1: a wider line support keeps a curved vertical whole (docs/theory/tilt.md).
   FeaturePipelineOptions po = pipeline;
   po.tilt.setZero();
   po.lines.lateral_tolerance_px =
       std::max(po.lines.lateral_tolerance_px, options.lateral_tolerance_px);
-  TiltEstimate tilt = measure_once(data, po, options);
+  TiltEstimate tilt = measure_once(set, po, options);
   // Pass 2, when the frames will be rectified: what is left on them, with the usual support.
   if (options.passes < 2 || !tilt.valid || tilt.tilt_deg() <= options.correct_deg) return tilt;
   po = pipeline;
   po.tilt = tilt.vector;
-  TiltEstimate rest = measure_once(data, po, options);
+  TiltEstimate rest = measure_once(set, po, options);
   if (!rest.valid) return tilt;
   rest.vector = compose(tilt.vector, rest.vector);
   return rest;
+}
+
+}  // namespace
+
+TiltEstimate measure_tilt(const dataset::Dataset& data,
+                          const FeaturePipelineOptions& pipeline,
+                          const TiltCheckOptions& options) {
+  ImageSet set;
+  set.camera = data.camera();
+  set.count = std::min<std::size_t>(static_cast<std::size_t>(options.frames), data.size());
+  const std::size_t n = set.count;
+  set.image = [&data, n](std::size_t k) {
+    return data.image(n == 1 ? 0 : k * (data.size() - 1) / (n - 1));
+  };
+  return measure_tilt(set, pipeline, options);
+}
+
+TiltEstimate measure_image_tilt(const cv::Mat& image,
+                                const CameraGeometry& camera,
+                                const FeaturePipelineOptions& pipeline,
+                                const TiltCheckOptions& options) {
+  ImageSet set;
+  set.camera = camera;
+  set.count = 1;
+  set.image = [&image](std::size_t) { return image; };
+  return measure_tilt(set, pipeline, options);
 }
 
 std::string tilt_line(const TiltEstimate& tilt, bool rectified) {

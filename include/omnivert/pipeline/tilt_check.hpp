@@ -44,6 +44,12 @@ TiltEstimate measure_tilt(const dataset::Dataset& data,
                           const FeaturePipelineOptions& pipeline,
                           const TiltCheckOptions& options);
 
+// The tilt of one image (`omnivert extract`), measured as measure_tilt measures a dataset.
+TiltEstimate measure_image_tilt(const cv::Mat& image,
+                                const CameraGeometry& camera,
+                                const FeaturePipelineOptions& pipeline,
+                                const TiltCheckOptions& options);
+
 // One line for the terminal: the measured tilt and whether the frames were rectified, or the
 // given tilt they were rectified with; empty when the tilt was neither measured nor given.
 std::string tilt_line(const TiltEstimate& tilt, bool rectified);
