@@ -10,6 +10,7 @@
 
 #include "omnivert/core/error.hpp"
 #include "omnivert/core/file_io.hpp"
+#include "omnivert/pipeline/tilt_check.hpp"
 
 namespace omnivert::pipeline::internal {
 
@@ -79,8 +80,26 @@ StreamedRun stream_dataset(const dataset::Dataset& data,
   so.input = o.input;
   CameraGeometry camera = data.camera();
   if (!o.mask.empty()) camera.mask = o.mask;
-  StreamingCalibrator cal(camera, data.wheel_sensor().wheel_base, so);
   StreamedRun s;
+  // The tilt (docs/theory/tilt.md): given, or measured on the first image alone (nothing is
+  // looked ahead), and the frames rectified when it is above correct_deg.
+  if (so.features.tilt.isZero() && o.tilt.given_deg > 0.0) {
+    so.features.tilt = s.tracked.tilt.vector = o.tilt.given_vector();
+    s.tracked.tilt_corrected = true;
+  } else if (so.features.tilt.isZero() && o.tilt.enabled) {
+    try {
+      s.tracked.tilt = measure_image_tilt(data.image(0), camera, so.features, o.tilt);
+    } catch (const InputError&) {
+      // an unreadable first image: not measured (the loop below reports the frame)
+    }
+    if (s.tracked.tilt.valid && s.tracked.tilt.tilt_deg() > o.tilt.correct_deg) {
+      so.features.tilt = s.tracked.tilt.vector;
+      s.tracked.tilt_corrected = true;
+    }
+    const std::string w = tilt_warning(s.tracked.tilt, o.tilt, s.tracked.tilt_corrected);
+    if (!w.empty()) s.tracked.warnings.push_back(w);
+  }
+  StreamingCalibrator cal(camera, data.wheel_sensor().wheel_base, so);
   const std::size_t n = data.size();
   s.input.run.frames.reserve(n);
   s.estimates.reserve(n);
