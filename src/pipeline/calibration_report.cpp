@@ -10,6 +10,7 @@
 
 #include "calib/updater.hpp"  // chi2_quantile
 #include "omnivert/core/angles.hpp"
+#include "omnivert/pipeline/tilt_check.hpp"
 
 namespace omnivert::pipeline {
 
@@ -491,6 +492,10 @@ void html_inputs(std::ostringstream& h, const calib::CalibrationResult& r, const
     kv("frames dropped for wheel gaps", std::to_string(in.run->frames_dropped_for_gaps));
   }
   if (!in.time_offset.line.empty()) kv("camera-odometry time offset", in.time_offset.line);
+  {
+    const std::string t = tilt_line(in.tilt, in.tilt_rectified);
+    kv("tilt of the mirror axis", t.empty() ? std::string("not measured") : t);
+  }
   kv("wheel base e / Chong-Kleeman K (x inflation)",
      f("%.4f m", in.options.robot.wheel_base) + " / " + f("%.3g m", in.options.robot.odometry_K) +
          " (x" + f("%g", in.options.filter.odometry_inflation) + ")");

@@ -109,9 +109,16 @@ TEST_F(TiltCheck, StreamingRectifiesWithTheFirstImagesTilt) {
   pipeline::CalibrateDatasetOptions o;
   o.streaming = true;
   o.calibration.refinement.enabled = false;
-  const auto r =
-      pipeline::calibrate_dataset(tilted_dir().string(), scratch("streamed").string(), o);
+  const fs::path out = scratch("streamed");
+  const auto r = pipeline::calibrate_dataset(tilted_dir().string(), out.string(), o);
   ASSERT_TRUE(r.tilt.valid);
+  // The tilt in summary.json and in the report.
+  const auto summary = nlohmann::json::parse(read_text(out / "summary.json"));
+  EXPECT_EQ(summary["inputs"]["tilt"]["source"], "measured");
+  EXPECT_EQ(summary["inputs"]["tilt"]["frames"], 1);
+  EXPECT_TRUE(summary["inputs"]["tilt"]["rectified"].get<bool>());
+  EXPECT_NEAR(summary["inputs"]["tilt"]["tilt_deg"].get<double>(), kTiltDeg, 0.2);
+  EXPECT_NE(read_text(out / "report.html").find("frames rectified"), std::string::npos);
   EXPECT_EQ(r.tilt.frames, 1);
   EXPECT_TRUE(r.tilt_corrected);
   EXPECT_LT(error_deg(r.tilt.vector), 0.2);
