@@ -41,6 +41,37 @@ using CO = calib::CalibrationOptions;
 using DO = pipeline::CalibrateDatasetOptions;
 using SC = sim::SimConfig;
 
+// The tilt check's options of a job whose options hold `tilt` (pipeline::TiltCheckOptions).
+template <class O>
+OptionTable<O> tilt_options() {
+  return {
+      field<bool, O>(
+          "tilt_check", "measure the tilt of the mirror axis before tracking", [](O & o) -> auto& {
+            return o.tilt.enabled;
+          }),
+      field<double, O>(
+          "tilt_correct_above", "rectify the frames above this tilt [deg]", [](O & o) -> auto& {
+            return o.tilt.correct_deg;
+          }),
+      field<double, O>(
+          "tilt_deg",
+          "the tilt when known [deg]: rectified with it, not measured (0: measure)",
+          [](O & o) -> auto& { return o.tilt.given_deg; }),
+      field<double, O>(
+          "tilt_direction_deg",
+          "the camera bearing the given tilt leans towards [deg]",
+          [](O & o) -> auto& { return o.tilt.given_direction_deg; }),
+  };
+}
+
+// The tables `parts`, one after the other.
+template <class O>
+OptionTable<O> joined(std::initializer_list<OptionTable<O>> parts) {
+  OptionTable<O> t;
+  for (const OptionTable<O>& p : parts) t.insert(t.end(), p.begin(), p.end());
+  return t;
+}
+
 }  // namespace
 
 const OptionTable<FP>& extraction_table() {
@@ -280,107 +311,81 @@ const OptionTable<CO>& robot_table() {
 }
 
 const OptionTable<DO>& dataset_job_table() {
-  static const OptionTable<DO> t{
-      field<bool, DO>(
-          "force",
-          "write extrinsics.yaml even when the run does not determine them",
-          [](DO & o) -> auto& { return o.force; }),
-      field<std::string, DO>(
-          "tracks", "calibrate from this tracks.csv instead of the images", [](DO & o) -> auto& {
-            return o.tracks_file;
-          }),
-      field<bool, DO>(
-          "streaming",
-          "frame by frame as the robot drives, nothing looked ahead (streaming.csv)",
-          [](DO & o) -> auto& { return o.streaming; }),
-      field<std::string, DO>(
-          "mask", "image mask file instead of sensor.yaml's mask:", [](DO & o) -> auto& {
-            return o.mask;
-          }),
-      field<double, DO>(
-          "crowded_sigma", "bearing sigma factor of a crowded line", [](DO & o) -> auto& {
-            return o.input.crowded_sigma_scale;
-          }),
-      field<double, DO>(
-          "calibration_length_fraction",
-          "lines shorter than this fraction of the annulus are tracked, not used",
-          [](DO & o) -> auto& { return o.input.min_annulus_fraction; }),
-      field<double, DO>(
-          "max_wheel_gap", "wheel samples further apart are a gap [s]", [](DO & o) -> auto& {
-            return o.input.max_wheel_gap_s;
-          }),
-      {"time_offset",
-       "camera-odometry time offset [s], or 'estimate'",
-       [](DO& o) {
-         return o.time_offset_s ? py::cast(*o.time_offset_s) : py::cast(std::string("estimate"));
+  static const OptionTable<DO> t = joined<DO>(
+      {OptionTable<DO>{
+           field<bool, DO>(
+               "force",
+               "write extrinsics.yaml even when the run does not determine them",
+               [](DO & o) -> auto& { return o.force; }),
+           field<std::string, DO>(
+               "tracks",
+               "calibrate from this tracks.csv instead of the images",
+               [](DO & o) -> auto& { return o.tracks_file; }),
+           field<bool, DO>(
+               "streaming",
+               "frame by frame as the robot drives, nothing looked ahead (streaming.csv)",
+               [](DO & o) -> auto& { return o.streaming; }),
+           field<std::string, DO>(
+               "mask", "image mask file instead of sensor.yaml's mask:", [](DO & o) -> auto& {
+                 return o.mask;
+               }),
+           field<double, DO>(
+               "crowded_sigma", "bearing sigma factor of a crowded line", [](DO & o) -> auto& {
+                 return o.input.crowded_sigma_scale;
+               }),
+           field<double, DO>(
+               "calibration_length_fraction",
+               "lines shorter than this fraction of the annulus are tracked, not used",
+               [](DO & o) -> auto& { return o.input.min_annulus_fraction; }),
+           field<double, DO>(
+               "max_wheel_gap", "wheel samples further apart are a gap [s]", [](DO & o) -> auto& {
+                 return o.input.max_wheel_gap_s;
+               }),
+           {"time_offset",
+            "camera-odometry time offset [s], or 'estimate'",
+            [](DO& o) {
+              return o.time_offset_s ? py::cast(*o.time_offset_s)
+                                     : py::cast(std::string("estimate"));
+            },
+            [](DO& o, const py::handle& v) {
+              if (py::isinstance<py::str>(v) && v.cast<std::string>() == "estimate")
+                o.time_offset_s.reset();
+              else
+                o.time_offset_s = v.cast<double>();
+            }},
        },
-       [](DO& o, const py::handle& v) {
-         if (py::isinstance<py::str>(v) && v.cast<std::string>() == "estimate")
-           o.time_offset_s.reset();
-         else
-           o.time_offset_s = v.cast<double>();
-       }},
-      field<bool, DO>(
-          "tilt_check", "measure the tilt of the mirror axis before tracking", [](DO & o) -> auto& {
-            return o.tilt.enabled;
-          }),
-      field<double, DO>(
-          "tilt_correct_above", "rectify the frames above this tilt [deg]", [](DO & o) -> auto& {
-            return o.tilt.correct_deg;
-          }),
-      field<double, DO>(
-          "tilt_deg",
-          "the tilt when known [deg]: rectified with it, not measured (0: measure)",
-          [](DO & o) -> auto& { return o.tilt.given_deg; }),
-      field<double, DO>(
-          "tilt_direction_deg",
-          "the camera bearing the given tilt leans towards [deg]",
-          [](DO & o) -> auto& { return o.tilt.given_direction_deg; }),
-      field<std::string, DO>(
-          "base_frame", "the robot's frame in the robot-format files", [](DO & o) -> auto& {
-            return o.frames.base;
-          }),
-      field<std::string, DO>(
-          "camera_frame", "the camera's frame in the robot-format files", [](DO & o) -> auto& {
-            return o.frames.camera;
-          }),
-      {"camera_height",
-       "camera centre above the base frame [m] (None: 0 in the files)",
-       [](DO& o) {
-         return o.frames.camera_height ? py::cast(*o.frames.camera_height) : py::none();
-       },
-       [](DO& o, const py::handle& v) {
-         o.frames.camera_height =
-             v.is_none() ? std::nullopt : std::optional<double>(v.cast<double>());
-       }},
-  };
+       tilt_options<DO>(),
+       OptionTable<DO>{
+           field<std::string, DO>(
+               "base_frame", "the robot's frame in the robot-format files", [](DO & o) -> auto& {
+                 return o.frames.base;
+               }),
+           field<std::string, DO>(
+               "camera_frame", "the camera's frame in the robot-format files", [](DO & o) -> auto& {
+                 return o.frames.camera;
+               }),
+           {"camera_height",
+            "camera centre above the base frame [m] (None: 0 in the files)",
+            [](DO& o) {
+              return o.frames.camera_height ? py::cast(*o.frames.camera_height) : py::none();
+            },
+            [](DO& o, const py::handle& v) {
+              o.frames.camera_height =
+                  v.is_none() ? std::nullopt : std::optional<double>(v.cast<double>());
+            }},
+       }});
   return t;
 }
 
 const OptionTable<pipeline::TrackDatasetOptions>& track_job_table() {
   using TD = pipeline::TrackDatasetOptions;
-  static const OptionTable<TD> t{
-      field<std::string, TD>(
+  static const OptionTable<TD> t = joined<TD>({
+      OptionTable<TD>{field<std::string, TD>(
           "mask", "image mask file instead of sensor.yaml's mask:", [](TD & o) -> auto& {
             return o.mask;
-          }),
-      field<bool, TD>(
-          "tilt_check", "measure the tilt of the mirror axis before tracking", [](TD & o) -> auto& {
-            return o.tilt.enabled;
-          }),
-      field<double, TD>(
-          "tilt_correct_above", "rectify the frames above this tilt [deg]", [](TD & o) -> auto& {
-            return o.tilt.correct_deg;
-          }),
-      field<double, TD>(
-          "tilt_deg",
-          "the tilt when known [deg]: rectified with it, not measured (0: measure)",
-          [](TD & o) -> auto& { return o.tilt.given_deg; }),
-      field<double, TD>(
-          "tilt_direction_deg",
-          "the camera bearing the given tilt leans towards [deg]",
-          [](TD & o) -> auto& { return o.tilt.given_direction_deg; }),
-  };
+          })},
+      tilt_options<TD>(),
+  });
   return t;
 }
 

@@ -82,22 +82,19 @@ StreamedRun stream_dataset(const dataset::Dataset& data,
   if (!o.mask.empty()) camera.mask = o.mask;
   StreamedRun s;
   // The tilt (docs/theory/tilt.md): given, or measured on the first image alone (nothing is
-  // looked ahead), and the frames rectified when it is above correct_deg.
-  if (so.features.tilt.isZero() && o.tilt.given_deg > 0.0) {
-    so.features.tilt = s.tracked.tilt.vector = o.tilt.given_vector();
-    s.tracked.tilt_corrected = true;
-  } else if (so.features.tilt.isZero() && o.tilt.enabled) {
-    try {
-      s.tracked.tilt = measure_image_tilt(data.image(0), camera, so.features, o.tilt);
-    } catch (const InputError&) {
-      // an unreadable first image: not measured (the loop below reports the frame)
-    }
-    if (s.tracked.tilt.valid && s.tracked.tilt.tilt_deg() > o.tilt.correct_deg) {
-      so.features.tilt = s.tracked.tilt.vector;
-      s.tracked.tilt_corrected = true;
-    }
-    const std::string w = tilt_warning(s.tracked.tilt, o.tilt, s.tracked.tilt_corrected);
-    if (!w.empty()) s.tracked.warnings.push_back(w);
+  // looked ahead).
+  if (so.features.tilt.isZero()) {
+    const TiltChoice c = choose_tilt(o.tilt, [&] {
+      try {
+        return measure_image_tilt(data.image(0), camera, so.features, o.tilt);
+      } catch (const InputError&) {
+        return TiltEstimate{};  // unreadable: not measured (the loop below reports the frame)
+      }
+    });
+    s.tracked.tilt = c.tilt;
+    s.tracked.tilt_corrected = c.rectified;
+    if (c.rectified) so.features.tilt = c.tilt.vector;
+    if (!c.warning.empty()) s.tracked.warnings.push_back(c.warning);
   }
   StreamingCalibrator cal(camera, data.wheel_sensor().wheel_base, so);
   const std::size_t n = data.size();

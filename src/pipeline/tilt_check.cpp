@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <functional>
 
+#include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
 #include "omnivert/core/tilt.hpp"
 
@@ -64,8 +65,23 @@ Eigen::Vector2d compose(const Eigen::Vector2d& first, const Eigen::Vector2d& sec
 
 Eigen::Vector2d TiltCheckOptions::given_vector() const {
   if (!(given_deg > 0.0)) return Eigen::Vector2d::Zero();
-  const double t = given_deg * M_PI / 180.0, d = given_direction_deg * M_PI / 180.0;
-  return t * Eigen::Vector2d(std::cos(d), std::sin(d));
+  const double d = deg2rad(given_direction_deg);
+  return deg2rad(given_deg) * Eigen::Vector2d(std::cos(d), std::sin(d));
+}
+
+TiltChoice choose_tilt(const TiltCheckOptions& options,
+                       const std::function<TiltEstimate()>& measure) {
+  TiltChoice c;
+  if (options.given_deg > 0.0) {
+    c.tilt.vector = options.given_vector();  // known: rectified with it, not measured
+    c.rectified = true;
+    return c;
+  }
+  if (!options.enabled) return c;
+  c.tilt = measure();
+  c.rectified = c.tilt.valid && c.tilt.tilt_deg() > options.correct_deg;
+  c.warning = tilt_warning(c.tilt, options, c.rectified);
+  return c;
 }
 
 namespace {

@@ -28,18 +28,13 @@ TrackDatasetResult track_dataset(const dataset::Dataset& data,
   if (!options.mask.empty()) camera.mask = options.mask;
   TrackDatasetResult out;
   FeaturePipelineOptions po = options.pipeline;
-  if (po.tilt.isZero() && options.tilt.given_deg > 0.0) {
-    po.tilt = options.tilt.given_vector();  // known: rectified with it, not measured
-    out.tilt.vector = po.tilt;              // (not valid: not a measurement)
-    out.tilt_corrected = true;
-  } else if (options.tilt.enabled && po.tilt.isZero()) {
-    out.tilt = measure_tilt(data, po, options.tilt);
-    if (out.tilt.valid && out.tilt.tilt_deg() > options.tilt.correct_deg) {
-      po.tilt = out.tilt.vector;
-      out.tilt_corrected = true;
-    }
-    const std::string w = tilt_warning(out.tilt, options.tilt, out.tilt_corrected);
-    if (!w.empty()) out.warnings.push_back(w);
+  if (po.tilt.isZero()) {
+    const TiltChoice c =
+        choose_tilt(options.tilt, [&] { return measure_tilt(data, po, options.tilt); });
+    out.tilt = c.tilt;
+    out.tilt_corrected = c.rectified;
+    if (c.rectified) po.tilt = c.tilt.vector;
+    if (!c.warning.empty()) out.warnings.push_back(c.warning);
   }
   FeaturePipeline pipe(camera, po);
   FrameSource frames(data, pipe, options.threads);

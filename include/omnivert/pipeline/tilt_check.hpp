@@ -4,6 +4,7 @@
 // support (a tilted vertical is a curve, not a radial line), and the TiltEstimator fits the
 // tilt to the edge pixels of all their lines.
 
+#include <functional>
 #include <string>
 
 #include "omnivert/dataset/dataset.hpp"
@@ -43,6 +44,17 @@ struct TiltCheckOptions {
 TiltEstimate measure_tilt(const dataset::Dataset& data,
                           const FeaturePipelineOptions& pipeline,
                           const TiltCheckOptions& options);
+
+// The tilt a run's frames are rectified with (docs/theory/tilt.md): the given one
+// (options.given_deg), or else, when options.enabled, the one `measure` returns if it exceeds
+// options.correct_deg. What track_dataset and the streaming run decide.
+struct TiltChoice {
+  TiltEstimate tilt;       // the measurement (valid), or the given vector (not valid)
+  bool rectified = false;  // the frames are to be rectified with tilt.vector
+  std::string warning;     // tilt_warning's, for a measured tilt
+};
+TiltChoice choose_tilt(const TiltCheckOptions& options,
+                       const std::function<TiltEstimate()>& measure);
 
 // The tilt of one image (`omnivert extract`), measured as measure_tilt measures a dataset.
 TiltEstimate measure_image_tilt(const cv::Mat& image,
