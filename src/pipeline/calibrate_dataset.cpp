@@ -106,9 +106,11 @@ void refined_time_offset(const calib::RefinementResult& ref,
                          CalibrateDatasetResult& r) {
   if (!ref.time_offset_estimated || !std::isfinite(ref.time_offset_sigma_s)) return;
   TimeOffsetEstimate& e = r.time_offset;
+  if (!e.refined) {  // a second refinement (time_offset_from_refinement) keeps the tracks'
+    e.tracks_offset_s = e.offset_s;
+    e.tracks_sigma_s = e.sigma_s;
+  }
   e.refined = true;
-  e.tracks_offset_s = e.offset_s;
-  e.tracks_sigma_s = e.sigma_s;
   e.offset_s = (r.time_offset_applied ? e.offset_s : 0.0) + ref.time_offset_s;
   e.sigma_s = ref.time_offset_sigma_s;
   e.determined = e.sigma_s <= options.max_sigma_s;
@@ -256,6 +258,69 @@ void time_offset_from_tracks(dataset::Dataset& data,
   }
 }
 
+// Steps 2-3 on the tracks: the calibration's input, then filter, observability and refinement
+// (Sec. 8), with the time offset's correction estimated by the refinement from the offset
+// applied (or none) when the tracks determined it: the tracks' estimate is the first order of
+// a model whose coefficients change where the motion changes; the refinement's is the whole
+// model's.
+// Returns the seconds it took.
+double calibrate_tracks(const dataset::Dataset& data,
+                        const TrackDatasetResult& tracked,
+                        std::optional<internal::StreamedRun>& streamed,
+                        const CalibrateDatasetOptions& o,
+                        calib::CalibrationOptions opt,
+                        CalibrateDatasetResult& r) {
+  const auto t0 = Clock::now();
+  r.warnings.insert(r.warnings.begin(), tracked.warnings.begin(), tracked.warnings.end());
+  r.input = streamed ? std::move(streamed->input)
+                     : calibration_run_from_tracks(data, tracked.rows, o.input);
+  r.warnings.insert(r.warnings.end(), r.input.warnings.begin(), r.input.warnings.end());
+  if (r.input.tracks < kFewTracks)
+    r.warnings.push_back(
+        few_tracks_warning(r.input.tracks, o.features, r.input.min_annulus_fraction));
+  r.warnings.insert(r.warnings.end(), o.notes.begin(), o.notes.end());
+  for (const auto& w : r.warnings) spdlog::warn("{}", w);
+  const bool refine_offset =
+      !o.time_offset_s && !streamed && opt.refinement.enabled && r.time_offset.determined;
+  if (refine_offset) {
+    r.input.run.clock = wheel_clock(data);
+    opt.refinement.estimate_time_offset = true;
+  }
+  if (o.progress) o.progress("calibrate", 0, 0);
+  r.calibration = streamed ? calib::result_of_filter(r.input.run, opt, std::move(streamed->filter))
+                           : calib::calibrate(r.input.run, opt);
+  if (refine_offset) refined_time_offset(r.calibration.refinement, o.time_offset, r);
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// The refinement's correction of the offset the images were tracked with, when significant
+// (|dS| above TimeOffsetOptions::significance sigmas and min_applied_s: the tracks' estimate
+// was left unapplied, its sigma covering a single change of motion, or was off): the total is
+// applied and the images tracked again, once, the warnings back to those before the
+// calibration; true when the run is to be calibrated again.
+bool time_offset_from_refinement(dataset::Dataset& data,
+                                 const CalibrateDatasetOptions& o,
+                                 bool from_images,
+                                 TrackDatasetResult& tracked,
+                                 const std::vector<std::string>& warnings_before,
+                                 CalibrateDatasetResult& r) {
+  TimeOffsetEstimate& e = r.time_offset;
+  const calib::RefinementResult& ref = r.calibration.refinement;
+  if (!e.refined || !e.determined || e.retracked) return false;
+  TimeOffsetEstimate correction;
+  correction.determined = true;
+  correction.offset_s = ref.time_offset_s;
+  correction.sigma_s = ref.time_offset_sigma_s;
+  if (!correction.significant(o.time_offset)) return false;
+  e.retracked = true;
+  e.retracked_s = e.offset_s;
+  e.tracks_applied = r.time_offset_applied;
+  r.warnings = warnings_before;
+  apply_time_offset(data, e.offset_s, false, r);
+  if (from_images) tracked = tracks_of(data, o, std::nullopt, "track again");
+  return true;
+}
+
 }  // namespace
 
 CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
@@ -282,40 +347,19 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
       streamed ? std::move(streamed->tracked) : tracks_of(data, o, std::move(given));
 
   time_offset_from_tracks(data, o, opt, from_images, tracked, r);
-  r.warnings.insert(r.warnings.begin(), tracked.warnings.begin(), tracked.warnings.end());
+  const std::vector<std::string> warnings_before = r.warnings;
+  double calibrating_s = calibrate_tracks(data, tracked, streamed, o, opt, r);
+  if (time_offset_from_refinement(data, o, from_images, tracked, warnings_before, r))
+    calibrating_s += calibrate_tracks(data, tracked, streamed, o, opt, r);
   r.tilt = tracked.tilt;
   r.tilt_corrected = tracked.tilt_corrected;
   write_tracks_csv(out / "tracks.csv", tracked.rows);
   viz::write_tracks_png(out / "tracks.png", tracked.rows);
-  const auto t1 = Clock::now();
   r.frames = tracked.frames;
   r.frames_skipped = tracked.frames_skipped;
   r.detections = static_cast<std::int64_t>(tracked.rows.size());
-
-  // Step 2: the calibration's input; step 3: filter, observability, refinement (Sec. 8).
-  r.input = streamed ? std::move(streamed->input)
-                     : calibration_run_from_tracks(data, tracked.rows, o.input);
-  r.warnings.insert(r.warnings.end(), r.input.warnings.begin(), r.input.warnings.end());
-  if (r.input.tracks < kFewTracks)
-    r.warnings.push_back(
-        few_tracks_warning(r.input.tracks, o.features, r.input.min_annulus_fraction));
-  r.warnings.insert(r.warnings.end(), o.notes.begin(), o.notes.end());
-  for (const auto& w : r.warnings) spdlog::warn("{}", w);
-  // The time offset's correction estimated with the extrinsics by the refinement, from the
-  // offset applied (or none): the tracks' estimate is the first order of a model whose
-  // coefficients change where the motion changes; the refinement's is the whole model's.
-  const bool refine_offset =
-      !o.time_offset_s && !streamed && opt.refinement.enabled && r.time_offset.determined;
-  if (refine_offset) {
-    r.input.run.clock = wheel_clock(data);
-    opt.refinement.estimate_time_offset = true;
-  }
-  if (o.progress) o.progress("calibrate", 0, 0);
-  r.calibration = streamed ? calib::result_of_filter(r.input.run, opt, std::move(streamed->filter))
-                           : calib::calibrate(r.input.run, opt);
   const auto t2 = Clock::now();
   const calib::CalibrationResult& result = r.calibration;
-  if (refine_offset) refined_time_offset(result.refinement, o.time_offset, r);
   if (!result.extrinsics.vec().allFinite() || !result.covariance.allFinite())
     throw std::runtime_error(
         "the calibration diverged (non-finite estimate); nothing written but tracks.csv. Check "
@@ -350,8 +394,8 @@ CalibrateDatasetResult calibrate_dataset(const std::string& dataset_dir,
   ri.truth = r.truth;
   ri.force = o.force;
   ri.exit_code = r.wrote_extrinsics ? 0 : 3;
-  ri.seconds_tracking = std::chrono::duration<double>(t1 - t0).count();
-  ri.seconds_calibration = std::chrono::duration<double>(t2 - t1).count();
+  ri.seconds_tracking = std::chrono::duration<double>(t2 - t0).count() - calibrating_s;
+  ri.seconds_calibration = calibrating_s;
   ri.warnings = r.warnings;
   ri.wrote_extrinsics = r.wrote_extrinsics;
   r.time_offset_message =

@@ -23,6 +23,7 @@ bool TimeOffsetOptions::IsValid(std::string* why) const {
   if (min_common_tracks < 1 || min_pairs < 1)
     return fail("min_common_tracks and min_pairs must be >= 1");
   if (!positive(max_sigma_s)) return fail("max_sigma_s must be > 0 [s]");
+  if (jackknife_block < 0) return fail("jackknife_block must be >= 0 (0: no jackknife)");
   if (!non_negative(min_rise) || !non_negative(significance) || !non_negative(min_applied_s))
     return fail("min_rise, significance and min_applied_s must be >= 0");
   return true;
@@ -130,28 +131,62 @@ struct Minimum {
   double rise = 0;                        // the median of J over the grid minus the minimum
 };
 
-// The grid minimum of J, refined by the parabola through it and its two neighbours.
-Minimum grid_minimum(const Problem& p, const TimeOffsetOptions& o) {
-  const int half = static_cast<int>(std::lround(o.max_offset_s / o.step_s));
-  std::vector<double> J(static_cast<std::size_t>(2 * half + 1));
-  for (int k = -half; k <= half; ++k) J[static_cast<std::size_t>(k + half)] = p.cost(k * o.step_s);
+// The minimum of J sampled on the grid S_k = (k - half) step, refined by the parabola through
+// it and its two neighbours.
+Minimum grid_minimum(const std::vector<double>& J, double step) {
+  const double half = static_cast<double>(J.size() / 2);
   const std::size_t best =
       static_cast<std::size_t>(std::min_element(J.begin(), J.end()) - J.begin());
   Minimum m;
-  m.S = (static_cast<double>(best) - half) * o.step_s;
+  m.S = (static_cast<double>(best) - half) * step;
   m.cost = J[best];
   m.rise = median(J) - J[best];
   if (best > 0 && best + 1 < J.size()) {
     const double jm = J[best - 1], j0 = J[best], jp = J[best + 1];
-    const double c2 = (jp + jm - 2 * j0) / (2 * o.step_s * o.step_s);  // curvature a
+    const double c2 = (jp + jm - 2 * j0) / (2 * step * step);  // curvature a
     if (c2 > 0) {
-      const double shift = (jm - jp) / (4 * c2 * o.step_s);  // the parabola's vertex
+      const double shift = (jm - jp) / (4 * c2 * step);  // the parabola's vertex
       m.S += shift;
       m.cost = j0 - c2 * shift * shift;
       m.curvature = c2;
     }
   }
   return m;
+}
+
+// J on the grid, kept per block of `block` consecutive triples (one block: all of them).
+std::vector<std::vector<double>> block_costs(const Problem& p,
+                                             const TimeOffsetOptions& o,
+                                             std::size_t block) {
+  const int half = static_cast<int>(std::lround(o.max_offset_s / o.step_s));
+  const std::size_t blocks = (p.used.size() + block - 1) / block;
+  std::vector<std::vector<double>> J(blocks, std::vector<double>(2 * half + 1, 0.0));
+  for (int k = -half; k <= half; ++k)
+    for (std::size_t u = 0; u < p.used.size(); ++u)
+      J[u / block][static_cast<std::size_t>(k + half)] +=
+          p.weighted_residual(p.triples[p.used[u]], k * o.step_s);
+  return J;
+}
+
+// The delete-a-block jackknife's variance of the minimiser: each block of consecutive
+// triples left out in turn, var = (m - 1) / m sum_b (S_(-b) - mean)^2. The few triples where
+// the motion changes carry S; when one change carries it all, leaving it out leaves J without
+// a minimum, and the variance says so, which neither the model nor the sandwich can.
+double jackknife_variance(const std::vector<std::vector<double>>& blocks,
+                          const std::vector<double>& J,
+                          double step) {
+  const std::size_t m = blocks.size();
+  if (m < 2) return INFINITY;
+  std::vector<double> S(m);
+  std::vector<double> without(J.size());
+  for (std::size_t b = 0; b < m; ++b) {
+    for (std::size_t k = 0; k < J.size(); ++k) without[k] = J[k] - blocks[b][k];
+    S[b] = grid_minimum(without, step).S;
+  }
+  double mean = 0, ss = 0;
+  for (double s : S) mean += s / static_cast<double>(m);
+  for (double s : S) ss += (s - mean) * (s - mean);
+  return static_cast<double>(m - 1) / static_cast<double>(m) * ss;
 }
 
 double median(std::vector<double> v) {
@@ -205,7 +240,13 @@ TimeOffsetEstimate estimate_time_offset(const TimeOffsetInput& in, const TimeOff
   }
   // A line that changed line or crossed another has a wrong turn: the median over the lines
   // of each triple leaves it out.
-  const Minimum m = grid_minimum(p, o);
+  const std::size_t block =
+      o.jackknife_block > 0 ? static_cast<std::size_t>(o.jackknife_block) : p.used.size();
+  const std::vector<std::vector<double>> blocks = block_costs(p, o, block);
+  std::vector<double> J(blocks.front().size(), 0.0);
+  for (const auto& b : blocks)
+    for (std::size_t k = 0; k < J.size(); ++k) J[k] += b[k];
+  const Minimum m = grid_minimum(J, o.step_s);
   e.pairs = static_cast<int>(p.used.size());
   e.offset_s = m.S;
   // J is weighted by the noise model, so sigma_S^2 = 1 / a; s^2 = J_min / (n - 1) above 1
@@ -218,9 +259,15 @@ TimeOffsetEstimate estimate_time_offset(const TimeOffsetInput& in, const TimeOff
   // their spread to be trusted below the model).
   if (std::isfinite(e.sigma_s) && o.sigma_step_s > 0)
     e.sigma_s = std::max(e.sigma_s, std::sqrt(p.sandwich_variance(m.S, o.sigma_step_s)));
+  // Whether the run tells S at all is the model's and the sandwich's say (the refinement then
+  // estimates it with the extrinsics); the jackknife only widens the sigma reported, and so
+  // keeps a single change of motion from shifting the stamps before tracking.
+  const double told_sigma = e.sigma_s;
+  if (std::isfinite(e.sigma_s) && o.jackknife_block > 0)
+    e.sigma_s = std::max(e.sigma_s, std::sqrt(jackknife_variance(blocks, J, o.step_s)));
   if (!(m.curvature > 0) || std::abs(m.S) >= o.max_offset_s - o.step_s) {
     e.why = "no minimum inside +-" + std::to_string(o.max_offset_s) + " s";
-  } else if (!(e.sigma_s <= o.max_sigma_s) || !(m.rise >= o.min_rise * std::max(s2, 1.0))) {
+  } else if (!(told_sigma <= o.max_sigma_s) || !(m.rise >= o.min_rise * std::max(s2, 1.0))) {
     e.why = "the run has too few turns starting or ending to tell it";
   } else {
     e.determined = true;
@@ -276,15 +323,20 @@ std::string time_offset_line(const TimeOffsetEstimate& e,
                              bool given,
                              bool applied,
                              const TimeOffsetOptions& o) {
-  char buf[400];
+  char buf[600];
   if (given) {
     std::snprintf(
         buf, sizeof buf, "time offset: image stamps late by %.1f ms (given)", e.offset_s * 1e3);
   } else if (e.refined) {
-    const std::string before = applied ? "applied before tracking"
-                                       : "not applied before tracking (applied above " +
-                                             fmt_g(o.significance) + " sigma and " +
-                                             fmt_g(o.min_applied_s * 1e3) + " ms)";
+    const bool tracks_applied = e.retracked ? e.tracks_applied : applied;
+    std::string before = tracks_applied ? "applied before tracking"
+                                        : "not applied before tracking (applied above " +
+                                              fmt_g(o.significance) + " sigma and " +
+                                              fmt_g(o.min_applied_s * 1e3) + " ms)";
+    if (e.retracked)
+      before += "; the refinement's first estimate, " +
+                fmt_g(std::round(e.retracked_s * 1e4) / 10) +
+                " ms, applied and the images tracked again";
     std::snprintf(buf,
                   sizeof buf,
                   "time offset: image stamps late by %.1f +- %.1f ms (refined with the "

@@ -3,7 +3,8 @@
 // simulator's), the camera off the axle (parallax), wheels at 50 Hz, images at 3 Hz whose
 // stamps are late by S, 0.03 degree of bearing noise, the wheels' noise of eq. (31). The offset is
 // recovered within its sigma; constant motion does not determine it; a wheel-base error does not
-// move it, nor do outliers; an offset of 80 ms is significant (applied).
+// move it, nor do outliers; an offset of 80 ms is significant (applied), one change of motion
+// is not enough to apply one.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -112,8 +113,9 @@ TEST(TimeOffset, ShiftedStampsAreRecoveredWithinTheirSigma) {
       // sigmas, near +-10 ms; TheSandwichSigmaIsLessOptimistic): hence the 12 ms floor.
       EXPECT_NEAR(e.offset_s, S, std::max(4 * e.sigma_s, 0.012));
       // The wheels' noise: 0.17 degree per image pair on a 0.3 rad/s turn's start is 10 ms; 8
-      // starts and ends of turns and straights.
-      EXPECT_LT(e.sigma_s, 0.006);
+      // starts and ends of turns and straights (the jackknife's sigma: 7.3 ms on average over
+      // 40 seeds).
+      EXPECT_LT(e.sigma_s, 0.015);
       EXPECT_GT(e.sigma_s, 0.0005);
       if (std::abs(S) > 0.06) {
         EXPECT_TRUE(e.significant({})) << e.offset_s << " +- " << e.sigma_s;
@@ -122,38 +124,71 @@ TEST(TimeOffset, ShiftedStampsAreRecoveredWithinTheirSigma) {
   }
 }
 
-// The errors in reported sigmas over 40 seeds at S = 40 ms: their RMS and how many are within
-// 3 sigmas, with the sigma of the model alone (sigma_step_s 0) and with the sandwich.
+// The errors in reported sigmas over 40 seeds of a run stamped late by S: their RMS, how many
+// are within 3 sigmas and how many would be applied.
 struct Consistency {
   double rms_z = 0;
-  int within = 0, determined = 0;
+  int within = 0, determined = 0, applied = 0;
 };
-Consistency consistency(const TimeOffsetOptions& o) {
+Consistency consistency(const std::vector<Segment>& run, double S, const TimeOffsetOptions& o) {
   Consistency c;
   double sum = 0;
   for (std::uint32_t seed = 1; seed <= 40; ++seed) {
-    const TimeOffsetEstimate e = estimate_time_offset(simulate(driving(), 0.04, 1.0, seed), o);
+    const TimeOffsetEstimate e = estimate_time_offset(simulate(run, S, 1.0, seed), o);
     if (!e.determined) continue;
-    const double z = (e.offset_s - 0.04) / e.sigma_s;
+    const double z = (e.offset_s - S) / e.sigma_s;
     sum += z * z;
     c.within += std::abs(z) <= 3.0;
+    c.applied += e.significant(o);
     ++c.determined;
   }
   c.rms_z = std::sqrt(sum / std::max(c.determined, 1));
   return c;
 }
 
-// Measured: the model's sigma gives errors of RMS 2.36 sigmas, 32 of 40 within 3; the sandwich
-// 1.78 and 36 of 40. Still above 1: the first-order model of each triple (k_j, c_j constant over
-// three image pairs) errs where the motion changes, which no noise term covers.
-TEST(TimeOffset, TheSandwichSigmaIsLessOptimistic) {
-  TimeOffsetOptions model;
-  model.sigma_step_s = 0;
-  const Consistency m = consistency(model), s = consistency({});
-  EXPECT_EQ(s.determined, 40);
+TimeOffsetOptions model_alone() {
+  TimeOffsetOptions o;
+  o.sigma_step_s = 0;
+  o.jackknife_block = 0;
+  return o;
+}
+
+TimeOffsetOptions with_the_sandwich() {
+  TimeOffsetOptions o;
+  o.jackknife_block = 0;
+  return o;
+}
+
+// Measured at S = 40 ms: the model's sigma gives errors of RMS 2.36 sigmas, 32 of 40 within 3;
+// the sandwich 1.78 and 36 of 40; the jackknife 1.31 and 37 of 40. Still above 1: the first-order
+// model of each triple (k_j, c_j constant over three image pairs) errs where the motion changes,
+// which no noise term covers.
+TEST(TimeOffset, TheSandwichAndTheJackknifeAreLessOptimistic) {
+  const Consistency m = consistency(driving(), 0.04, model_alone());
+  const Consistency s = consistency(driving(), 0.04, with_the_sandwich());
+  const Consistency j = consistency(driving(), 0.04, {});
+  EXPECT_EQ(j.determined, 40);
   EXPECT_LT(s.rms_z, 0.9 * m.rms_z);
-  EXPECT_LT(s.rms_z, 1.9);
-  EXPECT_GE(s.within, 36);
+  EXPECT_LT(j.rms_z, 0.9 * s.rms_z);
+  EXPECT_LT(j.rms_z, 1.5);
+  EXPECT_GE(j.within, 37);
+}
+
+// A straight ending in a turn in place: one change of motion carries S. Its error then is the
+// wheels' noise over that change and the model's error there, which the triples' spread cannot
+// show: with the sandwich, 28 of 40 unshifted runs are within 3 sigmas and 4 would be shifted
+// by 20-30 ms. Leaving that change out leaves J without a minimum, so the jackknife's sigma is
+// 80-350 ms: every run within it and none applied (the refinement estimates the offset with the
+// extrinsics instead).
+TEST(TimeOffset, OneChangeOfMotionIsNotEnoughToApplyIt) {
+  const std::vector<Segment> run = {{0.2, 0, 10}, {0, 0.3, 8}};
+  const Consistency s = consistency(run, 0.0, with_the_sandwich());
+  const Consistency j = consistency(run, 0.0, {});
+  EXPECT_EQ(j.determined, 40);
+  EXPECT_LT(s.within, 34);
+  EXPECT_GT(s.applied, 0);
+  EXPECT_EQ(j.within, 40);
+  EXPECT_EQ(j.applied, 0);
 }
 
 TEST(TimeOffset, AWheelBaseErrorDoesNotMoveIt) {

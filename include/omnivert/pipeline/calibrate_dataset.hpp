@@ -67,8 +67,9 @@ struct CalibrateDatasetOptions {
   calib::RobotFrames frames;
   // The camera-odometry time offset [s], positive when the image stamps are late: given (the
   // stamps shifted before tracking), or empty: estimated from the tracks and, when significant,
-  // applied and the images tracked again on the corrected stamps (pipeline/time_offset.hpp,
-  // docs/calibration.md).
+  // applied and the images tracked again on the corrected stamps; with the refinement,
+  // estimated again with the extrinsics and, when its correction is significant, applied and
+  // the run tracked and calibrated again, once (pipeline/time_offset.hpp, docs/calibration.md).
   std::optional<double> time_offset_s;
   TimeOffsetOptions time_offset;
   // The check by eye (pipeline/reprojection.hpp), written as reprojection.png: against

@@ -20,12 +20,15 @@
 // S, each triple weighted by its modelled variance sigma_i^2 = trace(P Sigma P) (P the
 // projection away from A; Sigma the wheels' d_theta noise, eq. 31, common to every line, and
 // the bearings'), refined by the parabola through the grid minimum and its neighbours. Its
-// sigma is the larger of the model's, sigma_S^2 = max(s^2, 1) / a, J(S) ~ J_min + a (S - S*)^2,
-// s^2 = J_min / (n - 1), and the sandwich's, sum_{|i-k|<=3} g_i g_k / J''^2 (g_i the slope of
-// triple i's term at S*, over +-sigma_step_s), which counts once the noise that overlapping
+// sigma is the largest of three: the model's, sigma_S^2 = max(s^2, 1) / a, with
+// J(S) ~ J_min + a (S - S*)^2 and s^2 = J_min / (n - 1); the sandwich's,
+// sum_{|i-k|<=3} g_i g_k / J''^2 (g_i the slope of triple i's term at S*, over
+// +-sigma_step_s), which counts once the noise that overlapping
 // triples share and takes the residuals as they are: the wheels' noise in the triples where
 // the motion changes limits it (0.17 degree per image pair on the simulator: about 10 ms for
-// one turn starting). Only those triples carry S: a run
+// one turn starting); and the delete-a-block jackknife's (blocks of four triples left out in
+// turn), which alone sees how many changes of motion carry S: with one, leaving it out leaves J
+// without a minimum, and the sigma is hundreds of ms. Only those triples carry S: a run
 // without turns (or starts and stops) leaves it undetermined.
 
 #include <cstdint>
@@ -51,6 +54,10 @@ struct TimeOffsetOptions {
   // The sandwich sigma's step [s]: the slopes and the curvature of J over +-this (J is a sum of
   // medians, not smooth at the grid's step); 0: the model's sigma alone.
   double sigma_step_s = 0.005;
+  // The delete-a-block jackknife's sigma, blocks of this many consecutive triples (four: a
+  // triple shares images with the three after it); the sigma reported is the largest of the
+  // model's, the sandwich's and the jackknife's. 0: no jackknife.
+  int jackknife_block = 4;
   // An estimate is applied when |S| exceeds `significance` sigmas and `min_applied_s`: a
   // synchronised recording keeps its stamps (and its results) unchanged.
   double significance = 3.0;
@@ -72,6 +79,13 @@ struct TimeOffsetEstimate {
   // correction), and the estimate from the tracks alone is kept here.
   bool refined = false;
   double tracks_offset_s = 0.0, tracks_sigma_s = 0.0;
+  // When the refinement's correction of the offset the images were tracked with was
+  // significant, its estimate (retracked_s) was applied, the images tracked again and the run
+  // calibrated again, once (offset_s and sigma_s are then the second refinement's);
+  // tracks_applied: whether the tracks' estimate had been applied before.
+  bool retracked = false;
+  double retracked_s = 0.0;
+  bool tracks_applied = false;
   // Whether the estimate is significant (TimeOffsetOptions::significance, min_applied_s).
   bool significant(const TimeOffsetOptions& o) const;
 };
