@@ -230,24 +230,33 @@ bool marginal_with_time_offset(Built* b,
   // No ridge (information_with_ridge's 1e-10 of the diagonal moved the extrinsics' covariance
   // by 4e-5 of itself: the pose chain is that badly conditioned); a variable without any
   // residual gets a unit diagonal. Scaled to a unit diagonal, F_s = D^-1/2 F D^-1/2, for the
-  // factorisation.
+  // factorisation. Only where that fails (a line's direction without information, which
+  // makes F singular and its LDLT's solves not finite) is the ridge added, 1e-10 of F_s's unit
+  // diagonal: the direction, free of the extrinsics and the offset, then barely touches them.
   const Eigen::SparseMatrix<double> J = sparse_jacobian(crs);
   Eigen::SparseMatrix<double> F = J.transpose() * J;
   for (int i = 0; i < F.rows(); ++i)
     if (!(F.coeff(i, i) > 0.0)) F.coeffRef(i, i) = 1.0;
   const Eigen::VectorXd d = F.diagonal().cwiseSqrt().cwiseInverse();
   F = d.asDiagonal() * F * d.asDiagonal();
-  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(F);
-  if (ldlt.info() != Eigen::Success) return false;
   const int n = crs.num_cols;  // the extrinsics, then the correction: the last four columns
   Eigen::Matrix4d C;
-  for (int k = 0; k < 4; ++k) {
-    Eigen::VectorXd e = Eigen::VectorXd::Zero(n);
-    e(n - 4 + k) = 1.0;
-    C.col(k) = ldlt.solve(e).tail<4>();
+  const auto marginal = [&](const Eigen::SparseMatrix<double>& Fs) {
+    const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(Fs);
+    if (ldlt.info() != Eigen::Success) return false;
+    for (int k = 0; k < 4; ++k) {
+      Eigen::VectorXd e = Eigen::VectorXd::Zero(n);
+      e(n - 4 + k) = 1.0;
+      C.col(k) = ldlt.solve(e).tail<4>();
+    }
+    C = d.tail<4>().asDiagonal() * C * d.tail<4>().asDiagonal();
+    return C.allFinite() && (C.diagonal().array() > 0.0).all();
+  };
+  if (!marginal(F)) {
+    Eigen::SparseMatrix<double> ridge(n, n);
+    ridge.setIdentity();
+    if (!marginal(F + 1e-10 * ridge)) return false;
   }
-  C = d.tail<4>().asDiagonal() * C * d.tail<4>().asDiagonal();
-  if (!C.allFinite() || !(C.diagonal().array() > 0.0).all()) return false;
   *covariance = 0.5 * (C.topLeftCorner<3, 3>() + C.topLeftCorner<3, 3>().transpose());
   *time_offset_variance = C(3, 3);
   return true;

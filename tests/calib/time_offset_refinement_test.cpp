@@ -3,7 +3,8 @@
 // wheels' motion composed between the shifted stamps equals compose_wheel_steps at no shift and
 // its derivative in the shift the numerical one; on runs of the paper's shape (a straight, a
 // turn in place, a straight) whose image stamps are late by S, the shift is recovered within
-// its sigma, and over Monte-Carlo runs the sigma is the spread of the errors.
+// its sigma, and over Monte-Carlo runs the sigma is the spread of the errors; a line seen once
+// (a singular information) leaves the marginal as it was.
 #include <ceres/ceres.h>
 #include <gtest/gtest.h>
 
@@ -212,6 +213,30 @@ TEST(TimeOffsetRefinement, TheSparseMarginalEqualsCeresCovariance) {
     for (int j = 0; j < 3; ++j)
       EXPECT_NEAR(C(i, j), ref[3 * i + j], 1e-6 * std::sqrt(C(i, i) * C(j, j)));
   EXPECT_NEAR(v, ref_v, 1e-6 * ref_v);
+}
+
+TEST(TimeOffsetRefinement, ALineSeenOnceLeavesTheMarginalFinite) {
+  // A line seen in one image only: one bearing for its two coordinates, so J^T J is singular
+  // and its plain LDLT fails (as ceres::Covariance does), which left the offset without a
+  // sigma. That bearing tells nothing of the rest (the line's position absorbs it), so the
+  // marginal of the extrinsics and the offset is the run's without it.
+  TimedRun r = make_run(0.04, 3);
+  internal::Built without = internal::build(r.run, options(), r.truth, false);
+  Eigen::Matrix3d ref;
+  double ref_v = 0;
+  ASSERT_TRUE(internal::marginal_with_time_offset(&without, &ref, &ref_v));
+  const std::size_t k = r.run.frames.size() / 2;
+  r.truth.features[99] = r.truth.poses[k].head<2>() + Eigen::Vector2d(3.0, 2.0);
+  r.run.frames[k].observations.push_back(
+      {99, bearing_from_geometry(r.truth.poses[k], r.truth.features[99], kTruth)});
+  internal::Built b = internal::build(r.run, options(), r.truth, false);
+  Eigen::Matrix3d C;
+  double v = 0;
+  ASSERT_TRUE(internal::marginal_with_time_offset(&b, &C, &v));
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      EXPECT_NEAR(C(i, j), ref(i, j), 1e-4 * std::sqrt(ref(i, i) * ref(j, j)));
+  EXPECT_NEAR(v, ref_v, 1e-4 * ref_v);
 }
 
 TEST(TimeOffsetRefinement, WithoutTheOptionNothingIsEstimated) {
