@@ -20,7 +20,7 @@ struct TrackerFlags {
   bool no_gate = false;
   int look_back = 20;
   // Each flag not given keeps the value of the rule set (--rules) or of TrackerOptions.
-  std::optional<double> f1, f2, f3;
+  std::optional<double> f1, f2, f3, partial_area_scale;
   std::string gate_candidates = "default";  // on|off|default (the rule set's)
   std::optional<double> gate_min_distance, gate_tolerance_deg;
   std::string same_polarity = "default";  // on|off|default (the rule set's)
@@ -43,6 +43,7 @@ struct TrackerFlags {
     if (f1) o.match.f1 = *f1;
     if (f2) o.match.f2 = *f2;
     if (f3) o.match.f3 = *f3;
+    if (partial_area_scale) o.match.partial_area_scale = *partial_area_scale;
     if (gate_candidates != "default") o.gate_candidates = gate_candidates == "on";
     if (continuity_deg) o.continuity_tolerance = deg2rad(*continuity_deg);
     if (continuity_model != "default") {
@@ -202,6 +203,13 @@ inline void add_tracker_options(CLI::App* cmd, TrackerFlags& t) {
       ->group(g);
   cmd->add_option("--f3", t.f3, "Test 3, eq. (10): min <= F3 * second min (default 0.8)")
       ->check(CLI::Range(0.0, 1.0))
+      ->group(g);
+  cmd->add_option("--partial-area-scale",
+                  t.partial_area_scale,
+                  "Occluder-tolerant descriptor distance: where one of the three areas holds more "
+                  "than (s-1)/s of the squared distance, the other two decide, scaled by s "
+                  "(e.g. 2 in scenes with people; default 0: off, eq. 6)")
+      ->check(CLI::Number)
       ->group(g);
 }
 

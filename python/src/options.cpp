@@ -168,6 +168,11 @@ const OptionTable<TO>& tracker_table() {
           "f3", "test 3, eq. (10): min <= f3 * second min", [](TO & o) -> auto& {
             return o.match.f3;
           }),
+      field<double, TO>(
+          "partial_area_scale",
+          "occluder-tolerant descriptor distance: the two areas that agree decide "
+          "where one holds more than (s-1)/s of the squared distance; 0: off",
+          [](TO & o) -> auto& { return o.match.partial_area_scale; }),
       field<bool, TO>(
           "gate_candidates",
           "tests 1, 3 and mutual among the lines the gate admits",

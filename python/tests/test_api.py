@@ -100,3 +100,16 @@ def test_match_finds_the_same_lines():
     assert m["best"].tolist() == [4, 7, 1]
     np.testing.assert_allclose(m["distance"], 0, atol=1e-3)
     assert m["verdict"][0] in ("accepted", "test2", "test3", "test1")
+
+
+def test_match_leaves_out_an_area_an_occluder_changed():
+    rng = np.random.default_rng(2)
+    d = rng.random((2, 192)).astype(np.float32)
+    q = d[[0]].copy()
+    q[0, :64] = rng.random(64)  # the inner area changed, as by a person passing
+    paper = omnivert.match(q, d)
+    tolerant = omnivert.match(q, d, partial_area_scale=2.0)
+    assert paper["distance"][0] == pytest.approx(np.linalg.norm(q[0] - d[0]), rel=1e-4)
+    assert tolerant["distance"][0] == pytest.approx(0.0, abs=1e-3)
+    with pytest.raises(omnivert.InputError):
+        omnivert.match(q, d, partial_area_scale=0.5)

@@ -17,6 +17,9 @@ bool MatchOptions::IsValid(std::string* error) const {
   // F2 and F3 "clearly range from zero to one" (Sec. 4.2, 4.3).
   if (!(f2 > 0.0 && f2 <= 1.0)) return fail("F2 must be in (0, 1] (Table 2: 0.75)");
   if (!(f3 > 0.0 && f3 <= 1.0)) return fail("F3 must be in (0, 1] (Table 2: 0.8)");
+  if (!(partial_area_scale == 0.0 ||
+        (partial_area_scale >= 1.0 && std::isfinite(partial_area_scale))))
+    return fail("the partial-area scale must be 0 (off) or a finite number >= 1");
   return true;
 }
 
@@ -75,6 +78,8 @@ Matcher::DistanceView Matcher::compute_distances(const ConstDescriptors& query,
   if (candidate_norms_.size() < cols_) candidate_norms_.resize(distances_.cols());
   if (rows_ == 0 || cols_ == 0) return last_distances();
 
+  if (options_.partial_area_scale > 0.0 && query.cols() % 3 == 0)
+    return partial_distances(query, candidates);
   // Eq. (6) as |a - b|^2 = |a|^2 + |b|^2 - 2 a.b: one matrix product for all pairs.
   auto d = distances_.topLeftCorner(rows_, cols_);
   d.noalias() = query * candidates.transpose();
@@ -89,6 +94,54 @@ Matcher::DistanceView Matcher::compute_distances(const ConstDescriptors& query,
     }
   }
   return last_distances();
+}
+
+// MatchOptions::partial_area_scale: per area k, d_k^2 = |a_k|^2 + |b_k|^2 - 2 a_k.b_k by one
+// matrix product over its third of the columns; their sum in distances_, their largest in
+// worst_.
+Matcher::DistanceView Matcher::partial_distances(const ConstDescriptors& query,
+                                                 const ConstDescriptors& candidates) {
+  if (area_.rows() < distances_.rows() || area_.cols() < distances_.cols()) {
+    area_.resize(distances_.rows(), distances_.cols());
+    worst_.resize(distances_.rows(), distances_.cols());
+  }
+  auto d = distances_.topLeftCorner(rows_, cols_);
+  auto a = area_.topLeftCorner(rows_, cols_);
+  auto m = worst_.topLeftCorner(rows_, cols_);
+  const Eigen::Index w = query.cols() / 3;
+  for (Eigen::Index k = 0; k < 3; ++k) {
+    const auto q = query.middleCols(k * w, w);
+    const auto c = candidates.middleCols(k * w, w);
+    a.noalias() = q * c.transpose();
+    query_norms_.head(rows_) = q.rowwise().squaredNorm();
+    candidate_norms_.head(cols_) = c.rowwise().squaredNorm();
+    for (Eigen::Index i = 0; i < rows_; ++i)
+      for (Eigen::Index j = 0; j < cols_; ++j) {
+        const float sq = std::max(query_norms_(i) + candidate_norms_(j) - 2.0f * a(i, j), 0.0f);
+        d(i, j) = k == 0 ? sq : d(i, j) + sq;
+        m(i, j) = k == 0 ? sq : std::max(m(i, j), sq);
+      }
+  }
+  const float s = static_cast<float>(options_.partial_area_scale);
+  for (Eigen::Index i = 0; i < rows_; ++i)
+    for (Eigen::Index j = 0; j < cols_; ++j)
+      d(i, j) = std::sqrt(std::min(d(i, j), s * (d(i, j) - m(i, j))));
+  return last_distances();
+}
+
+float descriptor_distance_sq(const MatchOptions& o,
+                             const Eigen::Ref<const Eigen::RowVectorXf>& a,
+                             const Eigen::Ref<const Eigen::RowVectorXf>& b) {
+  const Eigen::Index n = a.size();
+  if (!(o.partial_area_scale > 0.0) || n % 3 != 0) return (a - b).squaredNorm();
+  const Eigen::Index w = n / 3;
+  float sum = 0.0f, worst = 0.0f;
+  for (Eigen::Index k = 0; k < 3; ++k) {
+    const float sq = (a.segment(k * w, w) - b.segment(k * w, w)).squaredNorm();
+    sum += sq;
+    worst = std::max(worst, sq);
+  }
+  return std::min(sum, static_cast<float>(o.partial_area_scale) * (sum - worst));
 }
 
 MatchResult Matcher::evaluate_row(const Eigen::Ref<const Eigen::RowVectorXf>& row) const {
@@ -139,12 +192,18 @@ std::vector<MatchResult> match_brute_force(const MatchOptions& options,
     row.clear();
     double sum = 0.0;
     for (Eigen::Index j = 0; j < nb; ++j) {
-      double s = 0.0;  // eq. (6), term by term
-      for (Eigen::Index k = 0; k < query.cols(); ++k) {
+      // Eq. (6) term by term, per area when the occluder-tolerant distance is on.
+      const Eigen::Index cols = query.cols();
+      const bool partial = options.partial_area_scale > 0.0 && cols % 3 == 0;
+      double area[3] = {0.0, 0.0, 0.0};
+      for (Eigen::Index k = 0; k < cols; ++k) {
         const double diff = static_cast<double>(query(i, k)) - candidates(j, k);
-        s += diff * diff;
+        area[partial ? 3 * k / cols : 0] += diff * diff;
       }
-      const double dist = std::sqrt(s);
+      const double s = area[0] + area[1] + area[2];
+      const double worst = std::max({area[0], area[1], area[2]});
+      const double dist =
+          std::sqrt(partial ? std::min(s, options.partial_area_scale * (s - worst)) : s);
       sum += dist;
       row.emplace_back(dist, static_cast<int>(j));
     }

@@ -149,7 +149,8 @@ void Tracker::link_by_prediction(const FrameFeatures& frame, std::vector<TrackAs
     float distance = 0.0f;
     if (ok) {
       const Slot& s = slot_back(match->k);
-      distance = (frame.descriptors.row(a) - s.descriptors.row(match->j)).norm();
+      distance = std::sqrt(descriptor_distance_sq(
+          options_.match, frame.descriptors.row(a), s.descriptors.row(match->j)));
       ok = distance <= options_.predict_f1;
     }
     if (!ok) {

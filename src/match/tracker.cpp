@@ -428,7 +428,7 @@ int Tracker::nearest_new_line(const FrameFeatures& frame, const CandidateSearch&
     float nearest_sq = std::numeric_limits<float>::infinity();
     for (int a = 0; a < n; ++a) {
       if (!admissible(frame, c, a, j)) continue;
-      const float sq = (frame.descriptors.row(a) - b).squaredNorm();
+      const float sq = descriptor_distance_sq(options_.match, frame.descriptors.row(a), b);
       if (sq < nearest_sq) {
         nearest_sq = sq;
         nearest = a;
@@ -443,7 +443,7 @@ int Tracker::nearest_new_line(const FrameFeatures& frame, const CandidateSearch&
     const auto b = c.slot->descriptors.row(j);
     float nearest_sq = std::numeric_limits<float>::infinity();
     for (int a = 0; a < n; ++a) {
-      const float sq = (frame.descriptors.row(a) - b).squaredNorm();
+      const float sq = descriptor_distance_sq(options_.match, frame.descriptors.row(a), b);
       if (sq < nearest_sq) {
         nearest_sq = sq;
         nearest = a;

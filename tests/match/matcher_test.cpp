@@ -68,6 +68,14 @@ TEST(MatchOptions, Validation) {
   o = {};
   o.f1 = std::nan("");
   EXPECT_FALSE(o.IsValid(&error));
+  o = {};
+  o.partial_area_scale = 0.5;  // below 1 it would shrink every distance
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_NE(error.find("partial-area"), std::string::npos);
+  o.partial_area_scale = INFINITY;
+  EXPECT_FALSE(o.IsValid(&error));
+  o.partial_area_scale = 2.0;
+  EXPECT_TRUE(o.IsValid(&error));
 }
 
 TEST(Matcher, KnownDistancesAreReproduced) {
@@ -213,6 +221,86 @@ TEST(Matcher, AgreesWithBruteForceOnRandomInputs) {
   }
   EXPECT_GT(accepted, 500);  // the random sets do exercise acceptance
   EXPECT_GT(compared, 3000);
+}
+
+// MatchOptions::partial_area_scale on known geometry: a candidate equal to the query but in
+// one area (an occluder there: that area's histograms replaced) is at D^2 = d_k^2 by eq. (6)
+// and at 0 with the occluder-tolerant distance; a candidate that differs evenly in all three
+// areas keeps its eq. (6) distance (no area holds more than half of D^2 at s = 2).
+TEST(Matcher, OneChangedAreaIsLeftOutAndEvenChangesAreNot) {
+  std::mt19937 rng(3);
+  const DescriptorMatrix a = random_descriptors(1, rng);
+  DescriptorMatrix b(2, a.cols());
+  const Eigen::Index w = a.cols() / 3;
+  b.row(0) = a.row(0);
+  b.row(0).segment(0, w) = random_descriptors(1, rng, static_cast<int>(w)).row(0) *
+                           a.row(0).segment(0, w).norm();  // the inner area replaced
+  b.row(1) = a.row(0);
+  for (Eigen::Index k = 0; k < 3; ++k) b(1, k * w) += 0.05f;  // the same change in each area
+  const double d_area = (a.row(0) - b.row(0)).norm();
+  const double d_even = (a.row(0) - b.row(1)).norm();
+  ASSERT_GT(d_area, 0.3);
+
+  MatchOptions paper, tolerant;
+  tolerant.partial_area_scale = 2.0;
+  Matcher m_paper(paper), m_tolerant(tolerant);
+  EXPECT_NEAR(m_paper.compute_distances(a, b)(0, 0), d_area, 1e-5);
+  const auto d = m_tolerant.compute_distances(a, b);
+  EXPECT_NEAR(d(0, 0), 0.0, 1e-3);
+  EXPECT_NEAR(d(0, 1), d_even, 1e-5);
+  EXPECT_NEAR(std::sqrt(descriptor_distance_sq(tolerant, a.row(0), b.row(0))), 0.0, 1e-3);
+  EXPECT_NEAR(std::sqrt(descriptor_distance_sq(tolerant, a.row(0), b.row(1))), d_even, 1e-5);
+  EXPECT_NEAR(std::sqrt(descriptor_distance_sq(paper, a.row(0), b.row(0))), d_area, 1e-5);
+  // Two areas changed: the third alone cannot decide, s (d_1^2 + ... - max) > sum for s = 2
+  // only when one area dominates; here the two changed areas share the distance.
+  DescriptorMatrix c = a;
+  c(0, 0) += 0.3f;
+  c(0, w) += 0.3f;
+  EXPECT_NEAR(m_tolerant.compute_distances(a, c)(0, 0), (a.row(0) - c.row(0)).norm(), 1e-5);
+}
+
+// The occluder-tolerant fast path (three matrix products) against the reference term by term.
+TEST(Matcher, TheOccluderTolerantDistanceAgreesWithBruteForce) {
+  std::mt19937 rng(11);
+  MatchOptions o;
+  o.partial_area_scale = 2.0;
+  Matcher m(o);
+  std::vector<MatchResult> fast;
+  int partial = 0;
+  for (int trial = 0; trial < 50; ++trial) {
+    const int na = std::uniform_int_distribution<int>(1, 40)(rng);
+    const int nb = std::uniform_int_distribution<int>(2, 40)(rng);
+    DescriptorMatrix a = random_descriptors(na, rng);
+    const DescriptorMatrix b = random_descriptors(nb, rng);
+    for (int i = 0; i < na; i += 2) {  // copies of a candidate with one area replaced
+      const int j = std::uniform_int_distribution<int>(0, nb - 1)(rng);
+      a.row(i) = b.row(j);
+      const Eigen::Index k = std::uniform_int_distribution<Eigen::Index>(0, 2)(rng) * 64;
+      a.row(i).segment(k, 64) =
+          random_descriptors(1, rng, 64).row(0) * b.row(j).segment(k, 64).norm();
+    }
+    m.match(a, b, &fast);
+    const auto ref = match_brute_force(o, a, b);
+    const auto dist = m.last_distances();
+    for (int i = 0; i < na; ++i) {
+      for (int j = 0; j < nb; ++j) {
+        const double full = (a.row(i) - b.row(j)).norm();
+        const double exact = std::sqrt(descriptor_distance_sq(o, a.row(i), b.row(j)));
+        // Single precision: 1e-7 on d^2, 3e-4 on d near an exact copy (the square root).
+        ASSERT_NEAR(dist(i, j) * dist(i, j), exact * exact, 1e-5) << i << "," << j;
+        partial += exact < full - 1e-3;
+      }
+      const MatchResult& f = fast[static_cast<std::size_t>(i)];
+      const MatchResult& r = ref[static_cast<std::size_t>(i)];
+      EXPECT_NEAR(f.min_distance, r.min_distance, 1e-3);
+      EXPECT_NEAR(f.second_distance, r.second_distance, 1e-3);
+      EXPECT_NEAR(f.mean_distance, r.mean_distance, 1e-3);
+      if (r.second_distance - r.min_distance > 1e-3f) {
+        EXPECT_EQ(f.best, r.best);
+      }
+    }
+  }
+  EXPECT_GT(partial, 100);  // the one-area copies do take the tolerant branch
 }
 
 }  // namespace

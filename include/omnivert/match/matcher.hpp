@@ -46,6 +46,15 @@ struct MatchOptions {
   bool use_test1 = true;
   bool use_test2 = true;
   bool use_test3 = true;
+  // The occluder-tolerant distance; 0: eq. (6) as the paper has it. The descriptor's three
+  // areas (Sec. 3: inner, middle and outer circle, columns in thirds) are compared apart,
+  // d_k^2 the squared distance over area k's histograms, and
+  //   D = sqrt(min(sum_k d_k^2, s (sum_k d_k^2 - max_k d_k^2)))
+  // with s this scale (at least 1): where one area holds more than (s - 1) / s of the
+  // squared distance, the other two decide. A person passing beside a line changes the
+  // histograms of the areas it enters (the inner circle spans +-17 degrees of bearing at the
+  // annulus's inner radius), not the others (docs/theory/matching.md#occluders).
+  double partial_area_scale = 0.0;
 
   // True when the options are usable; otherwise false with the reason in *error.
   bool IsValid(std::string* error) const;
@@ -80,6 +89,12 @@ MatchVerdict apply_match_tests(const MatchOptions& options,
                                double second_distance,
                                double mean_distance);
 
+// The squared descriptor distance of eq. (6) between rows a and b, or its occluder-tolerant
+// form (MatchOptions::partial_area_scale).
+float descriptor_distance_sq(const MatchOptions& options,
+                             const Eigen::Ref<const Eigen::RowVectorXf>& a,
+                             const Eigen::Ref<const Eigen::RowVectorXf>& b);
+
 // Computes distance matrices and applies the tests. Reuse one Matcher across frames: its
 // buffers grow to the largest sizes seen and are then reused.
 class Matcher {
@@ -111,17 +126,21 @@ class Matcher {
   DistanceView last_distances() const { return DistanceView(distances_, 0, 0, rows_, cols_); }
 
  private:
+  DistanceView partial_distances(const ConstDescriptors& query, const ConstDescriptors& candidates);
+
   MatchOptions options_;
   // Work space with capacity; the live part is the top-left rows_ x cols_ corner.
   DistanceMatrix distances_;
+  DistanceMatrix area_, worst_;  // the occluder-tolerant distance's: one area's d^2, the largest
   Eigen::VectorXf query_norms_;
   Eigen::VectorXf candidate_norms_;
   Eigen::Index rows_ = 0;
   Eigen::Index cols_ = 0;
 };
 
-// The plain reference: every distance by its definition (eq. 6), double precision, and the
-// tests applied to the sorted row. For tests of the fast path.
+// The plain reference: every distance by its definition (eq. 6, or the occluder-tolerant
+// form term by term), double precision, and the tests applied to the sorted row. For tests of
+// the fast path.
 std::vector<MatchResult> match_brute_force(const MatchOptions& options,
                                            const DescriptorMatrix& query,
                                            const DescriptorMatrix& candidates);
