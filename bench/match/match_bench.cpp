@@ -134,10 +134,14 @@ BENCHMARK(BM_TrackerRecommended)
     ->ArgsProduct({{20, 30, 40}, {0, 1, 2}})
     ->Unit(benchmark::kMicrosecond);
 
-// Our matcher alone, one frame against the previous one (tests 1-3 included).
+// Our matcher alone, one frame against the previous one (tests 1-3 included); "partial" 1: the
+// occluder-tolerant distance (MatchOptions::partial_area_scale 2: three products, one per
+// circle of the descriptor).
 void BM_MatcherPreviousFrame(benchmark::State& state) {
   const auto seq = make_sequence(static_cast<int>(state.range(0)));
-  Matcher m;
+  MatchOptions o;
+  o.partial_area_scale = state.range(1) == 1 ? 2.0 : 0.0;
+  Matcher m(o);
   std::vector<MatchResult> results;
   std::size_t f = 1;
   for (auto _ : state) {
@@ -147,10 +151,8 @@ void BM_MatcherPreviousFrame(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_MatcherPreviousFrame)
-    ->ArgName("lines")
-    ->Arg(20)
-    ->Arg(30)
-    ->Arg(40)
+    ->ArgNames({"lines", "partial"})
+    ->ArgsProduct({{20, 30, 40}, {0, 1}})
     ->Unit(benchmark::kMicrosecond);
 
 // The peer: cv::BFMatcher(NORM_L2).knnMatch(k = 2) of one frame against the previous one,
