@@ -96,6 +96,16 @@ Matcher::DistanceView Matcher::compute_distances(const ConstDescriptors& query,
   return last_distances();
 }
 
+namespace {
+
+// MatchOptions::partial_area_scale's rule on the areas' squared distances: their sum, or s
+// times the sum without the largest where that is less.
+float occluder_tolerant_sq(float sum, float worst, float s) {
+  return std::min(sum, s * (sum - worst));
+}
+
+}  // namespace
+
 // MatchOptions::partial_area_scale: per area k, d_k^2 = |a_k|^2 + |b_k|^2 - 2 a_k.b_k by one
 // matrix product over its third of the columns; their sum in distances_, their largest in
 // worst_.
@@ -125,7 +135,7 @@ Matcher::DistanceView Matcher::partial_distances(const ConstDescriptors& query,
   const float s = static_cast<float>(options_.partial_area_scale);
   for (Eigen::Index i = 0; i < rows_; ++i)
     for (Eigen::Index j = 0; j < cols_; ++j)
-      d(i, j) = std::sqrt(std::min(d(i, j), s * (d(i, j) - m(i, j))));
+      d(i, j) = std::sqrt(occluder_tolerant_sq(d(i, j), m(i, j), s));
   return last_distances();
 }
 
@@ -141,7 +151,7 @@ float descriptor_distance_sq(const MatchOptions& o,
     sum += sq;
     worst = std::max(worst, sq);
   }
-  return std::min(sum, static_cast<float>(o.partial_area_scale) * (sum - worst));
+  return occluder_tolerant_sq(sum, worst, static_cast<float>(o.partial_area_scale));
 }
 
 MatchResult Matcher::evaluate_row(const Eigen::Ref<const Eigen::RowVectorXf>& row) const {

@@ -307,11 +307,7 @@ bool time_offset_from_refinement(dataset::Dataset& data,
   TimeOffsetEstimate& e = r.time_offset;
   const calib::RefinementResult& ref = r.calibration.refinement;
   if (!e.refined || !e.determined || e.retracked) return false;
-  TimeOffsetEstimate correction;
-  correction.determined = true;
-  correction.offset_s = ref.time_offset_s;
-  correction.sigma_s = ref.time_offset_sigma_s;
-  if (!correction.significant(o.time_offset)) return false;
+  if (!o.time_offset.significant(ref.time_offset_s, ref.time_offset_sigma_s)) return false;
   e.retracked = true;
   e.retracked_s = e.offset_s;
   e.tracks_applied = r.time_offset_applied;

@@ -95,11 +95,6 @@ struct Problem {
     const double var = (P * Sigma * P).trace();
     return var > 0 ? std::pow(median(e), 2) / var : 0.0;
   }
-  double cost(double S) const {
-    double J = 0;
-    for (std::size_t k : used) J += weighted_residual(triples[k], S);
-    return J;
-  }
   // The sandwich variance of the minimiser S* of J = sum_i q_i (q_i the weighted residual of
   // triple i), with the slopes g_i and the curvature J'' taken over +-h:
   //   var(S*) = sum_{i, k sharing an image} g_i g_k / J''^2.
@@ -204,9 +199,12 @@ std::string fmt_g(double v) {
 
 }  // namespace
 
+bool TimeOffsetOptions::significant(double offset_s, double sigma_s) const {
+  return std::abs(offset_s) > significance * sigma_s && std::abs(offset_s) >= min_applied_s;
+}
+
 bool TimeOffsetEstimate::significant(const TimeOffsetOptions& o) const {
-  return determined && std::abs(offset_s) > o.significance * sigma_s &&
-         std::abs(offset_s) >= o.min_applied_s;
+  return determined && o.significant(offset_s, sigma_s);
 }
 
 TimeOffsetEstimate estimate_time_offset(const TimeOffsetInput& in, const TimeOffsetOptions& o) {

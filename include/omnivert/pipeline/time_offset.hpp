@@ -62,6 +62,9 @@ struct TimeOffsetOptions {
   // synchronised recording keeps its stamps (and its results) unchanged.
   double significance = 3.0;
   double min_applied_s = 0.02;
+  // Whether an offset with this sigma is applied: |offset| above `significance` sigmas and
+  // at least `min_applied_s`.
+  bool significant(double offset_s, double sigma_s) const;
 
   // True when every field is usable; otherwise false with the reason in *why (may be null).
   bool IsValid(std::string* why) const;
