@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <future>
 #include <iomanip>
 #include <limits>
 #include <map>
@@ -16,6 +17,7 @@
 
 #include "calib/batch_point.hpp"
 #include "calib/updater.hpp"
+#include "core/parallel.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
 
@@ -120,23 +122,27 @@ double ratio_of(const BatchNoiseCheck& n) {
   return std::isfinite(ratio) && ratio > 0.0 ? ratio : 0.0;
 }
 
+// Whether the filter's noise check is the refinement's own: with no splits or joins anywhere,
+// the refinement already solved the filter's problem (known only once it has run).
+bool filter_check_may_be_the_refinements(const CalibrationOptions& options, const FilterResult& f) {
+  return options.refinement.enabled && f.splits.empty() && f.joins.empty();
+}
+
 // The noise check of the filter: on its own tracks, joined where it joined them
 // (FilterResult::joins) and split only where its window split them (FilterResult::splits),
 // each part starting at the track's filter estimate (after the window the filter treats a
 // track that slipped onto a neighbouring line as one feature, and the check should see
-// that). With no splits or joins anywhere, the refinement already solved this very problem.
+// that). It needs nothing of the refinement, so it may run beside it.
 BatchNoiseCheck filter_noise_check(const CalibrationRun& run,
                                    const CalibrationOptions& options,
                                    const BatchPoint& filter_point,
-                                   const CalibrationResult& r) {
-  if (r.refined && !r.refinement.renamed() && r.filter.splits.empty() && r.filter.joins.empty())
-    return r.refinement.noise;
+                                   const FilterResult& filter) {
   CalibrationOptions unsplit = options;
   unsplit.association.split_chi2 = 0.0;
   unsplit.association.join_pieces = false;
   std::map<int, int> origin;
   const CalibrationRun filter_run =
-      split_tracks(join_tracks(run, r.filter.joins), r.filter.splits, &origin);
+      split_tracks(join_tracks(run, filter.joins), filter.splits, &origin);
   BatchPoint start = filter_point;
   for (const auto& [id, tracker] : origin)
     if (const auto it = filter_point.features.find(tracker); it != filter_point.features.end())
@@ -203,6 +209,15 @@ CalibrationResult calibrate_once(const CalibrationRun& run, const CalibrationOpt
   r.filter = run_filter(run, options);
   r.seconds.filter = timer.lap("filter");
   const BatchPoint filter_point = batch_point_from_filter(run, options, r.filter);
+  // The filter's noise check on its own tracks does not wait for the refinement: with a
+  // second thread it runs beside it (the same numbers; spent for nothing when the trajectory
+  // leaves the extrinsics undetermined).
+  std::future<BatchNoiseCheck> beside;
+  if (nc.enabled && !filter_check_may_be_the_refinements(options, r.filter) &&
+      resolve_threads(options.threads) > 1)
+    beside = std::async(std::launch::async, [&run, &options, &filter_point, &r] {
+      return filter_noise_check(run, options, filter_point, r.filter);
+    });
   refine_and_analyse(run, options, filter_point, &timer, &r);
   r.noise_check.filter_model_covariance = r.filter.covariance;
   r.noise_check.refinement_model_covariance = r.refinement.covariance;
@@ -216,7 +231,13 @@ CalibrationResult calibrate_once(const CalibrationRun& run, const CalibrationOpt
     // is right (synthetic 0.3 degree, 50 runs: 3.50 -> 5.18). Less noise is applied only
     // where few pieces of lines were joined (CalibrationOptions::noise_check,
     // noise_check_lower_max_joins).
-    r.noise_check.filter_check = filter_noise_check(run, options, filter_point, r);
+    if (beside.valid())
+      r.noise_check.filter_check = beside.get();
+    else if (r.refined && !r.refinement.renamed() &&
+             filter_check_may_be_the_refinements(options, r.filter))
+      r.noise_check.filter_check = r.refinement.noise;
+    else
+      r.noise_check.filter_check = filter_noise_check(run, options, filter_point, r.filter);
     r.seconds.noise_check = timer.lap("the filter's noise check");
     apply_filter_noise(nc, &r);
     if (r.refined && r.refinement.covariance_ok) apply_refinement_noise(nc, &r);

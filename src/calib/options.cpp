@@ -101,6 +101,7 @@ bool checks_valid(const CalibrationOptions& o, std::string* why) {
     return fail(why, "noise_check.lower_max_joins must be a number (< 0: never applied)");
   if (n.dense_limit < 0) return fail(why, "noise_check.dense_limit must be >= 0");
   if (n.dense_track_limit < 0) return fail(why, "noise_check.dense_track_limit must be >= 0");
+  if (o.threads < 0) return fail(why, "threads must be >= 0 (0: every core)");
   const ObservabilityOptions& b = o.observability;
   if (!finite_positive(b.max_sigma_angle) || !finite_positive(b.max_sigma_rho))
     return fail(why, "observability.max_sigma_angle and observability.max_sigma_rho must be > 0");

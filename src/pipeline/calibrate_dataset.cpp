@@ -229,6 +229,7 @@ dataset::Dataset load_checked(const std::string& dataset_dir,
   if (!data.ground_truth_error().empty())
     spdlog::warn("ground truth not used: {}", data.ground_truth_error());
   *opt = options_from_dataset(data, o.calibration);
+  opt->threads = o.threads;  // --threads: the estimators' too
   if (!opt->IsValid(&why)) throw InputError("invalid calibration options: " + why);
   if (!o.reprojection.IsValid(&why)) throw InputError("invalid check options: " + why);
   // A reference asked for is checked before the work (bad input, exit code 2).

@@ -420,5 +420,32 @@ TEST(NoiseCheck, FindsBearingsLessNoisyThanAssumed) {
   EXPECT_EQ(kept_broken, less_broken);
 }
 
+// The filter's noise check runs beside the refinement when a second thread is allowed
+// (CalibrationOptions::threads): on tracks the tracker broke (the filter joins pieces, so the
+// check is not the refinement's own), one thread and two give the same numbers to the bit.
+TEST(NoiseCheck, BesideTheRefinementGivesTheSameNumbersAsAfterIt) {
+  SyntheticRunOptions so;
+  so.seed = 71;
+  so.break_probability = 0.1;
+  const SyntheticRun run = make_synthetic_run(so);
+  CalibrationOptions o = refined(options_for(so));
+  o.threads = 1;
+  const CalibrationResult one = calibrate(run.run, o);
+  o.threads = 2;
+  const CalibrationResult two = calibrate(run.run, o);
+  ASSERT_FALSE(one.filter.joins.empty());
+  ASSERT_TRUE(one.noise_check.checked && one.noise_check.filter_check.ok);
+  EXPECT_EQ(one.noise_check.filter_check.scale, two.noise_check.filter_check.scale);
+  EXPECT_EQ(one.noise_check.filter_check.covariance, two.noise_check.filter_check.covariance);
+  EXPECT_EQ(one.filter.covariance, two.filter.covariance);
+  EXPECT_EQ(one.refinement.covariance, two.refinement.covariance);
+  EXPECT_EQ(one.covariance, two.covariance);
+  EXPECT_EQ(one.extrinsics.vec(), two.extrinsics.vec());
+  o.threads = -1;
+  std::string why;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("threads"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace omnivert::calib

@@ -239,6 +239,9 @@ struct CalibrationOptions {
   RefinementOptions refinement;
   NoiseCheckOptions noise_check;
   ObservabilityOptions observability;
+  // Threads the estimators may use side by side (the filter's noise check beside the
+  // refinement): 0 every core, 1 one after the other. The results are the same to the bit.
+  int threads = 0;
 
   // True when the whole tree is usable; otherwise false with the reason in *why (may be
   // null), which names the offending field by its path, e.g. "noise.bearing_sigma must be > 0".

@@ -55,7 +55,7 @@ struct CalibrateDatasetOptions {
   std::string prior_source;
   std::vector<std::string> notes;  // extra warnings of the caller, reported with the rest
   TiltCheckOptions tilt;           // the tilt of the mirror axis (pipeline/tilt_check.hpp)
-  int threads = 0;                 // threads of the frame pipeline (TrackDatasetOptions)
+  int threads = 0;  // threads of the frame pipeline (TrackDatasetOptions) and the estimators
   // The causal mode of a robot that calibrates as it drives (pipeline/streaming.hpp): each
   // image through extraction, tracker and filter in turn on one thread, the estimate after
   // each written to streaming.csv with the time the frame took. The answer is the filter's;
