@@ -101,12 +101,17 @@ bool out_of_features(const Built& b, const AssociationSetup& setup) {
 }
 
 // The crossing guard, the features collapsed onto the camera, the outliers, each followed by
-// a solve. *rejected: the outliers. false: no feature left (AssociationSetup::stop_when_empty).
+// a solve; `at_solution`: the problem's values are a solution without the bearings these
+// judgements would remove (AssociationSetup::judge_before_solving), so the three are judged
+// there together and solved once, then the outliers again. *rejected: the outliers. false: no
+// feature left (AssociationSetup::stop_when_empty).
 bool reject_and_solve(Built* b,
                       const AssociationSetup& setup,
                       const std::map<int, int>& tracker,
-                      int* rejected) {
+                      int* rejected,
+                      bool at_solution = false) {
   const CalibrationOptions& options = *setup.options;
+  bool pending = at_solution;  // a solve is owed (every bearing back in)
   // Bearings where lines cross out first (the outliers are judged without them).
   if (reject_crossings(b,
                        options.association.crossing_guard,
@@ -115,12 +120,12 @@ bool reject_and_solve(Built* b,
                        tracker,
                        chi2_quantile(options.association.gate_probability, 2)) > 0) {
     if (out_of_features(*b, setup)) return false;
-    setup.solve(b);
+    if (!at_solution) setup.solve(b);
   }
   *rejected = 0;
   if (drop_collapsed_features(b, options.association.min_feature_range) > 0) {
     if (out_of_features(*b, setup)) return false;
-    setup.solve(b);
+    if (!at_solution) setup.solve(b);
   }
   const double gate = std::sqrt(chi2_quantile(options.association.gate_probability, 1));
   for (int round = 0; round < 3; ++round) {
@@ -128,20 +133,75 @@ bool reject_and_solve(Built* b,
     *rejected += n;
     if (n == 0) break;
     setup.solve(b);
+    pending = false;
   }
+  if (pending && !out_of_features(*b, setup)) setup.solve(b);
   return !out_of_features(*b, setup);
 }
 
-// The problem of the renamed run `run` from `at`, solved, and judged again.
+// The tracks of `next` that hold the same bearings as a track of `previous`, which differs from
+// it only by names (split_tracks and join_tracks rename: observation i of frame k is the same
+// bearing in both runs).
+std::set<int> changed_tracks(const CalibrationRun& previous, const CalibrationRun& next) {
+  std::map<int, std::set<int>> sources;  // track of next -> tracks of previous
+  std::map<int, int> size_next, size_previous;
+  for (std::size_t k = 0; k < next.frames.size(); ++k) {
+    const auto& a = next.frames[k].observations;
+    const auto* c = k < previous.frames.size() ? &previous.frames[k].observations : nullptr;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      ++size_next[a[i].track_id];
+      sources[a[i].track_id].insert(c && i < c->size() ? (*c)[i].track_id : -1);
+    }
+  }
+  for (const FrameInput& f : previous.frames)
+    for (const BearingObservation& o : f.observations) ++size_previous[o.track_id];
+  std::set<int> changed;
+  for (const auto& [id, from] : sources) {
+    const int source = *from.begin();
+    if (from.size() != 1 || source < 0 || size_previous[source] != size_next[id])
+      changed.insert(id);
+  }
+  return changed;
+}
+
+// The problem of the renamed run `run` (renamed from `previous`) from `at`, solved, and
+// judged again; with AssociationSetup::judge_before_solving, the tracks the renaming left as
+// they were judged at `at` first.
 AssociationEnd rebuild_and_judge(Built* b,
+                                 const CalibrationRun& previous,
                                  const CalibrationRun& run,
                                  const BatchPoint& at,
                                  const AssociationSetup& setup,
                                  Association* out) {
   *b = setup.rebuild(run, at);
   if (out_of_features(*b, setup)) return AssociationEnd::kNoTrack;
+  const std::map<int, int> tracker = tracker_ids(setup.base_origin, out->origin);
+  if (!setup.judge_before_solving) {
+    setup.solve(b);
+    if (!reject_and_solve(b, setup, tracker, &out->num_rejected))
+      return AssociationEnd::kNoTrackLeft;
+    return AssociationEnd::kDone;
+  }
+  // A start without the crossings and the outliers of the tracks the round left as they were,
+  // judged at `at` (their solution); the joined and split tracks neither judged nor judging.
+  const AssociationOptions& a = setup.options->association;
+  const std::set<int> changed = changed_tracks(previous, run);
+  reject_crossings(b,
+                   a.crossing_guard,
+                   a.max_missed_frames,
+                   setup.min_bearings,
+                   tracker,
+                   chi2_quantile(a.gate_probability, 2),
+                   &changed);
+  reject_outliers(b, std::sqrt(chi2_quantile(a.gate_probability, 1)), setup.min_bearings, &changed);
+  if (out_of_features(*b, setup)) return AssociationEnd::kNoTrack;
   setup.solve(b);
-  if (!reject_and_solve(b, setup, tracker_ids(setup.base_origin, out->origin), &out->num_rejected))
+  // Every bearing back in at that solution (a feature the start left out keeps its point from
+  // `at`) and judged there, all tracks together.
+  BatchPoint clean = point_of(*b);
+  for (const auto& [id, f] : at.features) clean.features.emplace(id, f);
+  *b = setup.rebuild(run, clean);
+  if (!reject_and_solve(b, setup, tracker, &out->num_rejected, /*at_solution=*/true))
     return AssociationEnd::kNoTrackLeft;
   return AssociationEnd::kDone;
 }
@@ -160,10 +220,11 @@ AssociationEnd associate(Built* b,
   for (int round = 0; setup.join_pieces && round < kMergeRounds; ++round) {
     BatchPoint at;
     const std::size_t before = out->merges.size();
+    const CalibrationRun previous = out->merged;
     if (!merge_round(b, *setup.options, &out->merged, &at, &out->merges)) break;
     spdlog::debug(
         "association: round {} joined {} pairs of pieces", round + 1, out->merges.size() - before);
-    if (const AssociationEnd end = rebuild_and_judge(b, out->merged, at, setup, out);
+    if (const AssociationEnd end = rebuild_and_judge(b, previous, out->merged, at, setup, out);
         end != AssociationEnd::kDone)
       return end;
   }
@@ -174,10 +235,11 @@ AssociationEnd associate(Built* b,
     if (found.empty()) break;
     spdlog::debug("association: round {} split {} tracks", round + 1, found.size());
     BatchPoint at = point_of(*b);
+    const CalibrationRun previous = round == 0 ? out->merged : out->split;
     out->split = split_round(
         out->merged, round == 0 ? out->merged : out->split, found, &out->splits, &out->origin, &at);
     out->num_splits += static_cast<int>(found.size());
-    if (const AssociationEnd end = rebuild_and_judge(b, out->split, at, setup, out);
+    if (const AssociationEnd end = rebuild_and_judge(b, previous, out->split, at, setup, out);
         end != AssociationEnd::kDone)
       return end;
   }

@@ -70,12 +70,14 @@ bool one_line(Built* b, int a, int c, double chi2, FeatureCovariance* cache);
 // margin, and with tracks broken every ~10 frames the guard leaves out most bearings
 // (CrossingGuard.PiecesOfOneLineDoNotGuardEachOther; synthetic paper run, break probability 0.1:
 // 950 of 1140 in the filter, most features of the refinement).
+// With `left_out`, those features are neither judged nor judge the others.
 int reject_crossings(Built* b,
                      double guard,
                      int margin,
                      int min_bearings,
                      const std::map<int, int>& origin,
-                     double merge_chi2);
+                     double merge_chi2,
+                     const std::set<int>* left_out = nullptr);
 
 // The likelihood-ratio statistic of "one point" for tracks a and c with the poses and the
 // extrinsics held at the current solution: the least squares cost of all their bearings
@@ -179,6 +181,10 @@ struct AssociationSetup {
   // Whether a problem left without features ends the loop (AssociationEnd); otherwise it is
   // solved on.
   bool stop_when_empty = false;
+  // After a round joined or split tracks, the bearings of the tracks it left as they were are
+  // judged at the last solution before the first solve of the new problem (it then starts
+  // clean, without the outliers found before); false: every bearing back in for that solve.
+  bool judge_before_solving = false;
   // The problem of a renamed run from a starting point (the estimator's own build), and its
   // solve.
   std::function<Built(const CalibrationRun&, const BatchPoint&)> rebuild;

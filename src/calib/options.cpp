@@ -91,6 +91,8 @@ bool checks_valid(const CalibrationOptions& o, std::string* why) {
     return fail(why, "refinement.odometry_inflation must be > 0");
   if (!finite_positive(r.huber_sigmas)) return fail(why, "refinement.huber_sigmas must be > 0");
   if (r.max_iterations < 1) return fail(why, "refinement.max_iterations must be >= 1");
+  if (!(r.association_function_tolerance > 0.0 && r.association_function_tolerance < 1.0))
+    return fail(why, "refinement.association_function_tolerance must be in (0, 1)");
   if (!finite_positive(r.time_offset_prior_sigma_s))
     return fail(why, "refinement.time_offset_prior_sigma_s must be > 0 [s]");
   const NoiseCheckOptions& n = o.noise_check;

@@ -72,6 +72,7 @@ AssociationSetup association_setup(const CalibrationOptions& assoc,
   s.min_bearings = 2;  // two bearings at least determine a feature point
   s.join_pieces = assoc.association.join_pieces;
   s.split = assoc.association;
+  s.judge_before_solving = true;
   s.rebuild = [&assoc](const CalibrationRun& run, const BatchPoint& at) {
     return build(run, assoc, at, assoc.refinement.robust);
   };
@@ -226,18 +227,20 @@ RefinementResult refine_batch(const CalibrationRun& run,
   res.num_bearings = b.num_bearings;
 
   const ceres::Solver::Options so = solver_options(options.refinement);
+  ceres::Solver::Options loose = so;
+  loose.function_tolerance = options.refinement.association_function_tolerance;
   ceres::Solver::Summary summary;
-  solve_logged(so, &b, &summary, "first solve");
+  solve_logged(loose, &b, &summary, "first solve");
   // Lines that cross, outliers (false matches, at the filter's gate), pieces of one line,
   // slipped tracks; the problem solved again after each decision.
   Association association;
-  associate(&b, run, association_setup(assoc, so, &summary), &association);
+  associate(&b, run, association_setup(assoc, loose, &summary), &association);
   record_association(&association, &res);
-  if (model.noise.track_bias_sigma > 0.0) {
+  if (model.noise.track_bias_sigma > 0.0)
     b = final_with_bias(
         res.renamed() ? res.solved_run : run, b, model, options.refinement.robust, 2);
-    solve_logged(so, &b, &summary, "with the track biases");
-  }
+  solve_logged(
+      so, &b, &summary, model.noise.track_bias_sigma > 0.0 ? "with the track biases" : "last");
   res.guarded = b.guarded;
   res.rejected =
       unused_bearings(res.renamed() ? res.solved_run : run, b, [](int id) { return id; });

@@ -164,6 +164,11 @@ struct RefinementOptions {
   bool robust = false;        // Huber loss on bearings
   double huber_sigmas = 3.0;  // Huber threshold in bearing sigmas
   int max_iterations = 100;
+  // The solves before and between the association's decisions (outliers, crossings, joins,
+  // splits) stop when an iteration changes the cost by less than this fraction; the last
+  // solve, whose answer is reported, at 1e-10. Each decision needs the solution to a
+  // fraction of a sigma, not to the last digit.
+  double association_function_tolerance = 1e-6;
   // With the run's CalibrationRun::clock: a correction dS of the camera-odometry time offset
   // estimated with the extrinsics (the image stamps late by a further dS; docs/calibration.md
   // #time-offset), with the prior dS ~ N(0, time_offset_prior_sigma_s^2) that keeps a run
