@@ -145,14 +145,23 @@ void FilterState::reparametrise(int slot,
   const int a = slots_[slot].index, k = feature_param_size(slots_[slot].param);
   const int m = static_cast<int>(y.size());
   assert(J.rows() == m && J.cols() == k);
-  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(n - k + m, n);
-  T.topLeftCorner(a, a).setIdentity();
-  T.block(a, a, m, k) = J;
-  T.bottomRightCorner(n - a - k, n - a - k).setIdentity();
+  // P <- T P T^T with T the identity but for J in the slot's block: only the slot's rows and
+  // columns change, O(n k m) instead of the dense O(n^3)
+  // (FilterState.ReparametriseEqualsTheDenseProduct).
+  const int b = n - a - k;  // entries after the slot
+  Eigen::MatrixXd Pn(n - k + m, n - k + m);
+  Pn.topLeftCorner(a, a) = P_.topLeftCorner(a, a);
+  Pn.topRightCorner(a, b) = P_.topRightCorner(a, b);
+  Pn.bottomLeftCorner(b, a) = P_.bottomLeftCorner(b, a);
+  Pn.bottomRightCorner(b, b) = P_.bottomRightCorner(b, b);
+  Pn.block(0, a, a, m).noalias() = P_.block(0, a, a, k) * J.transpose();
+  Pn.block(a, a + m, m, b).noalias() = J * P_.block(a, a + k, k, b);
+  Pn.block(a, a, m, m).noalias() = J * P_.block(a, a, k, k) * J.transpose();
+  Pn.block(a, 0, m, a) = Pn.block(0, a, a, m).transpose();
+  Pn.block(a + m, a, b, m) = Pn.block(a, a + m, m, b).transpose();
   Eigen::VectorXd x(n - k + m);
   x << x_.head(a), y, x_.tail(n - a - k);
-  P_ = (T * P_ * T.transpose()).eval();
-  P_ = 0.5 * (P_ + P_.transpose()).eval();
+  P_ = 0.5 * (Pn + Pn.transpose());
   x_ = std::move(x);
   slots_[slot].param = param;
   reindex();

@@ -48,12 +48,28 @@ void Propagator::propagate(const FrameInput& frame, FilterState* state) const {
   if (!steps[1].isZero()) propagate(steps[1](0), steps[1](1), state);
 }
 
+void propagate_covariance(const std::vector<TransitionBlock>& F,
+                          const Eigen::MatrixXd& G,
+                          const Eigen::Matrix2d& Q,
+                          Eigen::MatrixXd* P) {
+  for (const TransitionBlock& b : F) {
+    const Eigen::MatrixXd rows = b.A * P->middleRows(b.index, b.A.rows());
+    P->middleRows(b.index, b.A.rows()) = rows;
+  }
+  for (const TransitionBlock& b : F) {
+    const Eigen::MatrixXd cols = P->middleCols(b.index, b.A.rows()) * b.A.transpose();
+    P->middleCols(b.index, b.A.rows()) = cols;
+  }
+  P->noalias() += G * Q * G.transpose();
+}
+
 void Propagator::propagate(double d_right, double d_left, FilterState* state) const {
   const int n = state->dim();
   const double e = options_.robot.wheel_base;
   // F_x is block diagonal (A^i per feature, identity for the extrinsics); F_u stacks the
   // B^i with zeros for the extrinsics (appendix A.4).
-  Eigen::MatrixXd F = Eigen::MatrixXd::Identity(n, n);
+  std::vector<TransitionBlock> F;
+  F.reserve(state->slots().size());
   Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, 2);
   Eigen::VectorXd& x = state->mutable_x();
   for (const FeatureSlot& s : state->slots()) {
@@ -62,21 +78,21 @@ void Propagator::propagate(double d_right, double d_left, FilterState* state) co
       case FeatureParam::kDistance: {  // Eq. (29), A^i and B^i of eq. (32)
         Mat2 A, B;
         x.segment<2>(i) = propagate_feature(x.segment<2>(i), d_right, d_left, e, &A, &B);
-        F.block<2, 2>(i, i) = A;
+        F.push_back({i, A});
         G.block<2, 2>(i, 0) = B;
         break;
       }
       case FeatureParam::kInverseDistance: {  // Eq. (29) in (1/D, theta)
         Mat2 A, B;
         x.segment<2>(i) = propagate_feature_inverse(x.segment<2>(i), d_right, d_left, e, &A, &B);
-        F.block<2, 2>(i, i) = A;
+        F.push_back({i, A});
         G.block<2, 2>(i, 0) = B;
         break;
       }
       case FeatureParam::kPoint: {  // Eq. (14) in the robot frame
         Mat2 A, B;
         x.segment<2>(i) = propagate_point(x.segment<2>(i), d_right, d_left, e, &A, &B);
-        F.block<2, 2>(i, i) = A;
+        F.push_back({i, A});
         G.block<2, 2>(i, 0) = B;
         break;
       }
@@ -84,7 +100,7 @@ void Propagator::propagate(double d_right, double d_left, FilterState* state) co
         Mat4 A;
         Mat42 B;
         x.segment<4>(i) = propagate_anchored(x.segment<4>(i), d_right, d_left, e, &A, &B);
-        F.block<4, 4>(i, i) = A;
+        F.push_back({i, A});
         G.block<4, 2>(i, 0) = B;
         break;
       }
@@ -96,8 +112,7 @@ void Propagator::propagate(double d_right, double d_left, FilterState* state) co
                                d_left,
                                options_.robot.odometry_K * options_.filter.odometry_inflation,
                                options_.robot.odometry_variance_floor);
-  Eigen::MatrixXd& P = state->mutable_P();
-  P = (F * P * F.transpose() + G * Q * G.transpose()).eval();
+  propagate_covariance(F, G, Q, &state->mutable_P());
   state->normalise();
 }
 

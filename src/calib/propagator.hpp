@@ -5,6 +5,7 @@
 // with K' = K * inflation (the paper inflates K five-fold; our default is 1: types.hpp).
 
 #include <array>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -27,6 +28,21 @@ class Propagator {
  private:
   CalibrationOptions options_;
 };
+
+// One diagonal block of F_x other than the identity: rows and columns index..index+A.rows()-1.
+struct TransitionBlock {
+  int index = 0;
+  Eigen::MatrixXd A;
+};
+
+// P <- F P F^T + G Q G^T, F the identity but for the blocks (appendix A.4: A^i per feature, the
+// extrinsics and biases unchanged), which do not overlap: each block multiplies its rows, then
+// its columns, O(n^2) per feature dimension instead of the dense O(n^3)
+// (Propagator.BlockCovarianceEqualsTheDenseProduct against F P F^T formed densely).
+void propagate_covariance(const std::vector<TransitionBlock>& F,
+                          const Eigen::MatrixXd& G,
+                          const Eigen::Matrix2d& Q,
+                          Eigen::MatrixXd* P);
 
 // The two steps of eq. (14), (d_right, d_left) each, that compose to one step with the
 // sideways displacement `lateral` (FrameInput::lateral): a turn in place by alpha, then a

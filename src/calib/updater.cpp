@@ -36,6 +36,25 @@ bool joseph_update(const Eigen::MatrixXd& H,
   return true;
 }
 
+bool joseph_update(const Eigen::SparseMatrix<double>& H,
+                   const Eigen::VectorXd& r,
+                   Eigen::MatrixXd* P) {
+  const Eigen::MatrixXd PHt = (*P) * H.transpose();
+  Eigen::MatrixXd S = H * PHt;
+  S.diagonal() += r;
+  const Eigen::LLT<Eigen::MatrixXd> llt(S);
+  if (llt.info() != Eigen::Success) return false;
+  const Eigen::MatrixXd K = llt.solve(PHt.transpose()).transpose();
+  // (I - K H) P (I - K H)^T + K R K^T = A - A H^T K^T + K R K^T with A = (I - K H) P.
+  Eigen::MatrixXd A = *P;
+  A.noalias() -= K * PHt.transpose();
+  Eigen::MatrixXd B = A * H.transpose();
+  B.noalias() -= K * r.asDiagonal();
+  A.noalias() -= B * K.transpose();
+  *P = 0.5 * (A + A.transpose());
+  return true;
+}
+
 namespace {
 // Regularised lower incomplete gamma P(a, x): series for x < a + 1, continued fraction
 // otherwise (Numerical Recipes, Sec. 6.2).
@@ -208,17 +227,23 @@ std::vector<BearingUpdateResult> Updater::update(const std::vector<BearingMeasur
   const Eigen::VectorXd x0 = state->x();
   const Eigen::MatrixXd P0 = state->P();
 
-  // Chi-square gate of each bearing on its own, at the prior.
+  // Chi-square gate of each bearing on its own, at the prior. H has a handful of nonzeros a
+  // row (eq. 30: the bearing's feature, the extrinsics, a bias), so H P H^T is taken over them.
   Eigen::MatrixXd H;
   const Eigen::VectorXd h0 = predict(*state, x0, z_all, &H);
+  const Eigen::SparseMatrix<double, Eigen::RowMajor> H_rows = H.sparseView();
   std::vector<BearingMeasurement> z;
   std::vector<int> used;
   std::vector<double> r_var;
   for (std::size_t k = 0; k < z_all.size(); ++k) {
     const double rk = measurement_variance(*state, z_all[k]);
     const double r = angle_diff(z_all[k].beta, h0(k));
-    const double S = H.row(k).dot(P0 * H.row(k).transpose()) + rk;
-    results[k].chi2 = r * r / S;
+    double hph = 0.0;
+    const int row = static_cast<int>(k);
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator a(H_rows, row); a; ++a)
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator b(H_rows, row); b; ++b)
+        hph += a.value() * P0(a.col(), b.col()) * b.value();
+    results[k].chi2 = r * r / (hph + rk);
     if (results[k].chi2 <= gate_) {  // also rejects NaN
       z.push_back(z_all[k]);
       used.push_back(static_cast<int>(k));
@@ -227,26 +252,30 @@ std::vector<BearingUpdateResult> Updater::update(const std::vector<BearingMeasur
   }
   if (z.empty()) return results;
   const int m = static_cast<int>(z.size());
-  Eigen::MatrixXd R = Eigen::MatrixXd::Zero(m, m);
-  for (int k = 0; k < m; ++k) R(k, k) = r_var[k];
+  const Eigen::VectorXd R = Eigen::Map<const Eigen::VectorXd>(r_var.data(), m);
 
   // Iterated EKF: x_{j+1} = x0 + K_j (z - h(x_j) - H_j (x0 - x_j)), K_j from H_j and P0.
   Eigen::VectorXd xj = x0;
+  Eigen::SparseMatrix<double> Hs;
   for (int it = 0; it < options_.filter.update_iterations; ++it) {
     const Eigen::VectorXd hj = predict(*state, xj, z, &H);
+    Hs = H.sparseView();
     Eigen::VectorXd r(m);
     for (int k = 0; k < m; ++k) r(k) = angle_diff(z[k].beta, hj(k));  // wrapped innovation
-    const Eigen::MatrixXd PHt = P0 * H.transpose();
-    const Eigen::LLT<Eigen::MatrixXd> llt(H * PHt + R);
+    const Eigen::MatrixXd PHt = P0 * Hs.transpose();
+    Eigen::MatrixXd S = Hs * PHt;
+    S.diagonal() += R;
+    const Eigen::LLT<Eigen::MatrixXd> llt(S);
     if (llt.info() != Eigen::Success) return results;
-    const Eigen::VectorXd xn = x0 + PHt * llt.solve(r + H * (xj - x0));
+    const Eigen::VectorXd xn = x0 + PHt * llt.solve(r + Hs * (xj - x0));
     const double step = (xn - xj).norm();
     xj = xn;
     if (step < 1e-10) break;
   }
   // Covariance at the last linearisation, through the shared Joseph update.
   predict(*state, xj, z, &H);
-  if (!joseph_update(H, R, &state->mutable_P())) return results;
+  Hs = H.sparseView();
+  if (!joseph_update(Hs, R, &state->mutable_P())) return results;
   state->mutable_x() = xj;
   state->normalise();
   for (int k : used) results[k].accepted = true;

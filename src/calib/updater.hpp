@@ -3,6 +3,7 @@
 // through which every covariance update goes.
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <vector>
 
 #include "calib/filter_state.hpp"
@@ -18,6 +19,15 @@ bool joseph_update(const Eigen::MatrixXd& H,
                    const Eigen::MatrixXd& R,
                    Eigen::MatrixXd* P,
                    Eigen::MatrixXd* K = nullptr);
+
+// The same update for a sparse H (each bearing's row touches its feature, the extrinsics and
+// a bias: eq. 30) and a diagonal R = diag(r), the filter's case: the products with H cost
+// n x nnz(H) instead of n^2 x m, and the Joseph form's two n^2 x m products remain,
+//   A = P - K (P H^T)^T,   P <- A - (A H^T - K R) K^T.
+// joseph_update is its plain reference (Updater.SparseJosephUpdateEqualsTheDenseOne).
+bool joseph_update(const Eigen::SparseMatrix<double>& H,
+                   const Eigen::VectorXd& r,
+                   Eigen::MatrixXd* P);
 
 // Quantile of the chi-square distribution with dof degrees of freedom (bisection on the
 // regularised incomplete gamma function; accurate to ~1e-10).
