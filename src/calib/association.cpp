@@ -139,9 +139,9 @@ bool reject_and_solve(Built* b,
   return !out_of_features(*b, setup);
 }
 
-// The tracks of `next` that hold the same bearings as a track of `previous`, which differs from
-// it only by names (split_tracks and join_tracks rename: observation i of frame k is the same
-// bearing in both runs).
+// The tracks of `next` that a round joined or split: those whose bearings are not exactly the
+// bearings of one track of `previous` (split_tracks and join_tracks only rename: observation i
+// of frame k is the same bearing in both runs).
 std::set<int> changed_tracks(const CalibrationRun& previous, const CalibrationRun& next) {
   std::map<int, std::set<int>> sources;  // track of next -> tracks of previous
   std::map<int, int> size_next, size_previous;
