@@ -100,6 +100,27 @@ bool out_of_features(const Built& b, const AssociationSetup& setup) {
   return setup.stop_when_empty && b.features.empty();
 }
 
+// The crossing guard of the association's options (reject_crossings), `left_out` neither
+// judged nor judging.
+int guard_crossings(Built* b,
+                    const AssociationSetup& setup,
+                    const std::map<int, int>& tracker,
+                    const std::set<int>* left_out = nullptr) {
+  const AssociationOptions& a = setup.options->association;
+  return reject_crossings(b,
+                          a.crossing_guard,
+                          a.max_missed_frames,
+                          setup.min_bearings,
+                          tracker,
+                          chi2_quantile(a.gate_probability, 2),
+                          left_out);
+}
+
+// The outlier gate in sigmas: the filter's chi-square gate, 1 degree of freedom.
+double outlier_gate(const AssociationSetup& setup) {
+  return std::sqrt(chi2_quantile(setup.options->association.gate_probability, 1));
+}
+
 // The crossing guard, the features collapsed onto the camera, the outliers, each followed by
 // a solve; `at_solution`: the problem's values are a solution without the bearings these
 // judgements would remove (AssociationSetup::judge_before_solving), so the three are judged
@@ -113,12 +134,7 @@ bool reject_and_solve(Built* b,
   const CalibrationOptions& options = *setup.options;
   bool pending = at_solution;  // a solve is owed (every bearing back in)
   // Bearings where lines cross out first (the outliers are judged without them).
-  if (reject_crossings(b,
-                       options.association.crossing_guard,
-                       options.association.max_missed_frames,
-                       setup.min_bearings,
-                       tracker,
-                       chi2_quantile(options.association.gate_probability, 2)) > 0) {
+  if (guard_crossings(b, setup, tracker) > 0) {
     if (out_of_features(*b, setup)) return false;
     if (!at_solution) setup.solve(b);
   }
@@ -127,7 +143,7 @@ bool reject_and_solve(Built* b,
     if (out_of_features(*b, setup)) return false;
     if (!at_solution) setup.solve(b);
   }
-  const double gate = std::sqrt(chi2_quantile(options.association.gate_probability, 1));
+  const double gate = outlier_gate(setup);
   for (int round = 0; round < 3; ++round) {
     const int n = reject_outliers(b, gate, setup.min_bearings);
     *rejected += n;
@@ -184,16 +200,9 @@ AssociationEnd rebuild_and_judge(Built* b,
   }
   // A start without the crossings and the outliers of the tracks the round left as they were,
   // judged at `at` (their solution); the joined and split tracks neither judged nor judging.
-  const AssociationOptions& a = setup.options->association;
   const std::set<int> changed = changed_tracks(previous, run);
-  reject_crossings(b,
-                   a.crossing_guard,
-                   a.max_missed_frames,
-                   setup.min_bearings,
-                   tracker,
-                   chi2_quantile(a.gate_probability, 2),
-                   &changed);
-  reject_outliers(b, std::sqrt(chi2_quantile(a.gate_probability, 1)), setup.min_bearings, &changed);
+  guard_crossings(b, setup, tracker, &changed);
+  reject_outliers(b, outlier_gate(setup), setup.min_bearings, &changed);
   if (out_of_features(*b, setup)) return AssociationEnd::kNoTrack;
   setup.solve(b);
   // Every bearing back in at that solution (a feature the start left out keeps its point from

@@ -236,11 +236,12 @@ RefinementResult refine_batch(const CalibrationRun& run,
   Association association;
   associate(&b, run, association_setup(assoc, loose, &summary), &association);
   record_association(&association, &res);
-  if (model.noise.track_bias_sigma > 0.0)
+  // The last solve, to the full tolerance; with the track biases when modelled.
+  const bool biased = model.noise.track_bias_sigma > 0.0;
+  if (biased)
     b = final_with_bias(
         res.renamed() ? res.solved_run : run, b, model, options.refinement.robust, 2);
-  solve_logged(
-      so, &b, &summary, model.noise.track_bias_sigma > 0.0 ? "with the track biases" : "last");
+  solve_logged(so, &b, &summary, biased ? "with the track biases" : "last");
   res.guarded = b.guarded;
   res.rejected =
       unused_bearings(res.renamed() ? res.solved_run : run, b, [](int id) { return id; });

@@ -56,6 +56,19 @@ bool joseph_update(const Eigen::SparseMatrix<double>& H,
 }
 
 namespace {
+
+using RowSparse = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+
+// h P h^T of row `row` of H over its nonzero entries (eq. 30: the bearing's feature, the
+// extrinsics, a bias), a handful instead of dim^2.
+double row_variance(const RowSparse& H, int row, const Eigen::MatrixXd& P) {
+  double hph = 0.0;
+  for (RowSparse::InnerIterator a(H, row); a; ++a)
+    for (RowSparse::InnerIterator b(H, row); b; ++b)
+      hph += a.value() * P(a.col(), b.col()) * b.value();
+  return hph;
+}
+
 // Regularised lower incomplete gamma P(a, x): series for x < a + 1, continued fraction
 // otherwise (Numerical Recipes, Sec. 6.2).
 double gamma_p(double a, double x) {
@@ -208,15 +221,10 @@ double Updater::innovation_chi2(const FilterState& state, const BearingMeasureme
   const Eigen::VectorXd h = predict(state, state.x(), {z}, &H);
   const double var = measurement_variance(state, z);
   const double r = angle_diff(z.beta, h(0));
-  // H P H^T over H's nonzero entries (the feature's block and the extrinsics): O(1), not
-  // O(dim^2), for the filter's search among the features
+  // Over H's nonzero entries: O(1), not O(dim^2), for the filter's search among the features
   // (CalibrationOptions::association.join_pieces).
-  std::vector<int> nz;
-  for (int i = 0; i < H.cols(); ++i)
-    if (H(0, i) != 0.0) nz.push_back(i);
-  double hph = 0.0;
-  for (int i : nz)
-    for (int j : nz) hph += H(0, i) * state.P()(i, j) * H(0, j);
+  const RowSparse H_row = H.sparseView();
+  const double hph = row_variance(H_row, 0, state.P());
   return r * r / (hph + var);
 }
 
@@ -231,18 +239,14 @@ std::vector<BearingUpdateResult> Updater::update(const std::vector<BearingMeasur
   // row (eq. 30: the bearing's feature, the extrinsics, a bias), so H P H^T is taken over them.
   Eigen::MatrixXd H;
   const Eigen::VectorXd h0 = predict(*state, x0, z_all, &H);
-  const Eigen::SparseMatrix<double, Eigen::RowMajor> H_rows = H.sparseView();
+  const RowSparse H_rows = H.sparseView();
   std::vector<BearingMeasurement> z;
   std::vector<int> used;
   std::vector<double> r_var;
   for (std::size_t k = 0; k < z_all.size(); ++k) {
     const double rk = measurement_variance(*state, z_all[k]);
     const double r = angle_diff(z_all[k].beta, h0(k));
-    double hph = 0.0;
-    const int row = static_cast<int>(k);
-    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator a(H_rows, row); a; ++a)
-      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator b(H_rows, row); b; ++b)
-        hph += a.value() * P0(a.col(), b.col()) * b.value();
+    const double hph = row_variance(H_rows, static_cast<int>(k), P0);
     results[k].chi2 = r * r / (hph + rk);
     if (results[k].chi2 <= gate_) {  // also rejects NaN
       z.push_back(z_all[k]);
