@@ -351,6 +351,13 @@ void add_calibrate_command(CLI::App& app) {
                 "Filter (window and after) and refinement: keep a track that starts where a line "
                 "the tracker lost is predicted as a line of its own, instead of joining it to that "
                 "line (docs/theory/association.md#pieces-of-one-line)");
+  cmd->add_option("--join-prediction-sigmas",
+                  a->options.calibration.association.join_prediction_sigmas,
+                  "Filter after the window: join a new track to a lost line only where that "
+                  "line's predicted bearing has a sigma of at most this many bearing sigmas; 0: "
+                  "no limit")
+      ->check(kNonNegative)
+      ->capture_default_str();
   cmd->add_option("--crossing-guard",
                   a->crossing_guard_deg,
                   "Leave out a track's bearings while another line is predicted within this "

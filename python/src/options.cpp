@@ -253,6 +253,11 @@ const OptionTable<CO>& calibration_table() {
           "join", "join a new track to the lost line it continues", [](CO & o) -> auto& {
             return o.association.join_pieces;
           }),
+      field<double, CO>(
+          "join_prediction_sigmas",
+          "filter: join only where the lost line's predicted bearing is this sharp [bearing "
+          "sigmas]",
+          [](CO & o) -> auto& { return o.association.join_prediction_sigmas; }),
       degrees<CO>(
           "crossing_guard",
           "leave out bearings within this of another line [deg]",

@@ -387,8 +387,10 @@ int CalibrationFilter::Impl::slot_of(int track_id) const {
 // features of the state whose point is known (kPoint, kDistance: a feature still in inverse depth
 // predicts a wide fan of bearings, where any line would pass), not seen in this frame and with no
 // feature seen in this frame predicted within the crossing guard of it, whose gate (eq. 30's
-// innovation, Updater::innovation_chi2) the bearing passes. A new track with exactly one
-// candidate, which no other new track has as a candidate, continues it. (Only the features
+// innovation, Updater::innovation_chi2) the bearing passes, and whose predicted bearing is sharp
+// (join_prediction_sigmas: on a long run through a line-rich room, new tracks of other lines
+// start within the gate of a wide prediction). A new track with exactly one candidate, which no
+// other new track has as a candidate, continues it. (Only the features
 // seen in this frame crowd a candidate: the old piece of a line that was not joined stays in
 // the state for max_missed_frames frames unseen, and would crowd the new piece of the same
 // line. Without the crowding test a new track of a door's edge can be joined to the feature
@@ -423,13 +425,18 @@ std::vector<const BearingObservation*> CalibrationFilter::Impl::join_pieces(
         !crowded(s))
       eligible.push_back(s);
   }
+  const double max_sigma =
+      options_.association.join_prediction_sigmas * options_.noise.bearing_sigma;
   std::vector<int> candidate(fresh.size(), -1);
   std::map<int, int> claims;  // slot -> new tracks that have it as a candidate
   for (std::size_t i = 0; i < fresh.size(); ++i) {
     int found = 0;
     for (int s : eligible) {
       const BearingMeasurement m{s, fresh[i]->beta, fresh[i]->sigma_scale};
-      if (!(updater_.innovation_chi2(state_, m) <= updater_.gate())) continue;
+      double predicted_var = 0.0;
+      if (!(updater_.innovation_chi2(state_, m, &predicted_var) <= updater_.gate())) continue;
+      if (max_sigma > 0.0 && predicted_var > std::pow(max_sigma * fresh[i]->sigma_scale, 2))
+        continue;
       ++claims[s];
       candidate[i] = s;
       ++found;

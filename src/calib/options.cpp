@@ -71,6 +71,8 @@ bool association_valid(const AssociationOptions& a, std::string* why) {
   if (!(a.gate_probability > 0.0 && a.gate_probability <= 1.0))
     return fail(why, "association.gate_probability must be in (0, 1]");
   if (a.max_missed_frames < 0) return fail(why, "association.max_missed_frames must be >= 0");
+  if (!(a.join_prediction_sigmas >= 0.0))
+    return fail(why, "association.join_prediction_sigmas must be >= 0 (0: no limit)");
   if (a.min_track_length < 2) return fail(why, "association.min_track_length must be >= 2");
   if (!finite_non_negative(a.min_feature_range))
     return fail(why, "association.min_feature_range must be >= 0 [m]");

@@ -216,7 +216,9 @@ double Updater::measurement_variance(const FilterState& state, const BearingMeas
          (options_.filter.second_order_noise ? second_order_variance(state, z) : 0.0);
 }
 
-double Updater::innovation_chi2(const FilterState& state, const BearingMeasurement& z) const {
+double Updater::innovation_chi2(const FilterState& state,
+                                const BearingMeasurement& z,
+                                double* prediction_variance) const {
   Eigen::MatrixXd H;
   const Eigen::VectorXd h = predict(state, state.x(), {z}, &H);
   const double var = measurement_variance(state, z);
@@ -225,6 +227,7 @@ double Updater::innovation_chi2(const FilterState& state, const BearingMeasureme
   // (CalibrationOptions::association.join_pieces).
   const RowSparse H_row = H.sparseView();
   const double hph = row_variance(H_row, 0, state.P());
+  if (prediction_variance) *prediction_variance = hph;
   return r * r / (hph + var);
 }
 

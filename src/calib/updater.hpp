@@ -57,7 +57,10 @@ class Updater {
                                           FilterState* state) const;
   // The gate's statistic of one bearing against the state's prediction, without updating:
   // the normalised innovation squared r^2 / (H P H^T + R) (R with the second-order term).
-  double innovation_chi2(const FilterState& state, const BearingMeasurement& z) const;
+  // *prediction_variance (when given): the predicted bearing's variance, H P H^T.
+  double innovation_chi2(const FilterState& state,
+                         const BearingMeasurement& z,
+                         double* prediction_variance = nullptr) const;
   // The chi-square gate (CalibrationOptions::association.gate_probability, 1 degree of freedom).
   double gate() const { return gate_; }
 

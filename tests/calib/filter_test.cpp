@@ -413,6 +413,16 @@ TEST(CalibrationFilter, ATrackFoundAgainUnderANewIdContinuesItsFeature) {
     ASSERT_TRUE(joined.tracks.count(c)) << c;
     EXPECT_EQ(joined.tracks.at(c).D_theta, whole.tracks.at(a).D_theta);
   }
+  // Where a feature's predicted bearing is wider than join_prediction_sigmas bearing sigmas it
+  // is no candidate: the default keeps these joins (their points are well known) and the
+  // same as with no limit; a limit no prediction meets joins nothing.
+  CalibrationOptions unlimited = o;
+  unlimited.association.join_prediction_sigmas = 0.0;
+  const FilterResult any = run_filter(renamed, unlimited);
+  EXPECT_EQ(std::set<TrackJoin>(any.joins.begin(), any.joins.end()), got);
+  CalibrationOptions strict = o;
+  strict.association.join_prediction_sigmas = 1e-3;
+  EXPECT_TRUE(run_filter(renamed, strict).joins.empty());
   // Off: each new id is a feature of its own, from the depth prior.
   o.association.join_pieces = false;
   const FilterResult apart = run_filter(renamed, o);

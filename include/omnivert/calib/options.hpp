@@ -143,6 +143,11 @@ struct AssociationOptions {
   // Kept apart, the pieces act as independent features and the filter is overconfident
   // (docs/theory/association.md#pieces-of-one-line). false: off.
   bool join_pieces = true;
+  // The filter joins only where the feature's predicted bearing is sharp: its sigma (from the
+  // state's covariance, sqrt(H P H^T)) at most this many bearing sigmas. A wide prediction
+  // lets the new track of another line pass its gate, and a wrong join biases the filter for
+  // the rest of a long run (docs/theory/association.md#pieces-of-one-line). 0: no limit.
+  double join_prediction_sigmas = 4.0;
   // Track splitting (window and refinement): a track whose bearings are better explained by
   // two features (before and after one frame) than by one, with a likelihood-ratio statistic
   // above split_chi2, is taken to have slipped onto a neighbouring line and is split in two
