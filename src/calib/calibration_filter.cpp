@@ -390,11 +390,11 @@ int CalibrationFilter::Impl::slot_of(int track_id) const {
 // innovation, Updater::innovation_chi2) the bearing passes, and whose predicted bearing is sharp
 // (join_prediction_sigmas: on a long run through a line-rich room, new tracks of other lines
 // start within the gate of a wide prediction). A new track with exactly one candidate, which no
-// other new track has as a candidate, continues it. (Only the features
-// seen in this frame crowd a candidate: the old piece of a line that was not joined stays in
-// the state for max_missed_frames frames unseen, and would crowd the new piece of the same
-// line. Without the crowding test a new track of a door's edge can be joined to the feature
-// of the edge beside it, which puts the filter a degree off in yaw.)
+// other new track has as a candidate, continues it. (Only the features seen in this frame crowd
+// a candidate: the old piece of a line that was not joined stays in the state for
+// max_missed_frames frames unseen, and would crowd the new piece of the same line. Without the
+// crowding test a new track of a door's edge can be joined to the feature of the edge beside
+// it, which puts the filter a degree off in yaw.)
 std::vector<const BearingObservation*> CalibrationFilter::Impl::join_pieces(
     std::vector<const BearingObservation*> fresh,
     std::vector<BearingMeasurement>* z,

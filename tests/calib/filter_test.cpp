@@ -512,6 +512,12 @@ TEST(CalibrationFilter, BadInputIsAnInputError) {
   EXPECT_FALSE(o.IsValid(&why));
   EXPECT_NE(why.find("bearing_sigma"), std::string::npos);
   EXPECT_THROW(CalibrationFilter{o}, InputError);
+  for (double sigmas : {-1.0, std::nan("")}) {
+    CalibrationOptions j;
+    j.association.join_prediction_sigmas = sigmas;
+    EXPECT_FALSE(j.IsValid(&why));
+    EXPECT_NE(why.find("join_prediction_sigmas"), std::string::npos);
+  }
 
   CalibrationFilter f(CalibrationOptions{});
   FrameInput bad;
