@@ -14,7 +14,7 @@ namespace omnivert::calib::internal {
 
 CalibrationRun split_round(const CalibrationRun& original,
                            const CalibrationRun& current,
-                           const std::map<int, int>& found,
+                           const std::vector<std::pair<int, int>>& found,
                            std::vector<TrackSplit>* splits,
                            std::map<int, int>* origin,
                            BatchPoint* at) {
@@ -240,9 +240,9 @@ AssociationEnd associate(Built* b,
   // Tracks that slipped onto a neighbouring line split in two, from the current solution (all
   // bearings back in, outliers judged again).
   for (int round = 0; setup.split.split_chi2 > 0.0 && round < setup.split.split_rounds; ++round) {
-    const std::map<int, int> found = find_splits(*b, setup.split);
+    const std::vector<std::pair<int, int>> found = find_splits(*b, setup.split);
     if (found.empty()) break;
-    spdlog::debug("association: round {} split {} tracks", round + 1, found.size());
+    spdlog::debug("association: round {} split tracks at {} frames", round + 1, found.size());
     BatchPoint at = point_of(*b);
     const CalibrationRun previous = round == 0 ? out->merged : out->split;
     out->split = split_round(

@@ -114,9 +114,10 @@ std::vector<TrackJoin> find_merges(Built* b, int max_gap, double chi2);
 // r_i and their Jacobians J_i (1x2) on the feature point, each segment's best feature step reduces
 // the squared residuals by g^T H^-1 g (g = sum J_i^T r_i, H = sum J_i^T J_i), computed for every j
 // at once from prefix sums. Under no slip the statistic at a fixed j is chi-square with 2 degrees
-// of freedom. Returns track id -> first frame of the second segment for tracks whose best statistic
-// exceeds the threshold.
-std::map<int, int> find_splits(const Built& b, const AssociationOptions& split);
+// of freedom. A track whose best statistic exceeds the threshold is split there, and each part
+// again where its own statistic does (from the same linearisation). Returns (track id, first
+// frame of a new part), sorted.
+std::vector<std::pair<int, int>> find_splits(const Built& b, const AssociationOptions& split);
 
 // One round of track splitting: `found` (find_splits, ids of `current`) is added to `splits`
 // (tracker's ids, frames of the runs), the run is split again from `original` (split_tracks),
@@ -125,7 +126,7 @@ std::map<int, int> find_splits(const Built& b, const AssociationOptions& split);
 // tracker's id. (The refinement and the filter's window.)
 CalibrationRun split_round(const CalibrationRun& original,
                            const CalibrationRun& current,
-                           const std::map<int, int>& found,
+                           const std::vector<std::pair<int, int>>& found,
                            std::vector<TrackSplit>* splits,
                            std::map<int, int>* origin,
                            BatchPoint* at);

@@ -6,6 +6,8 @@
 #include <set>
 #include <tuple>
 
+#include <spdlog/spdlog.h>
+
 #include <Eigen/Cholesky>
 
 #include "calib/association.hpp"
@@ -92,7 +94,7 @@ std::vector<TrackJoin> find_merges(Built* b, int max_gap, double chi2) {
   return out;
 }
 
-std::map<int, int> find_splits(const Built& b, const AssociationOptions& split) {
+std::vector<std::pair<int, int>> find_splits(const Built& b, const AssociationOptions& split) {
   struct Row {
     int frame;
     double r;
@@ -112,7 +114,13 @@ std::map<int, int> find_splits(const Built& b, const AssociationOptions& split) 
     seq[b.bearing_keys[i].track].push_back(
         {b.bearing_keys[i].frame, r, Eigen::Vector2d(jf[0], jf[1])});
   }
-  std::vector<std::tuple<double, int, int>> candidates;  // (statistic, track id, split frame)
+  struct Candidate {
+    double statistic;         // of the track's best split
+    int id;                   // the track
+    int first, last;          // its span (frames)
+    std::vector<int> frames;  // first frames of the new parts, the best split's among them
+  };
+  std::vector<Candidate> candidates;
   const int m = std::max(split.split_min_bearings, 2);
   auto gain = [](const Eigen::Matrix2d& H, const Eigen::Vector2d& g) {
     const Eigen::Matrix2d Hr = H + 1e-9 * (H.trace() + 1e-12) * Eigen::Matrix2d::Identity();
@@ -128,25 +136,54 @@ std::map<int, int> find_splits(const Built& b, const AssociationOptions& split) 
       H[i + 1] = H[i] + v[i].J * v[i].J.transpose();
       g[i + 1] = g[i] + v[i].J * v[i].r;
     }
-    const double whole = gain(H[n], g[n]);  // ~0 at a solution; kept for exactness
-    double best = 0.0;
-    int best_j = -1;
-    for (int j = m; j <= n - m; ++j) {
-      const double t = gain(H[j], g[j]) + gain(H[n] - H[j], g[n] - g[j]) - whole;
-      if (t > best) {
-        best = t;
-        best_j = j;
+    // The statistic of splitting the bearings [a, c) at j, and the best j (-1: none).
+    auto segment = [&](int a, int c) { return gain(H[c] - H[a], g[c] - g[a]); };
+    auto best_split = [&](int a, int c) {
+      const double whole = segment(a, c);  // ~0 for the whole track at a solution
+      std::pair<double, int> best{0.0, -1};
+      for (int j = a + m; j <= c - m; ++j) {
+        const double t = segment(a, j) + segment(j, c) - whole;
+        if (t > best.first) best = {t, j};
       }
+      return best;
+    };
+    const auto [statistic, j] = best_split(0, n);
+    if (j < 0 || !(statistic > split.split_chi2)) continue;
+    Candidate c{statistic, id, v.front().frame, v.back().frame, {v[j].frame}};
+    // A track that slipped more than once: each part split again where its own statistic,
+    // from the same linearisation, passes (binary segmentation).
+    std::vector<std::pair<int, int>> parts = {{0, j}, {j, n}};
+    while (!parts.empty()) {
+      const auto [a, e] = parts.back();
+      parts.pop_back();
+      const auto [t, k] = best_split(a, e);
+      if (k < 0 || !(t > split.split_chi2)) continue;
+      c.frames.push_back(v[k].frame);
+      parts.push_back({a, k});
+      parts.push_back({k, e});
     }
-    if (best_j > 0 && best > split.split_chi2) candidates.push_back({best, id, v[best_j].frame});
+    candidates.push_back(std::move(c));
   }
-  // A slip biases the extrinsics, and a biased solution leaves structure in the residuals of
-  // clean tracks too: only the tracks within a factor split_keep_fraction of the strongest
-  // statistic are split in this round; the others are judged again after the re-solve.
-  std::sort(candidates.begin(), candidates.end(), std::greater<>());
-  std::map<int, int> out;
-  for (const auto& [t, id, frame] : candidates)
-    if (t >= split.split_keep_fraction * std::get<0>(candidates.front())) out[id] = frame;
+  // A slip biases the solution near it, and a biased solution leaves structure in the residuals
+  // of clean tracks there too: a track is split in this round only if its statistic is within
+  // a factor split_keep_fraction of the strongest among the candidates whose spans overlap its
+  // own; the others are judged again after the re-solve. (Far from a slip the solution is not
+  // moved by it: in a long run most candidates are split in the first round.)
+  std::sort(candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) {
+    return std::tie(x.statistic, x.id) > std::tie(y.statistic, y.id);
+  });
+  std::vector<std::pair<int, int>> out;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const Candidate& c = candidates[i];
+    double strongest = c.statistic;
+    for (std::size_t k = 0; k < i; ++k)
+      if (candidates[k].first <= c.last && c.first <= candidates[k].last)
+        strongest = std::max(strongest, candidates[k].statistic);
+    if (c.statistic < split.split_keep_fraction * strongest) continue;
+    for (int frame : c.frames) out.emplace_back(c.id, frame);
+  }
+  std::sort(out.begin(), out.end());
+  spdlog::debug("association: {} tracks to split, {} splits now", candidates.size(), out.size());
   return out;
 }
 

@@ -83,6 +83,39 @@ TEST(TrackSplitting, SlippedTracksAreSplitAndTheirBiasRemoved) {
   }
 }
 
+// A track that slipped twice (onto a line 10 cm behind its own, then onto one 12 cm behind
+// that) is split at both slips in one round: each part of a split track is split again where
+// its own statistic, from the same linearisation, passes. The other tracks are left whole.
+TEST(TrackSplitting, ATrackThatSlippedTwiceIsSplitTwiceInOneRound) {
+  SyntheticRunOptions so;
+  so.bearing_sigma = deg2rad(0.05);
+  so.seed = 7;
+  SyntheticRun run = make_synthetic_run(so);
+  std::map<int, std::pair<int, int>> span;  // track -> (first, last) frame
+  for (std::size_t k = 0; k < run.run.frames.size(); ++k)
+    for (const BearingObservation& o : run.run.frames[k].observations) {
+      auto [it, fresh] = span.emplace(o.track_id, std::make_pair(int(k), int(k)));
+      it->second.second = static_cast<int>(k);
+    }
+  const auto longest = std::max_element(span.begin(), span.end(), [](const auto& x, const auto& y) {
+    return x.second.second - x.second.first < y.second.second - y.second.first;
+  });
+  const int track = longest->first;
+  const auto [first, last] = longest->second;
+  const int f1 = first + (last - first) / 3, f2 = first + 2 * (last - first) / 3;
+  ASSERT_GT(f2 - f1, 20);
+  run = slip(slip(run, track, f1, 0.10), track, f2, 0.12);
+  CalibrationOptions o = options_for(so);
+  o.association.crossing_guard = 0.0;
+  const internal::Built b = internal::build(run.run, o, truth_point(run), false);
+  const std::vector<std::pair<int, int>> found = internal::find_splits(b, o.association);
+  ASSERT_EQ(found.size(), 2u);
+  EXPECT_EQ(found[0].first, track);
+  EXPECT_EQ(found[1].first, track);
+  EXPECT_NEAR(found[0].second, f1, 8);
+  EXPECT_NEAR(found[1].second, f2, 8);
+}
+
 // Clean runs (no slip): splitting finds nothing to split, and the estimate is unchanged.
 TEST(TrackSplitting, CleanTracksAreLeftWhole) {
   SyntheticRunOptions so;

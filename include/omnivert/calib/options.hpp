@@ -155,8 +155,10 @@ struct AssociationOptions {
   // (docs/theory/association.md#slipped-tracks).
   double split_chi2 = 20.0;
   int split_min_bearings = 5;
-  double split_keep_fraction = 0.5;  // a round splits the tracks within this factor of the
-                                     // strongest statistic (the rest are judged after re-solving)
+  // A round splits the tracks within this factor of the strongest statistic among the tracks
+  // whose frames overlap their own (the rest are judged after re-solving); a split track's
+  // parts are split again in the same round where their own statistic passes.
+  double split_keep_fraction = 0.5;
   int split_rounds = 10;
 };
 

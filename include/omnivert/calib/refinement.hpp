@@ -30,7 +30,7 @@ struct RefinementResult {
   int num_bearings = 0;  // bearings used
   int num_rejected = 0;  // bearings removed as outliers (|residual| > the filter's gate)
   int num_features = 0;  // tracks in the problem (after splitting)
-  int num_splits = 0;    // tracks split in two (CalibrationOptions::association.split_chi2)
+  int num_splits = 0;    // splits made (a track cut at n frames counts n; association.split_chi2)
   // (track id, first frame of the new part): the tracker's id, or with merges the id of the
   // line's first piece.
   std::vector<TrackSplit> splits;
