@@ -16,6 +16,7 @@
 #include "calib/association.hpp"
 #include "calib/batch_problem.hpp"
 #include "calib/noise_check.hpp"
+#include "calib/serial_sparse_algebra.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
 
@@ -218,6 +219,7 @@ RefinementResult refine_batch(const CalibrationRun& run,
                               const BatchPoint& start) {
   std::string why;
   if (!options.IsValid(&why)) throw InputError("calibration options: " + why);
+  const SerialSparseAlgebra serial;  // this call's solves: one OpenMP thread in CHOLMOD
   // The decisions under the bearing's whole error; the bias, when modelled, at the end
   // (association_options).
   const CalibrationOptions& model = options;

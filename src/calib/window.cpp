@@ -13,6 +13,7 @@
 #include "calib/batch_factors.hpp"
 #include "calib/batch_point.hpp"
 #include "calib/batch_problem.hpp"
+#include "calib/serial_sparse_algebra.hpp"
 #include "omnivert/calib/flow_yaw.hpp"
 #include "omnivert/calib/model.hpp"
 #include "omnivert/calib/track_ids.hpp"
@@ -303,6 +304,7 @@ bool bootstrap_filter_state(const CalibrationRun& window_in,
   const CalibrationRun window = split_at_gaps(window_in, options, &gap_origin);
   const int W = static_cast<int>(window.frames.size());
   if (W < 2) return fail("window too short");
+  const SerialSparseAlgebra serial;  // the window's solves: one OpenMP thread in CHOLMOD
   WindowProblem problem(options, window);
   ceres::Solver::Summary summary;
   Built b;
