@@ -242,6 +242,7 @@ bool solve_best_start(const WindowProblem& problem,
     std::vector<std::future<void>> pending;
     for (std::size_t i = 0; i < starts.size(); ++i)
       pending.push_back(std::async(std::launch::async, [&, i] {
+        const SerialSparseAlgebra serial;  // each start's thread: one OpenMP thread in CHOLMOD
         Start& r = runs[i];
         r.from = starts[i];
         r.ok = problem.solve_from(starts[i], &r.built, &r.summary);
@@ -304,7 +305,7 @@ bool bootstrap_filter_state(const CalibrationRun& window_in,
   const CalibrationRun window = split_at_gaps(window_in, options, &gap_origin);
   const int W = static_cast<int>(window.frames.size());
   if (W < 2) return fail("window too short");
-  const SerialSparseAlgebra serial;  // the window's solves: one OpenMP thread in CHOLMOD
+  const SerialSparseAlgebra serial;  // the solves on this thread (the starts' threads: their own)
   WindowProblem problem(options, window);
   ceres::Solver::Summary summary;
   Built b;
