@@ -266,6 +266,14 @@ void add_model_options(CLI::App* cmd, CalibrateArgs& a) {
       ->each([&a](const std::string&) { a.options.input.enough_tracks = 0; })
       ->capture_default_str()
       ->group(gm);
+  cmd->add_option("--split-after-short",
+                  a.options.input.split_after_short,
+                  "Where a track's line was shorter than --calibration-length-fraction for at "
+                  "least this many frames and is long again, the rest of the track is a new "
+                  "track for the calibration (0: never split)")
+      ->check(kNonNegative)
+      ->capture_default_str()
+      ->group(gm);
   cmd->add_option("--time-offset",
                   a.time_offset,
                   "Camera-odometry time offset [s], positive when the image stamps are late: "

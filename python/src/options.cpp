@@ -347,6 +347,14 @@ const OptionTable<DO>& dataset_job_table() {
                "calibration_length_fraction",
                "lines shorter than this fraction of the annulus are tracked, not used",
                [](DO & o) -> auto& { return o.input.min_annulus_fraction; }),
+           field<int, DO>(
+               "calibration_enough_tracks",
+               "fewer tracks with long lines than this: shorter lines are used (0: never)",
+               [](DO & o) -> auto& { return o.input.enough_tracks; }),
+           field<int, DO>(
+               "split_after_short",
+               "a track whose line was short this many frames is a new track after (0: never)",
+               [](DO & o) -> auto& { return o.input.split_after_short; }),
            field<double, DO>(
                "max_wheel_gap", "wheel samples further apart are a gap [s]", [](DO & o) -> auto& {
                  return o.input.max_wheel_gap_s;

@@ -315,6 +315,7 @@ void add_bearings(const std::vector<TrackRow>& rows,
   out.tracks = static_cast<int>(used_tracks.size());
   out.crowded_sigma_scale = opt.crowded_sigma_scale;
   out.min_annulus_fraction = min_fraction;
+  out.split_after_short = opt.split_after_short;
   if (out.double_claims > 0) {
     out.warnings.push_back(std::to_string(out.double_claims) +
                            " times a track held two lines of one frame (the paper's rules allow "

@@ -220,6 +220,7 @@ json inputs_json(const calib::CalibrationResult& r, const ReportInputs& in) {
     inputs["crowded_sigma_scale"] = num(in.run->crowded_sigma_scale);
     inputs["short_bearings_left_out"] = in.run->short_bearings;
     inputs["min_annulus_fraction"] = num(in.run->min_annulus_fraction);
+    inputs["split_after_short"] = in.run->split_after_short;
     inputs["path_length_m"] = num(in.run->path_length);
     inputs["rotation_deg"] = num(rad2deg(in.run->rotation));
     inputs["frames_dropped_for_wheel_gaps"] = in.run->frames_dropped_for_gaps;

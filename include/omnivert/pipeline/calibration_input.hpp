@@ -69,6 +69,7 @@ struct DatasetRun {
   int crowded_bearings = 0;           // bearings of crowded lines used
   int short_bearings = 0;             // bearings left out: line below min_annulus_fraction
   double min_annulus_fraction = 0.0;  // that fraction (DatasetRunOptions)
+  int split_after_short = 0;          // DatasetRunOptions::split_after_short
   double crowded_sigma_scale = 1.0;   // their sigma scale (DatasetRunOptions)
   int starved_frames = 0;             // frames with fewer than min_lines lines
   int tracks = 0;                     // tracks used
