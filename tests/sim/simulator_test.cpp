@@ -91,22 +91,20 @@ void expect_short_lines_left_out(const dataset::Dataset& d,
     if (id % 3 != 1 && (longest < 0 || k > rows_of[longest])) longest = id;
     max_id = std::max(max_id, id);
   }
-  // Another track short in one frame only (fewer than split_after_short): it keeps its id.
-  std::map<std::int64_t, std::pair<bool, bool>> spans;  // rows before frame 50, after 51
-  for (const TrackRow& r : rows) {
-    if (r.frame < 50) spans[r.track_id].first = true;
-    if (r.frame > 51) spans[r.track_id].second = true;
-  }
+  // Another track short in frames 50 and 51 only (fewer than split_after_short, 3): it keeps
+  // its id; with split_after_short 2 it is cut there.
+  std::map<std::int64_t, int> spans;  // bits: rows before frame 50, at 50, at 51, after 51
+  for (const TrackRow& r : rows)
+    spans[r.track_id] |= r.frame < 50 ? 1 : r.frame == 50 ? 2 : r.frame == 51 ? 4 : 8;
   for (const auto& [id, k] : rows_of)
-    if (id % 3 != 1 && id != longest && spans[id].first && spans[id].second &&
-        (second < 0 || k > rows_of[second]))
+    if (id % 3 != 1 && id != longest && spans[id] == 15 && (second < 0 || k > rows_of[second]))
       second = id;
   ASSERT_GE(second, 0);
   std::vector<TrackRow> mixed = rows;
   for (TrackRow& r : mixed) {
     const bool is_short = r.track_id % 3 == 1 ||
                           (r.track_id == longest && r.frame >= 30 && r.frame < 40) ||
-                          (r.track_id == second && r.frame == 50);
+                          (r.track_id == second && (r.frame == 50 || r.frame == 51));
     r.annulus_fraction = is_short ? 0.3 : 0.7;
   }
   mixed.back().annulus_fraction = std::numeric_limits<double>::quiet_NaN();  // not known: used
@@ -141,7 +139,19 @@ void expect_short_lines_left_out(const dataset::Dataset& d,
       }
       if (ob.track_id == second && k > 51) ++second_after;
     }
-  EXPECT_GT(second_after, 0);  // the same id after its short frame
+  EXPECT_GT(second_after, 0);  // the same id after its two short frames
+  pipeline::DatasetRunOptions cut_at_two = half;
+  cut_at_two.split_after_short = 2;
+  const pipeline::DatasetRun two = pipeline::calibration_run_from_tracks(d, mixed, cut_at_two);
+  EXPECT_EQ(two.split_after_short, 2);
+  EXPECT_EQ(two.observations, sel.observations);
+  int second_before = 0;
+  second_after = 0;
+  for (std::size_t k = 0; k < two.run.frames.size(); ++k)
+    for (const auto& ob : two.run.frames[k].observations)
+      if (ob.track_id == second) ++(k < 50 ? second_before : second_after);
+  EXPECT_GT(second_before, 0);
+  EXPECT_EQ(second_after, 0);  // a new id after frame 51
   pipeline::DatasetRunOptions all;
   all.min_annulus_fraction = 0.0;
   const pipeline::DatasetRun every = pipeline::calibration_run_from_tracks(d, mixed, all);
@@ -161,7 +171,7 @@ void expect_short_lines_left_out(const dataset::Dataset& d,
     for (const auto& ob : more.run.frames[k].observations) {
       const bool is_short = (ob.track_id % 3 == 1 && ob.track_id <= max_id) ||
                             (ob.track_id == longest && k >= 30 && k < 40) ||
-                            (ob.track_id == second && k == 50);
+                            (ob.track_id == second && (k == 50 || k == 51));
       if (is_short) ++doubled;
       EXPECT_DOUBLE_EQ(ob.sigma_scale, is_short ? want_more.short_sigma_scale : 1.0)
           << "frame " << k << " track " << ob.track_id;

@@ -54,7 +54,7 @@ struct DatasetRunOptions {
   // Where a track's line was shorter than the fraction for at least this many frames and
   // is long again, the rest of the track is a new track for the calibration (the tracker may
   // have slipped onto another edge meanwhile). 0: never.
-  int split_after_short = 2;
+  int split_after_short = 3;
 
   // True when every field is usable; otherwise false with the reason in *why (may be null),
   // naming the field, e.g. "max_wheel_gap_s must be > 0 [s]".
