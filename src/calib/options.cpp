@@ -95,6 +95,11 @@ bool checks_valid(const CalibrationOptions& o, std::string* why) {
   if (r.max_iterations < 1) return fail(why, "refinement.max_iterations must be >= 1");
   if (!(r.association_function_tolerance > 0.0 && r.association_function_tolerance < 1.0))
     return fail(why, "refinement.association_function_tolerance must be in (0, 1)");
+  if (r.warm_start_window < 0)
+    return fail(why, "refinement.warm_start_window must be >= 0 (0: off)");
+  if (r.warm_start_window > 0 &&
+      !(r.warm_start_overlap >= 1 && r.warm_start_overlap < r.warm_start_window))
+    return fail(why, "refinement.warm_start_overlap must be in [1, warm_start_window)");
   if (!finite_positive(r.time_offset_prior_sigma_s))
     return fail(why, "refinement.time_offset_prior_sigma_s must be > 0 [s]");
   const NoiseCheckOptions& n = o.noise_check;

@@ -17,6 +17,7 @@
 #include "calib/batch_problem.hpp"
 #include "calib/noise_check.hpp"
 #include "calib/serial_sparse_algebra.hpp"
+#include "calib/warm_start.hpp"
 #include "omnivert/core/angles.hpp"
 #include "omnivert/core/error.hpp"
 
@@ -224,7 +225,7 @@ RefinementResult refine_batch(const CalibrationRun& run,
   // (association_options).
   const CalibrationOptions& model = options;
   const CalibrationOptions assoc = association_options(model);
-  Built b = build(run, assoc, start, options.refinement.robust);
+  Built b = build(run, assoc, warm_start(run, assoc, start), options.refinement.robust);
   RefinementResult res;
   res.num_bearings = b.num_bearings;
 

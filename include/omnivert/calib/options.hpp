@@ -176,6 +176,12 @@ struct RefinementOptions {
   // solve, whose answer is reported, at 1e-10. Each decision needs the solution to a
   // fraction of a sigma, not to the last digit.
   double association_function_tolerance = 1e-6;
+  // A run of at least two windows starts from poses and features solved window by window,
+  // this many frames each overlapping by warm_start_overlap, instead of dead reckoning: over a
+  // long run dead reckoning drifts, and the whole-run solve would spend most of its iterations
+  // taking the drift out (docs/theory/refinement.md#long-runs). 0: off.
+  int warm_start_window = 150;
+  int warm_start_overlap = 30;
   // With the run's CalibrationRun::clock: a correction dS of the camera-odometry time offset
   // estimated with the extrinsics (the image stamps late by a further dS; docs/calibration.md
   // #time-offset), with the prior dS ~ N(0, time_offset_prior_sigma_s^2) that keeps a run
