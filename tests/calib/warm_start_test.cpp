@@ -72,7 +72,7 @@ TEST(WarmStart, TakesTheDriftOutAndTheRefinementEndsWhereItEndsFromTheTruth) {
   const double left = largest_heading_error(warm.poses, run.true_poses);
   EXPECT_GT(drift, deg2rad(1.0));  // the wheels alone drift
   EXPECT_LT(left, 0.25 * drift) << "dead reckoning " << rad2deg(drift) << " deg, warm start "
-                               << rad2deg(left) << " deg";
+                                << rad2deg(left) << " deg";
   std::printf("dead reckoning %.2f deg, warm start %.2f deg\n", rad2deg(drift), rad2deg(left));
   EXPECT_EQ(warm.extrinsics.phi, start.extrinsics.phi);  // held
   EXPECT_EQ(warm.features.size(), start.features.size());
