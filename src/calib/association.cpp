@@ -94,6 +94,33 @@ std::map<int, int> tracker_ids(const std::map<int, int>& base, const std::map<in
   return m;
 }
 
+void place_changed(const CalibrationRun& run,
+                   const std::set<int>& changed,
+                   const AssociationSetup& setup,
+                   BatchPoint* at) {
+  if (changed.empty()) return;
+  CalibrationRun only = run;
+  for (FrameInput& f : only.frames)
+    std::erase_if(f.observations,
+                  [&](const BearingObservation& o) { return !changed.count(o.track_id); });
+  Built p = setup.rebuild(only, *at);
+  if (p.features.empty()) return;
+  for (auto& pose : p.poses)
+    if (p.problem->HasParameterBlock(pose.data()))
+      p.problem->SetParameterBlockConstant(pose.data());
+  p.problem->SetParameterBlockConstant(p.ex.data());
+  if (!p.time_offset.empty()) p.problem->SetParameterBlockConstant(p.time_offset.data());
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  so.max_num_iterations = 50;
+  so.num_threads = 1;
+  so.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, p.problem.get(), &summary);
+  for (const auto& [id, f] : p.features)
+    if (std::isfinite(f[0]) && std::isfinite(f[1])) at->features[id] = {f[0], f[1]};
+}
+
 namespace {
 
 bool out_of_features(const Built& b, const AssociationSetup& setup) {
@@ -181,35 +208,34 @@ std::set<int> changed_tracks(const CalibrationRun& previous, const CalibrationRu
 }
 
 // The problem of the renamed run `run` (renamed from `previous`) from `at`, solved, and
-// judged again; with AssociationSetup::judge_before_solving, the tracks the renaming left as
-// they were judged at `at` first.
+// judged again; with AssociationSetup::judge_before_solving, judged before its first solve,
+// at `at` with the points of the tracks the round joined or split placed (place_changed).
 AssociationEnd rebuild_and_judge(Built* b,
                                  const CalibrationRun& previous,
                                  const CalibrationRun& run,
                                  const BatchPoint& at,
                                  const AssociationSetup& setup,
                                  Association* out) {
-  *b = setup.rebuild(run, at);
-  if (out_of_features(*b, setup)) return AssociationEnd::kNoTrack;
   const std::map<int, int> tracker = tracker_ids(setup.base_origin, out->origin);
   if (!setup.judge_before_solving) {
+    // The old problem goes before the new one is built (on a long run each holds hundreds of
+    // MB).
+    *b = Built{};
+    *b = setup.rebuild(run, at);
+    if (out_of_features(*b, setup)) return AssociationEnd::kNoTrack;
     setup.solve(b);
     if (!reject_and_solve(b, setup, tracker, &out->num_rejected))
       return AssociationEnd::kNoTrackLeft;
     return AssociationEnd::kDone;
   }
-  // A start without the crossings and the outliers of the tracks the round left as they were,
-  // judged at `at` (their solution); the joined and split tracks neither judged nor judging.
-  const std::set<int> changed = changed_tracks(previous, run);
-  guard_crossings(b, setup, tracker, &changed);
-  reject_outliers(b, outlier_gate(setup), setup.min_bearings, &changed);
+  // `at` is the last solution: the tracks the round left as they were are at their points,
+  // the joined and split ones are placed from their own bearings, and every bearing is judged
+  // there, all tracks together (crossings, collapsed points, outliers), then solved.
+  BatchPoint start = at;
+  place_changed(run, changed_tracks(previous, run), setup, &start);
+  *b = Built{};
+  *b = setup.rebuild(run, start);
   if (out_of_features(*b, setup)) return AssociationEnd::kNoTrack;
-  setup.solve(b);
-  // Every bearing back in at that solution (a feature the start left out keeps its point from
-  // `at`) and judged there, all tracks together.
-  BatchPoint clean = point_of(*b);
-  for (const auto& [id, f] : at.features) clean.features.emplace(id, f);
-  *b = setup.rebuild(run, clean);
   if (!reject_and_solve(b, setup, tracker, &out->num_rejected, /*at_solution=*/true))
     return AssociationEnd::kNoTrackLeft;
   return AssociationEnd::kDone;

@@ -9,6 +9,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <set>
 #include <utility>
 #include <vector>
 
@@ -182,15 +183,27 @@ struct AssociationSetup {
   // Whether a problem left without features ends the loop (AssociationEnd); otherwise it is
   // solved on.
   bool stop_when_empty = false;
-  // After a round joined or split tracks, the bearings of the tracks it left as they were are
-  // judged at the last solution before the first solve of the new problem (it then starts
-  // clean, without the outliers found before); false: every bearing back in for that solve.
+  // After a round joined or split tracks, every bearing is judged before the first solve of
+  // the new problem, at the last solution with the joined and split tracks' points placed from
+  // their own bearings (it then starts clean, without the outliers found before, and one
+  // global solve per round is saved); false: every bearing back in for that solve.
   bool judge_before_solving = false;
   // The problem of a renamed run from a starting point (the estimator's own build), and its
   // solve.
   std::function<Built(const CalibrationRun&, const BatchPoint&)> rebuild;
   std::function<void(Built*)> solve;
 };
+
+// The points of the tracks in `changed` placed at `at`'s poses and extrinsics: each solved
+// from its own bearings alone (setup.rebuild's problem of those tracks, everything but their
+// points held; at most 50 iterations), replacing theirs in `at`. A joined track starts at its
+// first piece's point and a split part at the point of the track it came from (merge_round,
+// split_round), which lay between two lines; placed, each is where its own bearings put it
+// (AssociationSetup::judge_before_solving).
+void place_changed(const CalibrationRun& run,
+                   const std::set<int>& changed,
+                   const AssociationSetup& setup,
+                   BatchPoint* at);
 
 // What the association decided.
 struct Association {

@@ -193,6 +193,48 @@ SyntheticRun with_crossings(const SyntheticRun& clean) {
 // bearings where another feature is within the guard, and with it merged detections no longer move
 // the estimate: the run with merged detections gives the clean run's estimate; without the guard it
 // does not.
+// A round's renamed tracks are judged at the last solution with their points placed from
+// their own bearings (AssociationSetup::judge_before_solving): a split part that starts at the
+// point of the track it came from ends at its own line's point, the other points untouched.
+TEST(TrackSplitting, ASplitPartIsPlacedOnItsOwnLine) {
+  SyntheticRunOptions so;
+  so.bearing_sigma = deg2rad(0.05);
+  so.seed = 7;
+  const SyntheticRun clean = make_synthetic_run(so);
+  const int n = static_cast<int>(clean.run.frames.size());
+  const int track = clean.track_feature.begin()->first;
+  // From frame n/2 on, the track's bearings are a point 10 cm behind its own, renamed 1000.
+  SyntheticRun run = slip(clean, track, n / 2, 0.10);
+  const Eigen::Vector2d own = run.features[run.track_feature.at(track)];
+  const Eigen::Vector3d& p = run.true_poses[n / 2];
+  const double a = p(2) + run.truth.phi;
+  const Eigen::Vector2d c(p(0) + run.truth.rho * std::cos(a), p(1) + run.truth.rho * std::sin(a));
+  const Eigen::Vector2d behind = own + 0.10 * (own - c).normalized();
+  for (int k = n / 2; k < n; ++k)
+    for (BearingObservation& o : run.run.frames[static_cast<std::size_t>(k)].observations)
+      if (o.track_id == track) o.track_id = 1000;
+  const CalibrationOptions o = options_for(so);
+  internal::AssociationSetup setup;
+  setup.options = &o;
+  setup.rebuild = [&o](const CalibrationRun& r, const BatchPoint& at) {
+    return internal::build(r, o, at, /*robust=*/false);
+  };
+  BatchPoint at = truth_point(run);
+  at.features[1000] = own;  // where split_round starts it
+  const BatchPoint before = at;
+  internal::place_changed(run.run, {1000}, setup, &at);
+  EXPECT_LT((at.features.at(1000) - behind).norm(), 0.01) << at.features.at(1000).transpose();
+  EXPECT_GT((before.features.at(1000) - behind).norm(), 0.09);
+  for (const auto& [id, f] : before.features) {
+    if (id == 1000) continue;
+    EXPECT_EQ(at.features.at(id), f) << id;
+  }
+  // Nothing to place: `at` unchanged.
+  BatchPoint same = before;
+  internal::place_changed(run.run, {}, setup, &same);
+  EXPECT_EQ(same.features.at(1000), before.features.at(1000));
+}
+
 TEST(CrossingGuard, MergedDetectionsAreLeftOutAndDoNotMoveTheEstimate) {
   const int runs = 10;
   double moved_on = 0.0, moved_off = 0.0;  // mean squared Mahalanobis shift from the clean run
