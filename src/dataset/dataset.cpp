@@ -39,18 +39,21 @@ std::string trim(const std::string& s) {
 // the header and the data rows (blank lines skipped), each cut to `columns` fields: columns
 // beyond those are another tool's, ignored as EuRoC-style readers do, and the rows that had
 // any are counted in a note appended to `notes`. `what` names the columns for messages.
-std::vector<CsvRow> read_csv(const std::string& path,
-                             std::size_t columns,
-                             const std::string& what,
-                             std::string* header_out,
-                             std::vector<std::string>* notes) {
+// Each row is handed to `visit` as it is read (a long run's lines.csv holds millions of rows:
+// kept as strings they took several times the memory of the records made from them).
+template <typename Visit>
+void for_each_csv_row(const std::string& path,
+                      std::size_t columns,
+                      const std::string& what,
+                      std::string* header_out,
+                      std::vector<std::string>* notes,
+                      Visit&& visit) {
   int extra_rows = 0;
   if (const std::string why = unreadable_file_reason(path); !why.empty()) {
     throw InputError(path, 0, why);
   }
   std::ifstream in(path);
   if (!in) throw InputError(path, 0, "cannot be opened for reading");
-  std::vector<CsvRow> rows;
   std::string text;
   int line = 0;
   bool header_seen = false;
@@ -87,13 +90,24 @@ std::vector<CsvRow> read_csv(const std::string& path,
                        "expected " + std::to_string(columns) + " comma-separated columns (" + what +
                            "), got " + std::to_string(row.fields.size()));
     }
-    rows.push_back(std::move(row));
+    visit(row);
   }
   if (!header_seen)
     throw InputError(path, 0, "file is empty (expected a '#' header line: " + what + ")");
   if (extra_rows > 0 && notes)
     notes->push_back(path + ": " + std::to_string(extra_rows) + " rows have columns beyond the " +
                      std::to_string(columns) + " read; those were ignored");
+}
+
+// All the rows of for_each_csv_row at once.
+std::vector<CsvRow> read_csv(const std::string& path,
+                             std::size_t columns,
+                             const std::string& what,
+                             std::string* header_out,
+                             std::vector<std::string>* notes) {
+  std::vector<CsvRow> rows;
+  for_each_csv_row(
+      path, columns, what, header_out, notes, [&](CsvRow& r) { rows.push_back(std::move(r)); });
   return rows;
 }
 
@@ -334,31 +348,33 @@ GroundTruth load_ground_truth(const std::string& dir,
   const std::string lines = rel(dir, "lines.csv");
   if (fs::exists(lines, ec)) {
     gt.has_lines = true;
-    for (const CsvRow& r :
-         read_csv(lines,
-                  6,
-                  "timestamp [ns], frame, line_id, bearing [rad], r_inner [px], r_outer [px]",
-                  nullptr,
-                  notes)) {
-      LineRecord l;
-      l.timestamp_ns = parse_timestamp(r.fields[0], lines, r.line);
-      l.frame = parse_int(r.fields[1], "frame", lines, r.line);
-      l.line_id = parse_int(r.fields[2], "line_id", lines, r.line);
-      l.bearing = parse_double(r.fields[3], "bearing", lines, r.line);
-      l.r_inner = parse_double(r.fields[4], "r_inner", lines, r.line);
-      l.r_outer = parse_double(r.fields[5], "r_outer", lines, r.line);
-      check_frame_index(l.frame, images.size(), lines, r.line);
-      if (images[static_cast<std::size_t>(l.frame)].timestamp_ns != l.timestamp_ns) {
-        throw InputError(lines,
-                         r.line,
-                         "timestamp " + std::to_string(l.timestamp_ns) + " is not that of frame " +
-                             std::to_string(l.frame) + " in cam0/data.csv");
-      }
-      if (!gt.lines.empty() && l.frame < gt.lines.back().frame) {
-        throw InputError(lines, r.line, "frames must not decrease");
-      }
-      gt.lines.push_back(l);
-    }
+    for_each_csv_row(
+        lines,
+        6,
+        "timestamp [ns], frame, line_id, bearing [rad], r_inner [px], r_outer [px]",
+        nullptr,
+        notes,
+        [&](const CsvRow& r) {
+          LineRecord l;
+          l.timestamp_ns = parse_timestamp(r.fields[0], lines, r.line);
+          l.frame = parse_int(r.fields[1], "frame", lines, r.line);
+          l.line_id = parse_int(r.fields[2], "line_id", lines, r.line);
+          l.bearing = parse_double(r.fields[3], "bearing", lines, r.line);
+          l.r_inner = parse_double(r.fields[4], "r_inner", lines, r.line);
+          l.r_outer = parse_double(r.fields[5], "r_outer", lines, r.line);
+          check_frame_index(l.frame, images.size(), lines, r.line);
+          if (images[static_cast<std::size_t>(l.frame)].timestamp_ns != l.timestamp_ns) {
+            throw InputError(lines,
+                             r.line,
+                             "timestamp " + std::to_string(l.timestamp_ns) +
+                                 " is not that of frame " + std::to_string(l.frame) +
+                                 " in cam0/data.csv");
+          }
+          if (!gt.lines.empty() && l.frame < gt.lines.back().frame) {
+            throw InputError(lines, r.line, "frames must not decrease");
+          }
+          gt.lines.push_back(l);
+        });
     gt.line_offsets.assign(images.size() + 1, 0);
     for (const LineRecord& l : gt.lines) ++gt.line_offsets[static_cast<std::size_t>(l.frame) + 1];
     for (std::size_t k = 1; k < gt.line_offsets.size(); ++k)
