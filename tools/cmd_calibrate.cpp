@@ -161,18 +161,22 @@ void run_calibrate(CLI::App* cmd, const CalibrateArgs& a) {
   double tracking_s = 0;  // from the call to the end of tracking
   std::string bar_stage;
   o.progress = [&](const std::string& stage, std::size_t done, std::size_t total) {
-    if (stage != "calibrate") {  // "track", "track again"
-      if (bar && bar_stage != stage) bar->finish(), bar.reset();
-      if (!bar) bar.emplace(stage, total), bar_stage = stage;
-      bar->update(done);
+    if (stage == "calibrate") {
+      tracking_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      if (bar) bar->finish(), bar.reset();
       return;
     }
-    tracking_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (bar) bar->finish();
-    if (Progress::enabled())
-      std::fprintf(stderr,
-                   "calibrate: filter%s...\n",
-                   o.calibration.refinement.enabled ? " and refinement" : "");
+    // "track", "track again", "filter", "refinement: ..." (a bar each); a stage without a
+    // known end (the association's rounds, a solve) as a line of its own.
+    if (bar && bar_stage != stage) bar->finish(), bar.reset();
+    if (total == 0) {
+      if (Progress::enabled() && (bar_stage != stage || done > 0))
+        std::fprintf(stderr, done > 0 ? "%s: round %zu\n" : "%s\n", stage.c_str(), done);
+      bar_stage = stage;
+      return;
+    }
+    if (!bar) bar.emplace(stage, total), bar_stage = stage;
+    bar->update(done);
   };
   const pipeline::CalibrateDatasetResult r = pipeline::calibrate_dataset(dataset, a.out, o);
   if (const std::string t = pipeline::tilt_line(r.tilt, r.tilt_corrected); !t.empty())

@@ -5,6 +5,7 @@
 #include <exception>
 #include <string>
 
+#include <glog/logging.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
@@ -31,6 +32,12 @@ const std::string& command_line() { return g_command_line; }
 int main(int argc, char** argv) {
   // Warnings and log lines go to stderr: stdout carries results (tables, summaries).
   spdlog::set_default_logger(spdlog::stderr_color_mt("omnivert"));
+  // Ceres logs through glog: to stderr, never to files, and only its errors (its warnings,
+  // such as a rank-deficient Jacobian that the covariance then falls back from, are ours to
+  // report); with -v its warnings too.
+  FLAGS_logtostderr = true;
+  FLAGS_minloglevel = google::GLOG_ERROR;
+  google::InitGoogleLogging(argv[0]);
   CLI::App app{
       "omnivert: vertical lines in omnidirectional images (extraction, description, "
       "tracking, camera-odometry self-calibration)"};
@@ -38,7 +45,10 @@ int main(int argc, char** argv) {
   // Set while parsing, before the subcommand's callback runs.
   app.add_flag_callback(
          "-v,--verbose",
-         [] { spdlog::set_level(spdlog::level::debug); },
+         [] {
+           spdlog::set_level(spdlog::level::debug);
+           FLAGS_minloglevel = google::GLOG_WARNING;
+         },
          "More log output (each calibration stage's time, for one)")
       ->trigger_on_parse();
   app.set_version_flag("--version", "omnivert 0.1.0");

@@ -51,7 +51,11 @@ def test_calibrate_dataset_same_as_cli(demo_run, tmp_path):
     t = r.time_offset
     assert (t["offset_s"], t["sigma_s"]) == (r.summary["time_offset_s"], r.summary["time_offset_sigma_s"])
     assert t["refined"] == r.summary["time_offset"]["refined"] and t["message"] == r.summary["time_offset"]["message"]
-    assert calls[-1] == ("calibrate", 0, 0) and ("track", 93, 93) in calls
+    # The tracking, then the calibration's own stages (CalibrationOptions::progress).
+    stages = [c[0] for c in calls]
+    assert ("track", 93, 93) in calls and ("filter", 93, 93) in calls
+    assert stages.index("calibrate") < stages.index("filter") < stages.index("refinement: first solve")
+    assert calls[-1] == ("refinement: covariance", 0, 0)
     assert r.observable and r.calibration.source == "refinement"
     assert r.covariance.shape == (3, 3)
     assert r.calibration.observability.phi.determined

@@ -256,6 +256,8 @@ AssociationEnd associate(Built* b,
     BatchPoint at;
     const std::size_t before = out->merges.size();
     const CalibrationRun previous = out->merged;
+    if (setup.progress)
+      setup.progress("refinement: joining pieces", static_cast<std::size_t>(round) + 1, 0);
     if (!merge_round(b, *setup.options, &out->merged, &at, &out->merges)) break;
     spdlog::debug(
         "association: round {} joined {} pairs of pieces", round + 1, out->merges.size() - before);
@@ -266,6 +268,8 @@ AssociationEnd associate(Built* b,
   // Tracks that slipped onto a neighbouring line split in two, from the current solution (all
   // bearings back in, outliers judged again).
   for (int round = 0; setup.split.split_chi2 > 0.0 && round < setup.split.split_rounds; ++round) {
+    if (setup.progress)
+      setup.progress("refinement: splitting tracks", static_cast<std::size_t>(round) + 1, 0);
     const std::vector<std::pair<int, int>> found = find_splits(*b, setup.split);
     if (found.empty()) break;
     spdlog::debug("association: round {} split tracks at {} frames", round + 1, found.size());

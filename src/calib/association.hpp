@@ -10,6 +10,7 @@
 #include <map>
 #include <memory>
 #include <set>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -192,6 +193,9 @@ struct AssociationSetup {
   // solve.
   std::function<Built(const CalibrationRun&, const BatchPoint&)> rebuild;
   std::function<void(Built*)> solve;
+  // Each round reported as it starts (CalibrationOptions::progress; the refinement's, not the
+  // window's): "refinement: joining pieces" and "refinement: splitting tracks", the round.
+  std::function<void(const std::string&, std::size_t, std::size_t)> progress;
 };
 
 // The points of the tracks in `changed` placed at `at`'s poses and extrinsics: each solved

@@ -212,11 +212,14 @@ CalibrationResult calibrate_once(const CalibrationRun& run, const CalibrationOpt
   // The filter's noise check on its own tracks does not wait for the refinement: with a
   // second thread it runs beside it (the same numbers; spent for nothing when the trajectory
   // leaves the extrinsics undetermined).
+  // The check reports no progress: it runs on another thread, or after the refinement.
+  CalibrationOptions quiet = options;
+  quiet.progress = nullptr;
   std::future<BatchNoiseCheck> beside;
   if (nc.enabled && !filter_check_may_be_the_refinements(options, r.filter) &&
       resolve_threads(options.threads) > 1)
-    beside = std::async(std::launch::async, [&run, &options, &filter_point, &r] {
-      return filter_noise_check(run, options, filter_point, r.filter);
+    beside = std::async(std::launch::async, [&run, &quiet, &filter_point, &r] {
+      return filter_noise_check(run, quiet, filter_point, r.filter);
     });
   refine_and_analyse(run, options, filter_point, &timer, &r);
   r.noise_check.filter_model_covariance = r.filter.covariance;
@@ -237,7 +240,7 @@ CalibrationResult calibrate_once(const CalibrationRun& run, const CalibrationOpt
              filter_check_may_be_the_refinements(options, r.filter))
       r.noise_check.filter_check = r.refinement.noise;
     else
-      r.noise_check.filter_check = filter_noise_check(run, options, filter_point, r.filter);
+      r.noise_check.filter_check = filter_noise_check(run, quiet, filter_point, r.filter);
     r.seconds.noise_check = timer.lap("the filter's noise check");
     apply_filter_noise(nc, &r);
     if (r.refined && r.refinement.covariance_ok) apply_refinement_noise(nc, &r);

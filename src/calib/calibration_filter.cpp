@@ -514,7 +514,10 @@ std::map<BearingKey, int> guard_before_starts(const CalibrationRun& run,
 FilterResult run_filter(const CalibrationRun& run, const CalibrationOptions& options) {
   CalibrationFilter filter(options);
   filter.guard_ahead(guard_before_starts(run, options));
-  for (const FrameInput& f : run.frames) filter.process(f);
+  for (std::size_t k = 0; k < run.frames.size(); ++k) {
+    filter.process(run.frames[k]);
+    if (options.progress) options.progress("filter", k + 1, run.frames.size());
+  }
   filter.finish();
   return {filter.extrinsics(),
           filter.covariance(),

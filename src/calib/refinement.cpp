@@ -79,6 +79,7 @@ AssociationSetup association_setup(const CalibrationOptions& assoc,
     return build(run, assoc, at, assoc.refinement.robust);
   };
   s.solve = [&so, summary](Built* b) { solve_logged(so, b, summary, "association"); };
+  s.progress = assoc.progress;
   return s;
 }
 
@@ -233,6 +234,7 @@ RefinementResult refine_batch(const CalibrationRun& run,
   ceres::Solver::Options loose = so;
   loose.function_tolerance = options.refinement.association_function_tolerance;
   ceres::Solver::Summary summary;
+  if (options.progress) options.progress("refinement: first solve", 0, 0);
   solve_logged(loose, &b, &summary, "first solve");
   // Lines that cross, outliers (false matches, at the filter's gate), pieces of one line,
   // slipped tracks; the problem solved again after each decision.
@@ -265,6 +267,7 @@ RefinementResult refine_batch(const CalibrationRun& run,
   res.solution = point_of(b);
   res.extrinsics = res.solution.extrinsics;
   double time_offset_variance = std::numeric_limits<double>::quiet_NaN();
+  if (options.progress) options.progress("refinement: covariance", 0, 0);
   const auto t_covariance = std::chrono::steady_clock::now();
   const bool covariance = extrinsics_covariance(&b, &res.covariance, &time_offset_variance);
   spdlog::debug("refinement covariance: {:.2f} s", seconds_since(t_covariance));

@@ -58,6 +58,8 @@ BatchPoint warm_start(const CalibrationRun& run,
   o.noise.track_bias_sigma = 0.0;  // the windows hold no biases
   BatchPoint at = start;
   const ceres::Solver::Options so = window_solver();
+  std::size_t total = 1;  // windows start at 0, window - overlap, ... until one reaches n
+  for (int a = 0; a + window < n; a += window - overlap) ++total;
   int windows = 0, iterations = 0;
   for (int a = 0;;) {
     const int b = std::min(n, a + window);
@@ -73,6 +75,8 @@ BatchPoint warm_start(const CalibrationRun& run,
     ceres::Solve(so, w.problem.get(), &summary);
     ++windows;
     iterations += static_cast<int>(summary.iterations.size());
+    if (options.progress)
+      options.progress("refinement: warm start", static_cast<std::size_t>(windows), total);
     const BatchPoint solved = point_of(w);
     // The rigid motion of each pose of the window, for the features not solved in it whose
     // last frame lies in it or after it, and of the window's last pose for the poses after it.

@@ -287,7 +287,12 @@ double calibrate_tracks(const dataset::Dataset& data,
     r.input.run.clock = wheel_clock(data);
     opt.refinement.estimate_time_offset = true;
   }
-  if (o.progress) o.progress("calibrate", 0, 0);
+  if (o.progress) {
+    o.progress("calibrate", 0, 0);
+    opt.progress = [&o](const std::string& stage, std::size_t done, std::size_t total) {
+      o.progress(stage, done, total);
+    };
+  }
   r.calibration = streamed ? calib::result_of_filter(r.input.run, opt, std::move(streamed->filter))
                            : calib::calibrate(r.input.run, opt);
   if (refine_offset) refined_time_offset(r.calibration.refinement, o.time_offset, r);

@@ -7,6 +7,8 @@
 #include <map>
 #include <set>
 #include <string>
+#include <thread>
+#include <tuple>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -79,6 +81,67 @@ TEST(CalibrationResult, ReportsGiveTheEstimateItsSigmasAndTheVerdict) {
                            "\nrefinement: converged",
                            "\ntime: filter "})
     EXPECT_NE(full.find(item), std::string::npos) << item << " in\n" << full;
+}
+
+// CalibrationOptions::progress: every stage reported in order on the calling thread (the
+// filter's noise check, beside the refinement on a second thread, reports nothing), and the
+// results are those of a run without it, to the bit.
+TEST(Progress, EachStageOnTheCallingThreadAndTheSameResults) {
+  SyntheticRunOptions so;
+  so.bearing_sigma = deg2rad(0.05);
+  so.break_probability = 0.1;  // pieces of lines for the joining rounds
+  so.seed = 5;
+  const SyntheticRun run = make_synthetic_run(so);
+  const std::size_t n = run.run.frames.size();
+  CalibrationOptions o = refined(options_for(so));
+  o.refinement.warm_start_window = 30;  // a few windows on a short run
+  o.refinement.warm_start_overlap = 10;
+  o.threads = 2;
+  const CalibrationResult plain = calibrate(run.run, o);
+  std::vector<std::tuple<std::string, std::size_t, std::size_t>> seen;
+  bool other_thread = false;
+  const std::thread::id caller = std::this_thread::get_id();
+  o.progress = [&](const std::string& stage, std::size_t done, std::size_t total) {
+    if (std::this_thread::get_id() != caller) {
+      other_thread = true;
+      return;
+    }
+    seen.emplace_back(stage, done, total);
+  };
+  const CalibrationResult reported = calibrate(run.run, o);
+  EXPECT_FALSE(other_thread);
+  EXPECT_EQ(reported.extrinsics.phi, plain.extrinsics.phi);
+  EXPECT_EQ(reported.extrinsics.rho, plain.extrinsics.rho);
+  EXPECT_EQ(reported.extrinsics.psi, plain.extrinsics.psi);
+  EXPECT_EQ(reported.covariance, plain.covariance);
+  // The filter's frames one by one, then the refinement's stages in order.
+  std::vector<std::string> order;
+  std::size_t filter_frames = 0, windows = 0, window_total = 0, join_rounds = 0;
+  for (const auto& [stage, done, total] : seen) {
+    if (order.empty() || order.back() != stage) order.push_back(stage);
+    if (stage == "filter") {
+      EXPECT_EQ(done, ++filter_frames);
+      EXPECT_EQ(total, n);
+    } else if (stage == "refinement: warm start") {
+      EXPECT_EQ(done, ++windows);
+      window_total = total;
+    } else if (stage == "refinement: joining pieces") {
+      EXPECT_EQ(done, ++join_rounds);
+      EXPECT_EQ(total, 0u);
+    }
+  }
+  EXPECT_EQ(filter_frames, n);
+  // Windows start every 20 frames until one reaches the end.
+  EXPECT_EQ(window_total, (n - 30 + 19) / 20 + 1);
+  EXPECT_EQ(windows, window_total);
+  EXPECT_GE(join_rounds, 2u) << "the synthetic breaks leave pieces to join";
+  const std::vector<std::string> expected = {"filter",
+                                             "refinement: warm start",
+                                             "refinement: first solve",
+                                             "refinement: joining pieces",
+                                             "refinement: splitting tracks",
+                                             "refinement: covariance"};
+  EXPECT_EQ(order, expected);
 }
 
 }  // namespace

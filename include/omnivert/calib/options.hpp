@@ -14,6 +14,8 @@
 // paper_options(). Each option is defined once; the filter, its start-up window, the
 // refinement and the bound of Sec. 8.1 read the same fields.
 
+#include <cstddef>
+#include <functional>
 #include <string>
 
 #include <Eigen/Core>
@@ -260,6 +262,12 @@ struct CalibrationOptions {
   // Threads the estimators may use side by side (the filter's noise check beside the
   // refinement): 0 every core, 1 one after the other. The results are the same to the bit.
   int threads = 0;
+  // Long work reported as it goes (null: nothing), always on the calling thread: `stage` is
+  // "filter" (`done` frames of `total`), "refinement: warm start" (windows of `total`),
+  // "refinement: first solve", "refinement: joining pieces" and "refinement: splitting tracks"
+  // (`done` the round, `total` 0: the rounds end when nothing more joins or splits), and
+  // "refinement: covariance". The results do not depend on it.
+  std::function<void(const std::string& stage, std::size_t done, std::size_t total)> progress;
 
   // True when the whole tree is usable; otherwise false with the reason in *why (may be
   // null), which names the offending field by its path, e.g. "noise.bearing_sigma must be > 0".

@@ -80,7 +80,8 @@ struct CalibrateDatasetOptions {
   bool check_reference = false;
   bool check_off = false;
   // Called while tracking (stage "track", frames done, frames in all; "track again" when an
-  // estimated time offset is applied) and once before the calibration (stage "calibrate", 0, 0).
+  // estimated time offset is applied), once before the calibration (stage "calibrate", 0, 0),
+  // then with the calibration's stages (calib::CalibrationOptions::progress).
   std::function<void(const std::string& stage, std::size_t done, std::size_t total)> progress;
 
   // The whole tree at once: features, tracker, calibration, input, tilt, frames, time offset.
