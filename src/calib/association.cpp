@@ -127,20 +127,15 @@ bool out_of_features(const Built& b, const AssociationSetup& setup) {
   return setup.stop_when_empty && b.features.empty();
 }
 
-// The crossing guard of the association's options (reject_crossings), `left_out` neither
-// judged nor judging.
-int guard_crossings(Built* b,
-                    const AssociationSetup& setup,
-                    const std::map<int, int>& tracker,
-                    const std::set<int>* left_out = nullptr) {
+// The crossing guard of the association's options (reject_crossings).
+int guard_crossings(Built* b, const AssociationSetup& setup, const std::map<int, int>& tracker) {
   const AssociationOptions& a = setup.options->association;
   return reject_crossings(b,
                           a.crossing_guard,
                           a.max_missed_frames,
                           setup.min_bearings,
                           tracker,
-                          chi2_quantile(a.gate_probability, 2),
-                          left_out);
+                          chi2_quantile(a.gate_probability, 2));
 }
 
 // The outlier gate in sigmas: the filter's chi-square gate, 1 degree of freedom.
@@ -217,26 +212,19 @@ AssociationEnd rebuild_and_judge(Built* b,
                                  const AssociationSetup& setup,
                                  Association* out) {
   const std::map<int, int> tracker = tracker_ids(setup.base_origin, out->origin);
-  if (!setup.judge_before_solving) {
-    // The old problem goes before the new one is built (on a long run each holds hundreds of
-    // MB).
-    *b = Built{};
-    *b = setup.rebuild(run, at);
-    if (out_of_features(*b, setup)) return AssociationEnd::kNoTrack;
-    setup.solve(b);
-    if (!reject_and_solve(b, setup, tracker, &out->num_rejected))
-      return AssociationEnd::kNoTrackLeft;
-    return AssociationEnd::kDone;
-  }
-  // `at` is the last solution: the tracks the round left as they were are at their points,
-  // the joined and split ones are placed from their own bearings, and every bearing is judged
-  // there, all tracks together (crossings, collapsed points, outliers), then solved.
+  // `at` is the last solution: the tracks the round left as they were are at their points.
+  // Judged before solving, the joined and split ones are placed from their own bearings and
+  // every bearing is judged there, all tracks together (crossings, collapsed points,
+  // outliers); otherwise the problem is solved first with every bearing in.
   BatchPoint start = at;
-  place_changed(run, changed_tracks(previous, run), setup, &start);
+  if (setup.judge_before_solving) place_changed(run, changed_tracks(previous, run), setup, &start);
+  // The old problem goes before the new one is built (on a long run each holds hundreds of MB).
   *b = Built{};
   *b = setup.rebuild(run, start);
   if (out_of_features(*b, setup)) return AssociationEnd::kNoTrack;
-  if (!reject_and_solve(b, setup, tracker, &out->num_rejected, /*at_solution=*/true))
+  if (!setup.judge_before_solving) setup.solve(b);
+  if (!reject_and_solve(
+          b, setup, tracker, &out->num_rejected, /*at_solution=*/setup.judge_before_solving))
     return AssociationEnd::kNoTrackLeft;
   return AssociationEnd::kDone;
 }

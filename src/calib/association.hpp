@@ -72,14 +72,12 @@ bool one_line(Built* b, int a, int c, double chi2, FeatureCovariance* cache);
 // margin, and with tracks broken every ~10 frames the guard leaves out most bearings
 // (CrossingGuard.PiecesOfOneLineDoNotGuardEachOther; synthetic paper run, break probability 0.1:
 // 950 of 1140 in the filter, most features of the refinement).
-// With `left_out`, those features are neither judged nor judge the others.
 int reject_crossings(Built* b,
                      double guard,
                      int margin,
                      int min_bearings,
                      const std::map<int, int>& origin,
-                     double merge_chi2,
-                     const std::set<int>* left_out = nullptr);
+                     double merge_chi2);
 
 // The likelihood-ratio statistic of "one point" for tracks a and c with the poses and the
 // extrinsics held at the current solution: the least squares cost of all their bearings

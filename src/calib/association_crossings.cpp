@@ -76,8 +76,7 @@ int reject_crossings(Built* b,
                      int margin,
                      int min_bearings,
                      const std::map<int, int>& origin,
-                     double merge_chi2,
-                     const std::set<int>* left_out) {
+                     double merge_chi2) {
   if (!(guard > 0.0) || b->features.empty()) return 0;
   std::map<int, std::pair<int, int>> span;  // track id -> (first, last) frame
   for (const auto& [id, k] : b->bearing_keys) {
@@ -90,7 +89,7 @@ int reject_crossings(Built* b,
   std::vector<std::vector<std::pair<double, int>>> seen(static_cast<std::size_t>(frames));
   for (const auto& [id, f] : b->features) {
     const auto it = span.find(id);
-    if (it == span.end() || (left_out && left_out->count(id))) continue;
+    if (it == span.end()) continue;
     const int from = std::max(it->second.first - margin, 0);
     const int to = std::min(it->second.second + margin, frames - 1);
     for (int k = from; k <= to; ++k) {

@@ -58,9 +58,8 @@ int drop_collapsed_features(Built* b, double min_range) {
   return remove_features(b, drop);
 }
 
-int reject_outliers(Built* b, double threshold, int min_bearings, const std::set<int>* spared) {
-  const int n = filter_bearings(b, [&](ceres::ResidualBlockId id, const BearingKey& key) {
-    if (spared && spared->count(key.track)) return true;
+int reject_outliers(Built* b, double threshold, int min_bearings) {
+  const int n = filter_bearings(b, [&](ceres::ResidualBlockId id, const BearingKey&) {
     double r = 0.0, cost = 0.0;
     b->problem->EvaluateResidualBlock(id, /*apply_loss_function=*/false, &cost, &r, nullptr);
     if (std::abs(r) <= threshold) return true;  // (false for NaN)

@@ -91,11 +91,7 @@ int drop_collapsed_features(Built* b, double min_range);
 // Removes the bearings whose whitened residual exceeds `threshold` (the filter's chi-square
 // gate, in sigmas) at the current solution, then the features left with fewer than
 // `min_bearings` bearings (drop_unobserved_features). Returns how many bearings.
-// With `spared`, the bearings of those tracks are kept whatever their residual.
-int reject_outliers(Built* b,
-                    double threshold,
-                    int min_bearings,
-                    const std::set<int>* spared = nullptr);
+int reject_outliers(Built* b, double threshold, int min_bearings);
 
 // F = J^T J with a tiny ridge, relative to each variable's own information (their scales
 // differ by orders of magnitude): it keeps a feature seen without parallax from making F
