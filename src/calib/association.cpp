@@ -110,13 +110,8 @@ void place_changed(const CalibrationRun& run,
       p.problem->SetParameterBlockConstant(pose.data());
   p.problem->SetParameterBlockConstant(p.ex.data());
   if (!p.time_offset.empty()) p.problem->SetParameterBlockConstant(p.time_offset.data());
-  ceres::Solver::Options so;
-  so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-  so.max_num_iterations = 50;
-  so.num_threads = 1;
-  so.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
-  ceres::Solve(so, p.problem.get(), &summary);
+  ceres::Solve(small_solver_options(), p.problem.get(), &summary);
   for (const auto& [id, f] : p.features)
     if (std::isfinite(f[0]) && std::isfinite(f[1])) at->features[id] = {f[0], f[1]};
 }

@@ -272,6 +272,16 @@ bool marginal_with_time_offset(Built* b,
   return true;
 }
 
+ceres::Solver::Options small_solver_options() {
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  so.max_num_iterations = 50;
+  so.function_tolerance = 1e-6;
+  so.num_threads = 1;
+  so.logging_type = ceres::SILENT;
+  return so;
+}
+
 BatchPoint point_of(const Built& b) {
   BatchPoint p;
   for (const auto& q : b.poses) p.poses.emplace_back(q[0], q[1], q[2]);

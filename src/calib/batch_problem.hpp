@@ -125,6 +125,11 @@ Built build(const CalibrationRun& run,
             const BatchPoint& at,
             bool robust);
 
+// The solver of the small problems solved on the side (a window of the warm start, the placed
+// points of the association's renamed tracks): sparse normal Cholesky, at most 50 iterations,
+// Ceres' default function tolerance (1e-6), one thread, silent.
+ceres::Solver::Options small_solver_options();
+
 // The problem's current values, angles wrapped.
 BatchPoint point_of(const Built& b);
 

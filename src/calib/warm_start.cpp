@@ -29,16 +29,6 @@ struct Rigid {
   }
 };
 
-ceres::Solver::Options window_solver() {
-  ceres::Solver::Options so;
-  so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-  so.max_num_iterations = 50;
-  so.function_tolerance = 1e-6;
-  so.num_threads = 1;
-  so.logging_type = ceres::SILENT;
-  return so;
-}
-
 }  // namespace
 
 BatchPoint warm_start(const CalibrationRun& run,
@@ -57,7 +47,7 @@ BatchPoint warm_start(const CalibrationRun& run,
   CalibrationOptions o = options;
   o.noise.track_bias_sigma = 0.0;  // the windows hold no biases
   BatchPoint at = start;
-  const ceres::Solver::Options so = window_solver();
+  const ceres::Solver::Options so = small_solver_options();
   std::size_t total = 1;  // windows start at 0, window - overlap, ... until one reaches n
   for (int a = 0; a + window < n; a += window - overlap) ++total;
   int windows = 0, iterations = 0;

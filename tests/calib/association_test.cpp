@@ -189,10 +189,6 @@ SyntheticRun with_crossings(const SyntheticRun& clean) {
   return merge_crossings(clean, deg2rad(0.4), AssociationOptions{}.crossing_guard, 0.2);
 }
 
-// The crossing guard (CalibrationOptions::association.crossing_guard) leaves out exactly the
-// bearings where another feature is within the guard, and with it merged detections no longer move
-// the estimate: the run with merged detections gives the clean run's estimate; without the guard it
-// does not.
 // A round's renamed tracks are judged at the last solution with their points placed from
 // their own bearings (AssociationSetup::judge_before_solving): a split part that starts at the
 // point of the track it came from ends at its own line's point, the other points untouched.
@@ -206,10 +202,7 @@ TEST(TrackSplitting, ASplitPartIsPlacedOnItsOwnLine) {
   // From frame n/2 on, the track's bearings are a point 10 cm behind its own, renamed 1000.
   SyntheticRun run = slip(clean, track, n / 2, 0.10);
   const Eigen::Vector2d own = run.features[run.track_feature.at(track)];
-  const Eigen::Vector3d& p = run.true_poses[n / 2];
-  const double a = p(2) + run.truth.phi;
-  const Eigen::Vector2d c(p(0) + run.truth.rho * std::cos(a), p(1) + run.truth.rho * std::sin(a));
-  const Eigen::Vector2d behind = own + 0.10 * (own - c).normalized();
+  const Eigen::Vector2d behind = test_support::slip_point(run, track, n / 2, 0.10);
   for (int k = n / 2; k < n; ++k)
     for (BearingObservation& o : run.run.frames[static_cast<std::size_t>(k)].observations)
       if (o.track_id == track) o.track_id = 1000;
@@ -235,6 +228,10 @@ TEST(TrackSplitting, ASplitPartIsPlacedOnItsOwnLine) {
   EXPECT_EQ(same.features.at(1000), before.features.at(1000));
 }
 
+// The crossing guard (CalibrationOptions::association.crossing_guard) leaves out exactly the
+// bearings where another feature is within the guard, and with it merged detections no longer move
+// the estimate: the run with merged detections gives the clean run's estimate; without the guard it
+// does not.
 TEST(CrossingGuard, MergedDetectionsAreLeftOutAndDoNotMoveTheEstimate) {
   const int runs = 10;
   double moved_on = 0.0, moved_off = 0.0;  // mean squared Mahalanobis shift from the clean run

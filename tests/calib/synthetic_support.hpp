@@ -51,12 +51,19 @@ inline double nees(const RefinementResult& r, const Extrinsics& truth) {
 // From frame `from` on, the track of feature `f` follows a second line `behind` metres further
 // along the camera's ray of frame `from` (same noise): at the slip the two bearings coincide,
 // afterwards they drift apart as the robot moves, as a door leaf does behind its frame.
-inline SyntheticRun slip(SyntheticRun run, int track, int from, double behind) {
+// The point `behind` metres behind track's feature along the camera's ray of frame `from`:
+// where slip() moves its bearings.
+inline Eigen::Vector2d slip_point(const SyntheticRun& run, int track, int from, double behind) {
   const Eigen::Vector2d f = run.features[run.track_feature.at(track)];
   const Eigen::Vector3d& p = run.true_poses[from];
   const double a = p(2) + run.truth.phi;
   const Eigen::Vector2d c(p(0) + run.truth.rho * std::cos(a), p(1) + run.truth.rho * std::sin(a));
-  const Eigen::Vector2d g = f + behind * (f - c).normalized();
+  return f + behind * (f - c).normalized();
+}
+
+inline SyntheticRun slip(SyntheticRun run, int track, int from, double behind) {
+  const Eigen::Vector2d f = run.features[run.track_feature.at(track)];
+  const Eigen::Vector2d g = slip_point(run, track, from, behind);
   for (std::size_t k = from; k < run.run.frames.size(); ++k)
     for (BearingObservation& o : run.run.frames[k].observations)
       if (o.track_id == track)
