@@ -55,6 +55,29 @@ bool lower_side_applies(const NoiseCheckOptions& nc,
          static_cast<double>(joins) <= nc.lower_max_joins * check.clusters;
 }
 
+// The covariance "less noise" reports: the bearings' share shrunk only as far as the test allows,
+// to the largest variance factor it does not reject at `lower_level`, scale / (chi2(lower_level,
+// G) / G) with G the tracks checked (below 1 exactly where the verdict is "less noise"), not to
+// the point estimate `scale`. Under the model `scale` is itself about chi-square(G) / G: shrunk to
+// it, the runs the test flags by chance become overconfident (docs/theory/noise-check.md).
+// `reported` is the covariance before, whose bearings' share is the check's model's.
+Eigen::Matrix3d less_noise_covariance(const BatchNoiseCheck& check,
+                                      double lower_level,
+                                      const Eigen::Matrix3d& reported) {
+  const double bound = check.scale / noise_check_lower_limit(check.clusters, lower_level);
+  const double share = (1.0 - bound) / (1.0 - check.scale);  // of the shrink to `scale`
+  const Eigen::Matrix3d c = reported + share * (check.covariance - check.model_covariance);
+  return 0.5 * (c + c.transpose());
+}
+
+// tr(model^-1 covariance) / 3: the variance factor a reported covariance stands for.
+double factor_of(const Eigen::Matrix3d& model, const Eigen::Matrix3d& covariance) {
+  const Eigen::LDLT<Eigen::Matrix3d> m(model);
+  if (m.info() != Eigen::Success) return 0.0;
+  const double f = m.solve(covariance).trace() / 3.0;
+  return std::isfinite(f) && f > 0.0 ? f : 0.0;
+}
+
 // Each stage's time, on the log's debug level (omnivert -v).
 class StageTimer {
  public:
@@ -170,10 +193,13 @@ void apply_filter_noise(const NoiseCheckOptions& nc, CalibrationResult* r) {
     apply(r->filter.covariance * ratio);
   } else if (r->noise_check.filter_verdict == NoiseVerdict::kLessNoise &&
              lower_side_applies(nc, r->filter.joins.size(), r->noise_check.filter_check)) {
-    const Eigen::Matrix3d shrunk = r->filter.covariance + r->noise_check.filter_check.covariance -
-                                   r->noise_check.filter_check.model_covariance;
-    if (shrunk.allFinite() && Eigen::LLT<Eigen::Matrix3d>(shrunk).info() == Eigen::Success)
-      apply(0.5 * (shrunk + shrunk.transpose()));
+    const Eigen::Matrix3d before = r->filter.covariance;
+    const Eigen::Matrix3d shrunk =
+        less_noise_covariance(r->noise_check.filter_check, nc.lower_level, before);
+    if (shrunk.allFinite() && Eigen::LLT<Eigen::Matrix3d>(shrunk).info() == Eigen::Success) {
+      apply(shrunk);
+      r->noise_check.filter_ratio = r->noise_check.ratio = factor_of(before, shrunk);
+    }
   }
 }
 
@@ -189,12 +215,20 @@ void apply_refinement_noise(const NoiseCheckOptions& nc, CalibrationResult* r) {
   r->noise_check.checked = true;
   r->noise_check.check = r->refinement.noise;
   r->noise_check.verdict = noise_check_verdict(r->noise_check.check, nc.level, nc.lower_level);
-  if (r->noise_check.verdict == NoiseVerdict::kMoreNoise ||
-      (r->noise_check.verdict == NoiseVerdict::kLessNoise &&
-       lower_side_applies(nc, r->refinement.merges.size(), r->noise_check.check))) {
+  if (r->noise_check.verdict == NoiseVerdict::kMoreNoise) {
     r->noise_check.applied = true;
     r->noise_check.ratio = ratio;
     r->refinement.covariance = r->noise_check.check.covariance;
+  } else if (r->noise_check.verdict == NoiseVerdict::kLessNoise &&
+             lower_side_applies(nc, r->refinement.merges.size(), r->noise_check.check)) {
+    const Eigen::Matrix3d model = r->noise_check.check.model_covariance;
+    const Eigen::Matrix3d shrunk =
+        less_noise_covariance(r->noise_check.check, nc.lower_level, model);
+    if (shrunk.allFinite() && Eigen::LLT<Eigen::Matrix3d>(shrunk).info() == Eigen::Success) {
+      r->noise_check.applied = true;
+      r->noise_check.ratio = factor_of(model, shrunk);
+      r->refinement.covariance = shrunk;
+    }
   }
 }
 
