@@ -139,10 +139,7 @@ void refine_and_analyse(const CalibrationRun& run,
 
 // The overall variance ratio tr(model^-1 checked) / 3 of a noise check; 0 when it failed.
 double ratio_of(const BatchNoiseCheck& n) {
-  const Eigen::LDLT<Eigen::Matrix3d> model(n.model_covariance);
-  if (!n.ok || model.info() != Eigen::Success) return 0.0;
-  const double ratio = model.solve(n.covariance).trace() / 3.0;
-  return std::isfinite(ratio) && ratio > 0.0 ? ratio : 0.0;
+  return n.ok ? factor_of(n.model_covariance, n.covariance) : 0.0;
 }
 
 // Whether the filter's noise check is the refinement's own: with no splits or joins anywhere,
