@@ -9,6 +9,7 @@
 #include <iomanip>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -60,14 +61,18 @@ bool lower_side_applies(const NoiseCheckOptions& nc,
 // G) / G) with G the tracks checked (below 1 exactly where the verdict is "less noise"), not to
 // the point estimate `scale`. Under the model `scale` is itself about chi-square(G) / G: shrunk to
 // it, the runs the test flags by chance become overconfident (docs/theory/noise-check.md).
-// `reported` is the covariance before, whose bearings' share is the check's model's.
-Eigen::Matrix3d less_noise_covariance(const BatchNoiseCheck& check,
-                                      double lower_level,
-                                      const Eigen::Matrix3d& reported) {
+// `reported` is the covariance before, whose bearings' share is the check's model's. None when
+// the result is not positive definite (the covariance is then kept).
+std::optional<Eigen::Matrix3d> less_noise_covariance(const BatchNoiseCheck& check,
+                                                     double lower_level,
+                                                     const Eigen::Matrix3d& reported) {
   const double bound = check.scale / noise_check_lower_limit(check.clusters, lower_level);
   const double share = (1.0 - bound) / (1.0 - check.scale);  // of the shrink to `scale`
-  const Eigen::Matrix3d c = reported + share * (check.covariance - check.model_covariance);
-  return 0.5 * (c + c.transpose());
+  Eigen::Matrix3d c = reported + share * (check.covariance - check.model_covariance);
+  c = 0.5 * (c + c.transpose());
+  if (!c.allFinite() || Eigen::LLT<Eigen::Matrix3d>(c).info() != Eigen::Success)
+    return std::nullopt;
+  return c;
 }
 
 // tr(model^-1 covariance) / 3: the variance factor a reported covariance stands for.
@@ -191,11 +196,10 @@ void apply_filter_noise(const NoiseCheckOptions& nc, CalibrationResult* r) {
   } else if (r->noise_check.filter_verdict == NoiseVerdict::kLessNoise &&
              lower_side_applies(nc, r->filter.joins.size(), r->noise_check.filter_check)) {
     const Eigen::Matrix3d before = r->filter.covariance;
-    const Eigen::Matrix3d shrunk =
-        less_noise_covariance(r->noise_check.filter_check, nc.lower_level, before);
-    if (shrunk.allFinite() && Eigen::LLT<Eigen::Matrix3d>(shrunk).info() == Eigen::Success) {
-      apply(shrunk);
-      r->noise_check.filter_ratio = r->noise_check.ratio = factor_of(before, shrunk);
+    if (const auto shrunk =
+            less_noise_covariance(r->noise_check.filter_check, nc.lower_level, before)) {
+      apply(*shrunk);
+      r->noise_check.filter_ratio = r->noise_check.ratio = factor_of(before, *shrunk);
     }
   }
 }
@@ -219,12 +223,10 @@ void apply_refinement_noise(const NoiseCheckOptions& nc, CalibrationResult* r) {
   } else if (r->noise_check.verdict == NoiseVerdict::kLessNoise &&
              lower_side_applies(nc, r->refinement.merges.size(), r->noise_check.check)) {
     const Eigen::Matrix3d model = r->noise_check.check.model_covariance;
-    const Eigen::Matrix3d shrunk =
-        less_noise_covariance(r->noise_check.check, nc.lower_level, model);
-    if (shrunk.allFinite() && Eigen::LLT<Eigen::Matrix3d>(shrunk).info() == Eigen::Success) {
+    if (const auto shrunk = less_noise_covariance(r->noise_check.check, nc.lower_level, model)) {
       r->noise_check.applied = true;
-      r->noise_check.ratio = factor_of(model, shrunk);
-      r->refinement.covariance = shrunk;
+      r->noise_check.ratio = factor_of(model, *shrunk);
+      r->refinement.covariance = *shrunk;
     }
   }
 }
