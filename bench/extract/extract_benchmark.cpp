@@ -1,6 +1,6 @@
 // Per-frame cost of the front end on a 640x480 frame: mirror centre + radial lines +
 // 192-D descriptors (the pipeline of Sec. 2-3), and its stages, against two peers measured
-// in the same run on the same frame: ORB (500 keypoints, detect + describe) and OpenCV's
+// in the same run on the same frame: ORB (1,000 features, detect + describe) and OpenCV's
 // LSD/EDLines + LBD (BinaryDescriptor: detect + compute).
 //
 // The *_Masked variants run the same stages with an image mask (four struts 8 px wide across
@@ -175,7 +175,7 @@ void BM_FrontEnd_File(benchmark::State& state) {
 BENCHMARK(BM_FrontEnd_File)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
 
 void BM_Peer_ORB(benchmark::State& state) {
-  auto orb = cv::ORB::create(500);
+  auto orb = cv::ORB::create(1000);
   std::vector<cv::KeyPoint> kp;
   cv::Mat desc;
   for (auto _ : state) {

@@ -130,11 +130,183 @@ void DescriptorExtractor::prepare(const cv::Mat& gray, const MirrorCircle& circl
     }
   }
   if (usable_.empty()) sample_usable_.release();
+  if (!options_.reference) polar_table();
 }
+
+void DescriptorExtractor::polar_table() {
+  // The part of each sample's vote that does not depend on the line: |g| (times the usable
+  // fraction) and atan2(gy, gx), once per frame rather than once per area that covers the
+  // sample. The same float operations as describe_one_reference, so the same bits.
+  mag_.create(gx_.size(), CV_32F);
+  angle_.create(gx_.size(), CV_32F);
+  for (int v = 0; v < gx_.rows; ++v) {
+    const float* px = gx_.ptr<float>(v);
+    const float* py = gy_.ptr<float>(v);
+    float* m = mag_.ptr<float>(v);
+    float* a = angle_.ptr<float>(v);
+    for (int u = 0; u < gx_.cols; ++u) {
+      m[u] = std::sqrt(px[u] * px[u] + py[u] * py[u]);
+      a[u] = fast_atan2_any(py[u], px[u]);
+    }
+    if (!sample_usable_.empty()) {
+      const float* pu = sample_usable_.ptr<float>(v);
+      for (int u = 0; u < gx_.cols; ++u) m[u] *= pu[u];
+    }
+  }
+}
+
+namespace {
+// One row of an area's samples, prepared for voting (describe_one): per sample its magnitude
+// (zero: no vote), lower bin and weight of eq. (2), and left-side fraction (Sec. 3.2).
+struct VoteRow {
+  std::vector<float> m, w, left, d2;
+  std::vector<int> b;
+  void reserve(std::size_t n) {
+    if (m.size() >= n) return;
+    m.resize(n);
+    w.resize(n);
+    left.resize(n);
+    d2.resize(n);
+    b.resize(n);
+  }
+};
+
+// std::clamp(x, 0, 1) by value: a select the compiler can vectorise (std::clamp returns a
+// reference).
+inline float clamp01(float x) { return x < 0.0f ? 0.0f : (1.0f < x ? 1.0f : x); }
+
+// The constants of one line's areas (describe_one).
+struct AreaGeometry {
+  float st, inv_st, off, ra, ra2, theta, dx, dy, to_bin, cx;
+  int nb;
+};
+
+// The per-sample arithmetic of describe_one_reference for samples ua .. ua + n - 1 of a row at
+// ry from the area's centre, with |g| (pm) and atan2 (pa) from the table: a loop without
+// branches over distinct buffers, which the compiler vectorises.
+void prepare_votes(const AreaGeometry& g,
+                   int ua,
+                   int n,
+                   float ry,
+                   const float* __restrict pm,
+                   const float* __restrict pa,
+                   VoteRow& out) {
+  const float st = g.st, inv_st = g.inv_st, off = g.off, ra = g.ra, ra2 = g.ra2;
+  const float theta = g.theta, dx = g.dx, dy = g.dy, to_bin = g.to_bin, cx = g.cx;
+  const int nb = g.nb;
+  const float two_pi = static_cast<float>(kTwoPi);
+  const float inv_two_pi = static_cast<float>(1.0 / kTwoPi);
+  float* __restrict vm = out.m.data();
+  float* __restrict vw = out.w.data();
+  float* __restrict vleft = out.left.data();
+  float* __restrict vd2 = out.d2.data();
+  int* __restrict vb = out.b.data();
+  for (int i = 0; i < n; ++i) {
+    const float rx = static_cast<float>(ua + i) * st + off - cx;
+    const float d2 = rx * rx + ry * ry;
+    // A sample's share of the area and of each side: linear ramps one cell wide.
+    const float inside = clamp01((ra - std::sqrt(d2)) * inv_st + 0.5f);
+    // Outside the disc: no vote (a product, not a select, so that the load of pm[i] stays
+    // unconditional; m * 0 = +0 as m >= 0).
+    vm[i] = pm[i] * inside * (d2 > ra2 ? 0.0f : 1.0f);
+    vd2[i] = d2;
+    // Sec. 3.1: orientation relative to the line, wrapped to [0, 2 pi) without floor().
+    float phi = pa[i] - theta;
+    const float q = phi * inv_two_pi;
+    float fq = static_cast<float>(static_cast<int>(q));
+    fq = fq > q ? fq - 1.0f : fq;
+    phi -= two_pi * fq;
+    const float t = phi * to_bin;
+    const int b = static_cast<int>(t);
+    vw[i] = t - static_cast<float>(b);
+    vb[i] = b >= nb ? b - nb : b;
+    vleft[i] = clamp01((dx * ry - dy * rx) * inv_st + 0.5f);
+  }
+}
+}  // namespace
 
 void DescriptorExtractor::describe_one(const MirrorCircle& circle,
                                        double image_angle,
                                        float* row) const {
+  // describe_one_reference in two passes per row of an area: the per-sample arithmetic as a
+  // loop without branches (the compiler vectorises it), with |g| and the orientation from
+  // polar_table(), then the votes. Each row is cut to the samples its disc can reach. The
+  // same float operations on every vote as the reference, so the same bits.
+  const int nb = options_.bins;
+  const double ra = area_radius(circle);
+  const double sigma = options_.sigma_fraction * ra;
+  const float inv_2s2 = static_cast<float>(1.0 / (2 * sigma * sigma));
+  const bool weighted = options_.smoothing == DescriptorSmoothing::kGaussianWeight;
+  const float theta = static_cast<float>(image_angle);
+  const float dx = std::cos(theta), dy = std::sin(theta);
+  const float st = static_cast<float>(step_);
+  const float inv_st = 1.0f / st;
+  const float ra_out = static_cast<float>(ra) + 0.5f * st;
+  const float ra2 = ra_out * ra_out;
+  const float off = 0.5f * st - 0.5f;
+  AreaGeometry g{st,
+                 inv_st,
+                 off,
+                 static_cast<float>(ra),
+                 ra2,
+                 theta,
+                 dx,
+                 dy,
+                 static_cast<float>(nb / kTwoPi),
+                 0.0f,
+                 nb};
+  thread_local VoteRow vr;
+  vr.reserve(static_cast<std::size_t>(gx_.cols));
+  const float* const vm = vr.m.data();
+  const float* const vw = vr.w.data();
+  const float* const vleft = vr.left.data();
+  const float* const vd2 = vr.d2.data();
+  const int* const vb = vr.b.data();
+  std::fill(row, row + options_.size(), 0.0f);
+  const auto centers = area_centers(circle, image_angle);
+  for (int k = 0; k < options_.areas; ++k) {
+    float* hl = row + (2 * k) * nb;
+    float* hr = row + (2 * k + 1) * nb;
+    const float cx = static_cast<float>(centers[k].x - roi_.x);
+    const float cy = static_cast<float>(centers[k].y - roi_.y);
+    g.cx = cx;
+    const int u0 = std::max(1, static_cast<int>(std::floor((cx - ra - off) / st)));
+    const int u1 = std::min(gx_.cols - 2, static_cast<int>(std::ceil((cx + ra - off) / st)));
+    const int v0 = std::max(1, static_cast<int>(std::floor((cy - ra - off) / st)));
+    const int v1 = std::min(gx_.rows - 2, static_cast<int>(std::ceil((cy + ra - off) / st)));
+    for (int v = v0; v <= v1; ++v) {
+      const float ry = v * st + off - cy;
+      // rx^2 + ry^2 >= ry^2 in floating point too: the whole row is outside the disc.
+      if (ry * ry > ra2) continue;
+      // Samples further than the chord's half-length plus a cell fail the disc test anyway.
+      const float half = std::sqrt(ra2 - ry * ry) + st;
+      const int ua = std::max(u0, static_cast<int>(std::floor((cx - half - off) * inv_st)));
+      const int ub = std::min(u1, static_cast<int>(std::ceil((cx + half - off) * inv_st)));
+      const int n = ub - ua + 1;
+      if (n <= 0) continue;
+      prepare_votes(g, ua, n, ry, mag_.ptr<float>(v) + ua, angle_.ptr<float>(v) + ua, vr);
+      for (int i = 0; i < n; ++i) {
+        float m = vm[i];
+        if (m == 0.0f) continue;
+        if (weighted) m *= std::exp(-vd2[i] * inv_2s2);
+        // Eq. (2): m (1 - w) to the lower bin, m w to the upper, circularly.
+        const int b = vb[i];
+        const int b1 = b + 1 == nb ? 0 : b + 1;
+        const float w = vw[i];
+        const float ml = m * vleft[i], mr = m - ml;
+        hl[b] += ml * (1.0f - w);
+        hl[b1] += ml * w;
+        hr[b] += mr * (1.0f - w);
+        hr[b1] += mr * w;
+      }
+    }
+  }
+  normalize(row);
+}
+
+void DescriptorExtractor::describe_one_reference(const MirrorCircle& circle,
+                                                 double image_angle,
+                                                 float* row) const {
   const int nb = options_.bins;
   const double ra = area_radius(circle);
   const double sigma = options_.sigma_fraction * ra;
@@ -230,8 +402,13 @@ void DescriptorExtractor::compute(const cv::Mat& gray,
   out.resize(static_cast<Eigen::Index>(lines.size()), options_.size());
   if (lines.empty()) return;
   prepare(gray, circle);
-  for (std::size_t i = 0; i < lines.size(); ++i)
-    describe_one(circle, lines[i].image_angle, out.row(static_cast<Eigen::Index>(i)).data());
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    float* row = out.row(static_cast<Eigen::Index>(i)).data();
+    if (options_.reference)
+      describe_one_reference(circle, lines[i].image_angle, row);
+    else
+      describe_one(circle, lines[i].image_angle, row);
+  }
 }
 
 void DescriptorExtractor::compute_at_angles(const cv::Mat& gray,
@@ -242,8 +419,13 @@ void DescriptorExtractor::compute_at_angles(const cv::Mat& gray,
   out.resize(static_cast<Eigen::Index>(image_angles.size()), options_.size());
   if (image_angles.empty()) return;
   prepare(gray, circle);
-  for (std::size_t i = 0; i < image_angles.size(); ++i)
-    describe_one(circle, image_angles[i], out.row(static_cast<Eigen::Index>(i)).data());
+  for (std::size_t i = 0; i < image_angles.size(); ++i) {
+    float* row = out.row(static_cast<Eigen::Index>(i)).data();
+    if (options_.reference)
+      describe_one_reference(circle, image_angles[i], row);
+    else
+      describe_one(circle, image_angles[i], row);
+  }
 }
 
 }  // namespace omnivert

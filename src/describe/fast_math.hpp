@@ -25,4 +25,21 @@ inline float fast_atan2(float y, float x) {
   return r;
 }
 
+// fast_atan2 without the early return, so that a loop over an array of gradients vectorises:
+// equal to fast_atan2 for every (y, x).
+inline float fast_atan2_any(float y, float x) {
+  const float ax = std::abs(x), ay = std::abs(y);
+  const float mx = ax > ay ? ax : ay;
+  const float mn = ax > ay ? ay : ax;
+  const float z = mn / (mx > 0.0f ? mx : 1.0f);  // (0, 0): 0 / 1
+  const float z2 = z * z;
+  float r =
+      z * (0.99997726f +
+           z2 * (-0.33262347f +
+                 z2 * (0.19354346f + z2 * (-0.11643287f + z2 * (0.05265332f - 0.01172120f * z2)))));
+  r = ay > ax ? 1.57079637f - r : r;
+  r = x < 0 ? 3.14159274f - r : r;
+  return y < 0 ? -r : r;
+}
+
 }  // namespace omnivert

@@ -55,6 +55,12 @@ struct DescriptorOptions {
   // blurred image holds nothing finer. A large value forces full resolution.
   double min_samples_per_sigma = 5.0;
 
+  // The plain per-sample computation (gradient magnitude, orientation and area distance for
+  // every sample of every area) instead of the fast path, which takes magnitude and
+  // orientation once per frame from a table. The two give the same descriptors to the bit
+  // (test Descriptor.FastPathEqualsThePlainReference); the plain one is kept to check it.
+  bool reference = false;
+
   bool IsValid(std::string* why) const;
   // Descriptor length: areas x 2 halves x bins.
   int size() const { return areas * 2 * bins; }
@@ -96,12 +102,15 @@ class DescriptorExtractor {
  private:
   void prepare(const cv::Mat& gray, const MirrorCircle& circle);
   void describe_one(const MirrorCircle& circle, double image_angle, float* row) const;
+  void describe_one_reference(const MirrorCircle& circle, double image_angle, float* row) const;
+  void polar_table();
   void normalize(float* row) const;
 
   DescriptorOptions options_;
   cv::Rect roi_;  // region of the frame the gradient images cover
   int step_ = 1;  // one gradient sample every step_ pixels (blur reading)
   cv::Mat full_, blurred_, gx_, gy_;
+  cv::Mat mag_, angle_;    // fast path: per sample |g| (times its usable fraction), atan2(gy, gx)
   cv::Mat usable_;         // set_mask; empty: no mask
   cv::Mat sample_usable_;  // per gradient sample: usable fraction in [0, 1] (CV_32F); or empty
   cv::Mat mask_f_, weight_;
