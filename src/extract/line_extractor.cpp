@@ -65,6 +65,7 @@ void LineExtractor::build_lut(const MirrorCircle& circle) {
   }
   lut_r_min_ = r0;
   lut_r_max_ = r1;
+  build_row_spans();
 }
 
 namespace {
@@ -250,48 +251,6 @@ void LineExtractor::extract(const cv::Mat& gray,
   threshold_lines(circle, out);
   const double annulus = circle.r_max - circle.r_min;
   for (VerticalLine& l : out) l.annulus_fraction = l.edge_pixels / annulus;
-}
-
-void LineExtractor::edge_pass(const cv::Mat& gray, int cxi, int cyi) {
-  if (sobel_usable_.empty()) {
-    edge_pass_impl<false>(gray, cxi, cyi);
-  } else {
-    CV_Assert(sobel_usable_.size() == gray.size());
-    edge_pass_impl<true>(gray, cxi, cyi);
-  }
-}
-
-template <bool kMasked>
-void LineExtractor::edge_pass_impl(const cv::Mat& gray, int cxi, int cyi) {
-  // Step 2: one pass over the annulus: Sobel (eq. 1), magnitude threshold, orientation test.
-  const int W = gray.cols, H = gray.rows;
-  const uchar* usable = kMasked ? sobel_usable_.ptr<uchar>() : nullptr;
-  float* mag = mag_.ptr<float>();
-  const uchar* img = gray.ptr<uchar>();
-  const float t2 = static_cast<float>(options_.gradient_threshold * options_.gradient_threshold);
-  const float s = static_cast<float>(std::sin(deg2rad(options_.orientation_tolerance_deg)));
-  const float s2 = s * s;
-  std::vector<Candidate>& cands = cands_;
-  cands.clear();
-  for (int32_t i = 0; i < static_cast<int32_t>(lut_.size()); ++i) {
-    const LutEntry& e = lut_[i];
-    const int u = cxi + e.du, v = cyi + e.dv;
-    if (u < 1 || v < 1 || u >= W - 1 || v >= H - 1) continue;
-    const int idx = v * W + u;
-    if constexpr (kMasked) {
-      if (!usable[idx]) continue;  // the Sobel window touches a masked pixel
-    }
-    const uchar* p = img + idx;
-    const int gx = (p[-W + 1] + 2 * p[1] + p[W + 1]) - (p[-W - 1] + 2 * p[-1] + p[W - 1]);
-    const int gy = (p[W - 1] + 2 * p[W] + p[W + 1]) - (p[-W - 1] + 2 * p[-W] + p[-W + 1]);
-    const float m2 = static_cast<float>(gx * gx + gy * gy);
-    if (m2 < t2) continue;
-    const float radial = gx * e.ux + gy * e.uy;
-    if (radial * radial > s2 * m2) continue;  // gradient not tangential: not a radial edge
-    const float m = std::sqrt(m2);
-    mag[idx] = m;
-    cands.push_back({i, idx, static_cast<int16_t>(gx), static_cast<int16_t>(gy), m});
-  }
 }
 
 void LineExtractor::vote_sectors(int cxi, int cyi, float fx, float fy) {

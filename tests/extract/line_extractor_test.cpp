@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "omnivert/core/angles.hpp"
 #include "omnivert/describe/feature_pipeline.hpp"
@@ -161,6 +162,62 @@ TEST(LineExtractor, SignificanceKeepsNoLineInNoise) {
   std::printf("noise, 10 images: %d significant lines, %d with topk\n", kept, topk);
   EXPECT_LE(kept, 2);
   EXPECT_EQ(topk, 200);
+}
+
+// The fast edge pass (rows of the annulus, vectorised) against the plain one (pixel by pixel
+// through the lookup table): the same edge pixels and lines to the bit, with and without a
+// mask, and with the annulus cut by every side of the image.
+TEST(LineExtractor, FastEdgePassEqualsThePlainReference) {
+  cv::Mat usable(480, 640, CV_8U, cv::Scalar(255));
+  cv::line(usable, {320, 240}, {600, 60}, cv::Scalar(0), 8);
+  cv::circle(usable, {230, 330}, 50, cv::Scalar(0), cv::FILLED);
+  int compared = 0;
+  for (std::uint64_t seed : {1, 2, 3}) {
+    sim::RadialPatternOptions o;
+    o.seed = seed;
+    o.full_edges = 20;
+    o.patches = 8;
+    const sim::RadialPattern p = sim::draw_radial_pattern(o);
+    // The pattern's own circle, and circles whose annulus leaves the image on each side.
+    std::vector<MirrorCircle> circles{p.circle};
+    for (const auto& c : {Eigen::Vector2d(130.4, 240.2), Eigen::Vector2d(520.7, 239.6),
+                          Eigen::Vector2d(320.2, 90.3), Eigen::Vector2d(319.6, 400.8)}) {
+      MirrorCircle m = p.circle;
+      m.center = c;
+      circles.push_back(m);
+    }
+    for (const MirrorCircle& c : circles) {
+      for (bool masked : {false, true}) {
+        LineExtractorOptions plain;
+        plain.reference = true;
+        LineExtractor fast, ref(plain);
+        if (masked) {
+          fast.set_mask(usable);
+          ref.set_mask(usable);
+        }
+        std::vector<VerticalLine> a, b;
+        fast.extract(p.image, c, a);
+        ref.extract(p.image, c, b);
+        const auto& ea = fast.last_edge_points();
+        const auto& eb = ref.last_edge_points();
+        ASSERT_GT(eb.size(), 100u);
+        ASSERT_EQ(ea.size(), eb.size()) << "seed " << seed << " masked " << masked;
+        for (std::size_t i = 0; i < ea.size(); ++i) {
+          ASSERT_EQ(ea[i].x, eb[i].x);
+          ASSERT_EQ(ea[i].y, eb[i].y);
+          ASSERT_EQ(ea[i].weight, eb[i].weight);
+          ASSERT_EQ(ea[i].sector, eb[i].sector);
+        }
+        ASSERT_EQ(a.size(), b.size());
+        for (std::size_t i = 0; i < a.size(); ++i) {
+          EXPECT_EQ(a[i].image_angle, b[i].image_angle);
+          EXPECT_EQ(a[i].edge_pixels, b[i].edge_pixels);
+        }
+        ++compared;
+      }
+    }
+  }
+  EXPECT_EQ(compared, 30);
 }
 
 }  // namespace
