@@ -16,11 +16,15 @@ void LineExtractor::build_row_spans() {
   spans_.clear();
   lut_ux_.resize(lut_.size());
   lut_uy_.resize(lut_.size());
+  lut_inv_r_.resize(lut_.size());
+  lut_sector_.resize(lut_.size());
   std::size_t longest = 0;
   for (int32_t i = 0; i < static_cast<int32_t>(lut_.size()); ++i) {
     const LutEntry& e = lut_[i];
     lut_ux_[i] = e.ux;
     lut_uy_[i] = e.uy;
+    lut_inv_r_[i] = e.inv_r;
+    lut_sector_[i] = e.sector;
     // The table is in row-major order: a run continues while the row is the same and the
     // column is the next one.
     if (!spans_.empty() && spans_.back().dv == e.dv && spans_.back().du0 + spans_.back().n == e.du)
@@ -73,7 +77,16 @@ void LineExtractor::edge_pass_impl(const cv::Mat& gray, int cxi, int cyi) {
     if (radial * radial > s2 * m2) continue;  // gradient not tangential: not a radial edge
     const float m = std::sqrt(m2);
     mag[idx] = m;
-    cands.push_back({i, idx, static_cast<int16_t>(gx), static_cast<int16_t>(gy), m});
+    cands.push_back({idx,
+                     static_cast<int16_t>(gx),
+                     static_cast<int16_t>(gy),
+                     m,
+                     static_cast<int16_t>(e.du),
+                     static_cast<int16_t>(e.dv),
+                     e.ux,
+                     e.uy,
+                     e.inv_r,
+                     e.sector});
   }
 }
 
@@ -147,7 +160,17 @@ void LineExtractor::edge_rows(const cv::Mat& gray, int cxi, int cyi) {
       if (row_m2_[i] == 0.0f) continue;
       const float m = std::sqrt(row_m2_[i]);
       mag[idx0 + i] = m;
-      cands_.push_back({l0 + i, idx0 + i, row_gx_[i], row_gy_[i], m});
+      const int l = l0 + i;
+      cands_.push_back({idx0 + i,
+                        row_gx_[i],
+                        row_gy_[i],
+                        m,
+                        static_cast<int16_t>(u + i - cxi),
+                        static_cast<int16_t>(sp.dv),
+                        lut_ux_[l],
+                        lut_uy_[l],
+                        lut_inv_r_[l],
+                        lut_sector_[l]});
     }
   }
 }

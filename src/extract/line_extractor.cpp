@@ -277,7 +277,7 @@ void LineExtractor::vote_sectors(int cxi, int cyi, float fx, float fy) {
     if (!(c.m > mm && c.m >= mp)) continue;
     const float den = mm - 2 * c.m + mp;
     const float d = den < 0 ? std::clamp(0.5f * (mm - mp) / den, -0.5f, 0.5f) : 0.0f;
-    const LutEntry& e = lut_[c.lut];
+    const Candidate& e = c;  // with its table entry's fields
     // Position relative to the exact centre, and the first-order angle correction of the
     // LUT's sector for the sub-pixel centre and edge offset.
     const float ox = d * sx - fx, oy = d * sy - fy;

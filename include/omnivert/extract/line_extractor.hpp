@@ -144,7 +144,7 @@ class LineExtractor {
     int32_t dv, du0, n, lut0;  // row offset, first column offset, length, first table entry
   };
   std::vector<RowSpan> spans_;
-  std::vector<float> lut_ux_, lut_uy_;
+  std::vector<float> lut_ux_, lut_uy_, lut_inv_r_, lut_sector_;
   std::vector<float> row_m2_;
   std::vector<int16_t> row_gx_, row_gy_;
   bool uses_significance() const {
@@ -186,10 +186,13 @@ class LineExtractor {
   std::vector<LutEntry> lut_;
   double lut_r_min_ = -1, lut_r_max_ = -1;
   struct Candidate {  // a pixel that passed the magnitude and orientation tests
-    int32_t lut;
     int32_t px;
     int16_t gx, gy;
     float m;
+    // Its lookup-table entry's fields that step 3 needs, copied here: step 3 then reads the
+    // candidates in order rather than the table (several MB) at scattered places.
+    int16_t du, dv;
+    float ux, uy, inv_r, sector;
   };
   struct LineCandidate {
     int peak;  // sector of the vote peak
