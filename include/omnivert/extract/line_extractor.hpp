@@ -147,6 +147,7 @@ class LineExtractor {
   std::vector<float> lut_ux_, lut_uy_, lut_inv_r_, lut_sector_;
   std::vector<float> row_m2_;
   std::vector<int16_t> row_gx_, row_gy_;
+  std::vector<int32_t> row_passed_;
   bool uses_significance() const {
     return options_.threshold == LineThreshold::kSignificance ||
            options_.threshold == LineThreshold::kSignificantOrLong;
