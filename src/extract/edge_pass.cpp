@@ -108,7 +108,8 @@ void row_tests(const uchar* __restrict r0,
                int16_t* __restrict gx_out,
                int16_t* __restrict gy_out) {
   for (int i = 0; i < n; ++i) {
-    const int gx = (r0[i + 1] + 2 * r1[i + 1] + r2[i + 1]) - (r0[i - 1] + 2 * r1[i - 1] + r2[i - 1]);
+    const int gx =
+        (r0[i + 1] + 2 * r1[i + 1] + r2[i + 1]) - (r0[i - 1] + 2 * r1[i - 1] + r2[i - 1]);
     const int gy = (r2[i - 1] + 2 * r2[i] + r2[i + 1]) - (r0[i - 1] + 2 * r0[i] + r0[i + 1]);
     const float m2 = static_cast<float>(gx * gx + gy * gy);
     const float radial = gx * ux[i] + gy * uy[i];

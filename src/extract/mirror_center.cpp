@@ -246,28 +246,70 @@ double MirrorCenterDetector::self_reflection_radius(const cv::Mat& gray,
   return best >= 0.3 ? (disc / scale) * (1.0 + options_.inner_margin_fraction) : 0.25 * r_max;
 }
 
-std::optional<MirrorCircle> MirrorCenterDetector::detect(const cv::Mat& gray,
-                                                         const MirrorCircle& prior,
-                                                         std::string* why) const {
-  CV_Assert(gray.type() == CV_8UC1);
-  const double R = prior.rim_radius;
-  if (!(R > 0)) {
-    set_why(why, "no rim radius known: call estimate() on a first frame");
-    return std::nullopt;
+void MirrorCenterDetector::vote_band(const cv::Mat& gray,
+                                     const MirrorCircle& prior,
+                                     const cv::Rect& roi,
+                                     int A,
+                                     cv::Mat& acc) const {
+  // vote_band_reference on the band's runs of pixels only, each pixel's Sobel computed where
+  // it is needed (the same integers as OpenCV's inside the square).
+  const double R = prior.rim_radius, S = options_.search_radius;
+  const double t2 = options_.edge_threshold * options_.edge_threshold;
+  const double band_lo = std::max(0.0, R - S - 2), band_hi = R + S + 2;
+  const int W = gray.cols;
+  for (int v = 1; v < roi.height - 1; ++v) {
+    const double y = roi.y + v;
+    const double dy = y - prior.center.y();
+    // Only the columns of this row within the band can vote: up to two runs, [-o, -i] and
+    // [i, o] about the centre's column (a margin of a pixel; the test below decides).
+    if (std::abs(dy) > band_hi + 1) continue;
+    const double outer = std::sqrt(std::max(0.0, band_hi * band_hi - dy * dy)) + 1;
+    const double inner = std::abs(dy) < band_lo - 1
+                             ? std::sqrt(band_lo * band_lo - dy * dy) - 1
+                             : -1.0;  // the row crosses the inner circle: one run
+    const double cxr = prior.center.x() - roi.x;
+    const int lo = std::max(1, static_cast<int>(std::floor(cxr - outer)));
+    const int hi = std::min(roi.width - 2, static_cast<int>(std::ceil(cxr + outer)));
+    const int gap_lo = inner > 0 ? static_cast<int>(std::ceil(cxr - inner)) : hi + 1;
+    const int gap_hi = inner > 0 ? static_cast<int>(std::floor(cxr + inner)) : hi;
+    const uchar* row = gray.ptr<uchar>(roi.y + v) + roi.x;
+    const uchar* ok = usable_.empty() ? nullptr : usable_.ptr<uchar>(roi.y + v) + roi.x;
+    for (int u = lo; u <= hi; ++u) {
+      if (u > gap_lo && u < gap_hi) u = gap_hi;  // skip the disc inside the band
+      const double x = roi.x + u;
+      const double dx = x - prior.center.x();
+      const double d2 = dx * dx + dy * dy;
+      if (d2 < band_lo * band_lo || d2 > band_hi * band_hi) continue;
+      // Sobel, eq. (1) (the 3x3 window lies inside the band's rectangle).
+      const uchar* p = row + u;
+      const short gxu = static_cast<short>((p[-W + 1] + 2 * p[1] + p[W + 1]) -
+                                           (p[-W - 1] + 2 * p[-1] + p[W - 1]));
+      const short gyu = static_cast<short>((p[W - 1] + 2 * p[W] + p[W + 1]) -
+                                           (p[-W - 1] + 2 * p[-W] + p[-W + 1]));
+      const double g2 = double(gxu) * gxu + double(gyu) * gyu;
+      if (g2 < t2) continue;
+      if (ok && !ok[u]) continue;  // masked pixels cast no vote
+      const double g = std::sqrt(g2);
+      for (int sgn = -1; sgn <= 1; sgn += 2) {
+        const double cx = x + sgn * R * gxu / g - prior.center.x();
+        const double cy = y + sgn * R * gyu / g - prior.center.y();
+        const int ix = static_cast<int>(std::lround(cx)) + A;
+        const int iy = static_cast<int>(std::lround(cy)) + A;
+        if (ix >= 0 && iy >= 0 && ix < acc.cols && iy < acc.rows) acc.at<float>(iy, ix) += 1.0f;
+      }
+    }
   }
-  const double S = options_.search_radius;
-  // Band of the image that can hold the rim.
-  const double reach = R + S + 3;
-  const cv::Rect roi = cv::Rect(static_cast<int>(prior.center.x() - reach),
-                                static_cast<int>(prior.center.y() - reach),
-                                static_cast<int>(2 * reach) + 1,
-                                static_cast<int>(2 * reach) + 1) &
-                       cv::Rect(0, 0, gray.cols, gray.rows);
+}
+
+void MirrorCenterDetector::vote_band_reference(const cv::Mat& gray,
+                                               const MirrorCircle& prior,
+                                               const cv::Rect& roi,
+                                               int A,
+                                               cv::Mat& acc) const {
+  const double R = prior.rim_radius, S = options_.search_radius;
   cv::Mat gx, gy;
   cv::Sobel(gray(roi), gx, CV_16S, 1, 0, 3);
   cv::Sobel(gray(roi), gy, CV_16S, 0, 1, 3);
-  const int A = static_cast<int>(std::ceil(S)) + 3;
-  cv::Mat acc = cv::Mat::zeros(2 * A + 1, 2 * A + 1, CV_32F);
   const double t2 = options_.edge_threshold * options_.edge_threshold;
   const double band_lo = std::max(0.0, R - S - 2), band_hi = R + S + 2;
   for (int v = 1; v < roi.height - 1; ++v) {
@@ -285,6 +327,7 @@ std::optional<MirrorCircle> MirrorCenterDetector::detect(const cv::Mat& gray,
       if (ok && !ok[u]) continue;  // masked pixels cast no vote
       const double g = std::sqrt(g2);
       for (int sgn = -1; sgn <= 1; sgn += 2) {
+        // The centre is R along the gradient, on either side of the edge.
         const double cx = x + sgn * R * px[u] / g - prior.center.x();
         const double cy = y + sgn * R * py[u] / g - prior.center.y();
         const int ix = static_cast<int>(std::lround(cx)) + A;
@@ -293,6 +336,31 @@ std::optional<MirrorCircle> MirrorCenterDetector::detect(const cv::Mat& gray,
       }
     }
   }
+}
+
+std::optional<MirrorCircle> MirrorCenterDetector::detect(const cv::Mat& gray,
+                                                         const MirrorCircle& prior,
+                                                         std::string* why) const {
+  CV_Assert(gray.type() == CV_8UC1);
+  const double R = prior.rim_radius;
+  if (!(R > 0)) {
+    set_why(why, "no rim radius known: call estimate() on a first frame");
+    return std::nullopt;
+  }
+  const double S = options_.search_radius;
+  // Band of the image that can hold the rim.
+  const double reach = R + S + 3;
+  const cv::Rect roi = cv::Rect(static_cast<int>(prior.center.x() - reach),
+                                static_cast<int>(prior.center.y() - reach),
+                                static_cast<int>(2 * reach) + 1,
+                                static_cast<int>(2 * reach) + 1) &
+                       cv::Rect(0, 0, gray.cols, gray.rows);
+  const int A = static_cast<int>(std::ceil(S)) + 3;
+  cv::Mat acc = cv::Mat::zeros(2 * A + 1, 2 * A + 1, CV_32F);
+  if (options_.reference)
+    vote_band_reference(gray, prior, roi, A, acc);
+  else
+    vote_band(gray, prior, roi, A, acc);
   const Eigen::Vector2d peak = rim::accumulator_peak(acc, 1.0);
   Eigen::Vector2d center = prior.center + peak - Eigen::Vector2d(A, A);
   double rim = R;

@@ -180,8 +180,10 @@ TEST(LineExtractor, FastEdgePassEqualsThePlainReference) {
     const sim::RadialPattern p = sim::draw_radial_pattern(o);
     // The pattern's own circle, and circles whose annulus leaves the image on each side.
     std::vector<MirrorCircle> circles{p.circle};
-    for (const auto& c : {Eigen::Vector2d(130.4, 240.2), Eigen::Vector2d(520.7, 239.6),
-                          Eigen::Vector2d(320.2, 90.3), Eigen::Vector2d(319.6, 400.8)}) {
+    for (const auto& c : {Eigen::Vector2d(130.4, 240.2),
+                          Eigen::Vector2d(520.7, 239.6),
+                          Eigen::Vector2d(320.2, 90.3),
+                          Eigen::Vector2d(319.6, 400.8)}) {
       MirrorCircle m = p.circle;
       m.center = c;
       circles.push_back(m);

@@ -1,6 +1,7 @@
 // Mirror centre (Sec. 2 step 1) on drawn images with known centres.
 
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "omnivert/extract/mirror_center.hpp"
 #include "omnivert/sim/radial_pattern.hpp"
@@ -37,6 +38,54 @@ TEST(MirrorCenter, DetectFollowsAShiftedCentre) {
   const auto c = det.detect(p.image, prior);
   ASSERT_TRUE(c.has_value());
   EXPECT_LE((c->center - p.circle.center).norm(), 0.3);
+}
+
+// detect()'s votes from the band's runs with Sobel computed per pixel, against OpenCV's Sobel
+// of the band's square and a test of every pixel: the same centre and rim radius to the bit,
+// with and without a mask, for priors off the true centre and rims cut by the image's sides.
+TEST(MirrorCenter, FastVotesEqualThePlainReference) {
+  cv::Mat usable(480, 640, CV_8U, cv::Scalar(255));
+  cv::line(usable, {320, 240}, {620, 40}, cv::Scalar(0), 8);
+  int compared = 0;
+  for (std::uint64_t seed : {3, 5, 9}) {
+    sim::RadialPatternOptions o;
+    o.seed = seed;
+    o.center_jitter = 40.0;  // rims cut by the top and bottom of the image
+    auto p = sim::draw_radial_pattern(o);
+    // Noise in a ring outside the rim, at the band's outer edge: votes from every part of
+    // the band.
+    cv::Mat noise(p.image.size(), CV_8U);
+    cv::randu(noise, 0, 255);
+    cv::Mat ring(p.image.size(), CV_8U, cv::Scalar(0));
+    const cv::Point c(static_cast<int>(p.circle.center.x()), static_cast<int>(p.circle.center.y()));
+    cv::circle(ring, c, static_cast<int>(p.circle.rim_radius + 24), cv::Scalar(255), cv::FILLED);
+    cv::circle(ring, c, static_cast<int>(p.circle.rim_radius + 8), cv::Scalar(0), cv::FILLED);
+    noise.copyTo(p.image, ring);
+    for (const Eigen::Vector2d& shift :
+         {Eigen::Vector2d(0.3, 0.2), Eigen::Vector2d(8.4, -6.2), Eigen::Vector2d(-11.7, 4.9)}) {
+      for (bool masked : {false, true}) {
+        MirrorCircle prior = p.circle;
+        prior.center += shift;
+        MirrorCenterOptions plain;
+        plain.reference = true;
+        MirrorCenterDetector fast, ref(plain);
+        if (masked) {
+          fast.set_mask(usable);
+          ref.set_mask(usable);
+        }
+        const auto a = fast.detect(p.image, prior);
+        const auto b = ref.detect(p.image, prior);
+        ASSERT_TRUE(b.has_value());
+        ASSERT_TRUE(a.has_value());
+        EXPECT_EQ(a->center.x(), b->center.x());
+        EXPECT_EQ(a->center.y(), b->center.y());
+        EXPECT_EQ(a->rim_radius, b->rim_radius);
+        EXPECT_LE((b->center - p.circle.center).norm(), 0.5);
+        ++compared;
+      }
+    }
+  }
+  EXPECT_EQ(compared, 18);
 }
 
 }  // namespace

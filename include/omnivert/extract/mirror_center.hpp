@@ -44,6 +44,10 @@ struct MirrorCenterOptions {
   double rim_margin_fraction = 0.03;
   // r_min (when not given) = radius of the camera's self-reflection * (1 + this).
   double inner_margin_fraction = 0.10;
+  // detect() votes from a Sobel of the band's whole square and a test of every pixel in it,
+  // instead of from the band's runs of pixels only. The same votes and centre to the bit
+  // (test MirrorCenter.FastVotesEqualThePlainReference); kept to check the fast path.
+  bool reference = false;
 
   bool IsValid(std::string* why) const;
 };
@@ -88,6 +92,18 @@ class MirrorCenterDetector {
  private:
   MirrorCenterOptions options_;
   cv::Mat usable_;  // the mask eroded by the Sobel radius; empty: no mask
+  // detect()'s Hough votes for the centre offset (accumulator acc, offset A at its middle)
+  // from the edge pixels of the band R +- (S + 2) around the prior centre, inside roi.
+  void vote_band(const cv::Mat& gray,
+                 const MirrorCircle& prior,
+                 const cv::Rect& roi,
+                 int A,
+                 cv::Mat& acc) const;
+  void vote_band_reference(const cv::Mat& gray,
+                           const MirrorCircle& prior,
+                           const cv::Rect& roi,
+                           int A,
+                           cv::Mat& acc) const;
 };
 
 }  // namespace omnivert
