@@ -26,6 +26,7 @@ bool MirrorCenterOptions::IsValid(std::string* why) const {
     return fail("rim_margin_fraction must be in [0, 0.5)");
   if (!(inner_margin_fraction >= 0 && inner_margin_fraction < 1))
     return fail("inner_margin_fraction must be in [0, 1)");
+  if (!(track_px >= 0)) return fail("track_px must not be negative");
   return true;
 }
 
@@ -346,6 +347,18 @@ std::optional<MirrorCircle> MirrorCenterDetector::detect(const cv::Mat& gray,
   if (!(R > 0)) {
     set_why(why, "no rim radius known: call estimate() on a first frame");
     return std::nullopt;
+  }
+  if (options_.track_px > 0) {
+    // Tracked: the rim fitted from the prior centre, kept when it moved little.
+    Eigen::Vector2d center = prior.center;
+    double rim = R;
+    if (refine(gray, center, rim) && (center - prior.center).norm() <= options_.track_px &&
+        std::abs(rim - R) <= options_.track_px) {
+      MirrorCircle out = prior;
+      out.center = center;
+      out.rim_radius = rim;
+      return out;
+    }
   }
   const double S = options_.search_radius;
   // Band of the image that can hold the rim.

@@ -1,5 +1,7 @@
 // Mirror centre (Sec. 2 step 1) on drawn images with known centres.
 
+#include <cstdio>
+
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
@@ -66,9 +68,12 @@ TEST(MirrorCenter, FastVotesEqualThePlainReference) {
       for (bool masked : {false, true}) {
         MirrorCircle prior = p.circle;
         prior.center += shift;
-        MirrorCenterOptions plain;
+        // The search every time (track_px 0), so that both vote.
+        MirrorCenterOptions plain, searched;
+        searched.track_px = 0;
+        plain.track_px = 0;
         plain.reference = true;
-        MirrorCenterDetector fast, ref(plain);
+        MirrorCenterDetector fast(searched), ref(plain);
         if (masked) {
           fast.set_mask(usable);
           ref.set_mask(usable);
@@ -86,6 +91,34 @@ TEST(MirrorCenter, FastVotesEqualThePlainReference) {
     }
   }
   EXPECT_EQ(compared, 18);
+}
+
+// Tracked from frame to frame: from a prior within a pixel, the rim fitted without the search
+// finds the centre as well as the search does; from a prior 10 px off, the search takes over.
+TEST(MirrorCenter, TrackingFromANearPriorIsAsGoodAsTheSearch) {
+  MirrorCenterOptions searched;
+  searched.track_px = 0;
+  const MirrorCenterDetector tracked, search(searched);
+  double worst_tracked = 0, worst_searched = 0;
+  for (std::uint64_t seed : {2, 4, 6, 8}) {
+    sim::RadialPatternOptions o;
+    o.seed = seed;
+    const auto p = sim::draw_radial_pattern(o);
+    for (const Eigen::Vector2d& shift : {Eigen::Vector2d(0.4, -0.3), Eigen::Vector2d(-0.6, 0.5),
+                                         Eigen::Vector2d(7.0, -7.0)}) {
+      MirrorCircle prior = p.circle;
+      prior.center += shift;
+      const auto a = tracked.detect(p.image, prior);
+      const auto b = search.detect(p.image, prior);
+      ASSERT_TRUE(a.has_value() && b.has_value());
+      worst_tracked = std::max(worst_tracked, (a->center - p.circle.center).norm());
+      worst_searched = std::max(worst_searched, (b->center - p.circle.center).norm());
+      EXPECT_NEAR(a->rim_radius, p.circle.rim_radius, 0.3);
+    }
+  }
+  EXPECT_LE(worst_tracked, 0.05);
+  EXPECT_LE(worst_tracked, worst_searched + 0.01);
+  std::printf("worst centre error: tracked %.3f px, searched %.3f px\n", worst_tracked, worst_searched);
 }
 
 }  // namespace

@@ -44,6 +44,11 @@ struct MirrorCenterOptions {
   double rim_margin_fraction = 0.03;
   // r_min (when not given) = radius of the camera's self-reflection * (1 + this).
   double inner_margin_fraction = 0.10;
+  // detect() first fits the rim on rays from the prior centre (the camera vibrates little
+  // between frames) and keeps that fit when it moved the centre and the rim radius by at most
+  // this many pixels; otherwise, or when it fails, it searches within search_radius (a Hough
+  // vote, then the same fit). 0: always search.
+  double track_px = 1.0;
   // detect() votes from a Sobel of the band's whole square and a test of every pixel in it,
   // instead of from the band's runs of pixels only. The same votes and centre to the bit
   // (test MirrorCenter.FastVotesEqualThePlainReference); kept to check the fast path.
