@@ -104,8 +104,8 @@ TEST(MirrorCenter, TrackingFromANearPriorIsAsGoodAsTheSearch) {
     sim::RadialPatternOptions o;
     o.seed = seed;
     const auto p = sim::draw_radial_pattern(o);
-    for (const Eigen::Vector2d& shift : {Eigen::Vector2d(0.4, -0.3), Eigen::Vector2d(-0.6, 0.5),
-                                         Eigen::Vector2d(7.0, -7.0)}) {
+    for (const Eigen::Vector2d& shift :
+         {Eigen::Vector2d(0.4, -0.3), Eigen::Vector2d(-0.6, 0.5), Eigen::Vector2d(7.0, -7.0)}) {
       MirrorCircle prior = p.circle;
       prior.center += shift;
       const auto a = tracked.detect(p.image, prior);
@@ -118,7 +118,8 @@ TEST(MirrorCenter, TrackingFromANearPriorIsAsGoodAsTheSearch) {
   }
   EXPECT_LE(worst_tracked, 0.05);
   EXPECT_LE(worst_tracked, worst_searched + 0.01);
-  std::printf("worst centre error: tracked %.3f px, searched %.3f px\n", worst_tracked, worst_searched);
+  std::printf(
+      "worst centre error: tracked %.3f px, searched %.3f px\n", worst_tracked, worst_searched);
 }
 
 }  // namespace
