@@ -68,9 +68,11 @@ class MirrorCenterDetector {
                                        const CameraGeometry& geometry,
                                        std::string* why = nullptr) const;
 
-  // Per-frame detection with a known rim radius, searching within options.search_radius of
-  // `prior.center`. The annulus r_min/r_max is carried over from `prior`. Returns nullopt if
-  // the rim is not found (too few rim points), in which case the caller may keep the prior.
+  // Per-frame detection with a known rim radius: the rim fitted on rays from `prior.center`,
+  // kept when it moved at most options.track_px; otherwise a search within
+  // options.search_radius of `prior.center` (Hough votes, then the same fit). The annulus
+  // r_min/r_max is carried over from `prior`. Returns nullopt if the rim is not found (too few rim
+  // points), in which case the caller may keep the prior.
   std::optional<MirrorCircle> detect(const cv::Mat& gray,
                                      const MirrorCircle& prior,
                                      std::string* why = nullptr) const;
