@@ -247,6 +247,28 @@ double MirrorCenterDetector::self_reflection_radius(const cv::Mat& gray,
   return best >= 0.3 ? (disc / scale) * (1.0 + options_.inner_margin_fraction) : 0.25 * r_max;
 }
 
+namespace {
+// The two centres an edge pixel at (x, y) with gradient (gx, gy), |g| = g, votes for: R along
+// its gradient on either side of the edge, as offsets from `prior` binned in acc (middle A).
+void vote_centres(double x,
+                  double y,
+                  short gx,
+                  short gy,
+                  double g,
+                  double R,
+                  const Eigen::Vector2d& prior,
+                  int A,
+                  cv::Mat& acc) {
+  for (int sgn = -1; sgn <= 1; sgn += 2) {
+    const double cx = x + sgn * R * gx / g - prior.x();
+    const double cy = y + sgn * R * gy / g - prior.y();
+    const int ix = static_cast<int>(std::lround(cx)) + A;
+    const int iy = static_cast<int>(std::lround(cy)) + A;
+    if (ix >= 0 && iy >= 0 && ix < acc.cols && iy < acc.rows) acc.at<float>(iy, ix) += 1.0f;
+  }
+}
+}  // namespace
+
 void MirrorCenterDetector::vote_band(const cv::Mat& gray,
                                      const MirrorCircle& prior,
                                      const cv::Rect& roi,
@@ -291,13 +313,7 @@ void MirrorCenterDetector::vote_band(const cv::Mat& gray,
       if (g2 < t2) continue;
       if (ok && !ok[u]) continue;  // masked pixels cast no vote
       const double g = std::sqrt(g2);
-      for (int sgn = -1; sgn <= 1; sgn += 2) {
-        const double cx = x + sgn * R * gxu / g - prior.center.x();
-        const double cy = y + sgn * R * gyu / g - prior.center.y();
-        const int ix = static_cast<int>(std::lround(cx)) + A;
-        const int iy = static_cast<int>(std::lround(cy)) + A;
-        if (ix >= 0 && iy >= 0 && ix < acc.cols && iy < acc.rows) acc.at<float>(iy, ix) += 1.0f;
-      }
+      vote_centres(x, y, gxu, gyu, g, R, prior.center, A, acc);
     }
   }
 }
@@ -327,14 +343,7 @@ void MirrorCenterDetector::vote_band_reference(const cv::Mat& gray,
       if (g2 < t2) continue;
       if (ok && !ok[u]) continue;  // masked pixels cast no vote
       const double g = std::sqrt(g2);
-      for (int sgn = -1; sgn <= 1; sgn += 2) {
-        // The centre is R along the gradient, on either side of the edge.
-        const double cx = x + sgn * R * px[u] / g - prior.center.x();
-        const double cy = y + sgn * R * py[u] / g - prior.center.y();
-        const int ix = static_cast<int>(std::lround(cx)) + A;
-        const int iy = static_cast<int>(std::lround(cy)) + A;
-        if (ix >= 0 && iy >= 0 && ix < acc.cols && iy < acc.rows) acc.at<float>(iy, ix) += 1.0f;
-      }
+      vote_centres(x, y, px[u], py[u], g, R, prior.center, A, acc);
     }
   }
 }
