@@ -6,6 +6,7 @@
 // their time waiting on each other (on 2 cores: a tenth of the hall tour's refinement in futex
 // waits). While an object of this class lives, the solves the calling thread starts use one
 // OpenMP thread; the results are the same to the bit (CHOLMOD's loops split rows, not sums).
+// Test SerialSparseAlgebra.ARegionAskingForFourThreadsRunsOnOne checks that no team is started.
 
 namespace omnivert::calib::internal {
 
@@ -17,7 +18,7 @@ class SerialSparseAlgebra {
   SerialSparseAlgebra& operator=(const SerialSparseAlgebra&) = delete;
 
  private:
-  int before_;  // the calling thread's OpenMP thread count, restored at the end
+  int before_;  // the calling thread's OpenMP max-active-levels, restored at the end
 };
 
 }  // namespace omnivert::calib::internal
