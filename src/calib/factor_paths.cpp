@@ -1,6 +1,7 @@
 #include "calib/factor_paths.hpp"
 
 #include <algorithm>
+#include <cstddef>
 
 namespace omnivert::calib::internal {
 
@@ -41,11 +42,19 @@ FactorPaths::Forward FactorPaths::solve(
   const auto* outer = L.outerIndexPtr();
   const auto* inner = L.innerIndexPtr();
   const double* value = L.valuePtr();
+  // On raw rows (Y is row-major): the same products and differences, in the same order, as
+  // the row expressions they replace, without an expression's setup for rows of 2-6 entries.
+  const int nc = static_cast<int>(columns.size());
+  double* Y = out.Y.data();
   for (int i = 0; i < m; ++i) {
+    const double* yi = Y + static_cast<std::ptrdiff_t>(i) * nc;
+    if (std::all_of(yi, yi + nc, [](double v) { return v == 0.0; })) continue;
     const int j = out.rows[i];
-    if (out.Y.row(i).isZero(0.0)) continue;
-    for (auto p = outer[j]; p < outer[j + 1]; ++p)
-      out.Y.row(where_[inner[p]]) -= value[p] * out.Y.row(i);
+    for (auto p = outer[j]; p < outer[j + 1]; ++p) {
+      double* yr = Y + static_cast<std::ptrdiff_t>(where_[inner[p]]) * nc;
+      const double v = value[p];
+      for (int c = 0; c < nc; ++c) yr[c] -= v * yi[c];
+    }
   }
   for (const int r : out.rows) where_[r] = -1;
   return out;
