@@ -55,7 +55,7 @@ void DescriptorExtractor::prepare(const cv::Mat& gray, const MirrorCircle& circl
   const bool blur = options_.smoothing == DescriptorSmoothing::kGaussianBlur;
   // The blurred image holds nothing finer than sigma: sample it every `step_` pixels
   // (area-average by step_, then blur with the remaining sigma), with step_ chosen so that
-  // the remaining sigma is still >= 2.5 samples. Same histograms as full resolution up to
+  // sigma_G spans at least min_samples_per_sigma samples. Same histograms as full resolution up to
   // sampling, at 1/step_^2 of the cost.
   step_ = blur ? std::clamp(static_cast<int>(sigma / options_.min_samples_per_sigma), 1, 8) : 1;
   const double reach = circle.r_max + 2;
