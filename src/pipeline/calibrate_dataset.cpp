@@ -251,8 +251,10 @@ void time_offset_from_tracks(dataset::Dataset& data,
     r.time_offset.why = "not estimated when streaming";
     return;
   }
+  TimeOffsetOptions offset = o.time_offset;
+  offset.threads = o.threads;  // --threads: the grid's evaluation too
   r.time_offset = estimate_time_offset(
-      data, tracked.rows, opt.robot.odometry_K, opt.noise.bearing_sigma, o.time_offset);
+      data, tracked.rows, opt.robot.odometry_K, opt.noise.bearing_sigma, offset);
   if (r.time_offset.significant(o.time_offset)) {
     apply_time_offset(data, r.time_offset.offset_s, false, r);
     if (from_images) tracked = tracks_of(data, o, std::nullopt, "track again");

@@ -4,9 +4,11 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <utility>
 
 #include <Eigen/Geometry>
 
+#include "core/parallel.hpp"
 #include "omnivert/core/angles.hpp"
 
 namespace omnivert::pipeline {
@@ -24,6 +26,7 @@ bool TimeOffsetOptions::IsValid(std::string* why) const {
     return fail("min_common_tracks and min_pairs must be >= 1");
   if (!positive(max_sigma_s)) return fail("max_sigma_s must be > 0 [s]");
   if (jackknife_block < 0) return fail("jackknife_block must be >= 0 (0: no jackknife)");
+  if (threads < 0) return fail("threads must be >= 0 (0: every core)");
   if (!non_negative(min_rise) || !non_negative(significance) || !non_negative(min_applied_s))
     return fail("min_rise, significance and min_applied_s must be >= 0");
   return true;
@@ -91,9 +94,10 @@ struct Problem {
     Eigen::Matrix3d P = Eigen::Matrix3d::Identity();
     for (const Eigen::Vector3d& u : basis) P -= u * u.transpose();
     std::vector<double> e;
+    e.reserve(t.b.size());
     for (const Eigen::Vector3d& b : t.b) e.push_back((P * b).norm());
     const double var = (P * Sigma * P).trace();
-    return var > 0 ? std::pow(median(e), 2) / var : 0.0;
+    return var > 0 ? std::pow(median(std::move(e)), 2) / var : 0.0;
   }
   // The sandwich variance of the minimiser S* of J = sum_i q_i (q_i the weighted residual of
   // triple i), with the slopes g_i and the curvature J'' taken over +-h:
@@ -156,10 +160,13 @@ std::vector<std::vector<double>> block_costs(const Problem& p,
   const int half = static_cast<int>(std::lround(o.max_offset_s / o.step_s));
   const std::size_t blocks = (p.used.size() + block - 1) / block;
   std::vector<std::vector<double>> J(blocks, std::vector<double>(2 * half + 1, 0.0));
-  for (int k = -half; k <= half; ++k)
-    for (std::size_t u = 0; u < p.used.size(); ++u)
-      J[u / block][static_cast<std::size_t>(k + half)] +=
-          p.weighted_residual(p.triples[p.used[u]], k * o.step_s);
+  // One grid point per call: its sums in the triples' order, whichever thread takes it.
+  parallel_for(
+      static_cast<std::size_t>(2 * half + 1), resolve_threads(o.threads), [&](std::size_t g, int) {
+        const double S = (static_cast<int>(g) - half) * o.step_s;
+        for (std::size_t u = 0; u < p.used.size(); ++u)
+          J[u / block][g] += p.weighted_residual(p.triples[p.used[u]], S);
+      });
   return J;
 }
 

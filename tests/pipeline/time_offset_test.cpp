@@ -197,6 +197,24 @@ TEST(TimeOffset, AWheelBaseErrorDoesNotMoveIt) {
   EXPECT_NEAR(e.offset_s, 0.05, std::max(4 * e.sigma_s, 0.012));
 }
 
+// The grid's costs spread over threads (TimeOffsetOptions::threads): the same estimate to the
+// bit on 1, 2 and 3 threads.
+TEST(TimeOffset, TheSameEstimateOnEveryThreadCount) {
+  const TimeOffsetInput in = simulate(driving(), 0.04, 1.0, 3);
+  TimeOffsetOptions o;
+  o.threads = 1;
+  const TimeOffsetEstimate one = estimate_time_offset(in, o);
+  ASSERT_TRUE(one.determined) << one.why;
+  for (int threads : {2, 3}) {
+    o.threads = threads;
+    const TimeOffsetEstimate e = estimate_time_offset(in, o);
+    EXPECT_EQ(e.offset_s, one.offset_s) << threads;
+    EXPECT_EQ(e.sigma_s, one.sigma_s) << threads;
+    EXPECT_EQ(e.residual_scale, one.residual_scale) << threads;
+    EXPECT_EQ(e.pairs, one.pairs) << threads;
+  }
+}
+
 TEST(TimeOffset, OutliersAreLeftOut) {
   TimeOffsetInput in = simulate(driving(), 0.03, 1.0, 3);
   // A track that jumped to another line and back, twice: its turns off by 5 degrees.

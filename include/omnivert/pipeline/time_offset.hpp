@@ -58,6 +58,9 @@ struct TimeOffsetOptions {
   // triple shares images with the three after it); the sigma reported is the largest of the
   // model's, the sandwich's and the jackknife's. 0: no jackknife.
   int jackknife_block = 4;
+  // Threads that evaluate J over the grid (0: every core). Each grid point's sum is taken by
+  // one thread in the triples' order, so the estimate is the same for every count.
+  int threads = 0;
   // An estimate is applied when |S| exceeds `significance` sigmas and `min_applied_s`: a
   // synchronised recording keeps its stamps (and its results) unchanged.
   double significance = 3.0;
