@@ -80,14 +80,18 @@ Eigen::SparseMatrix<double> information_with_ridge(const Eigen::SparseMatrix<dou
 }
 
 Eigen::SparseMatrix<double> sparse_jacobian(const ceres::CRSMatrix& crs) {
-  std::vector<Eigen::Triplet<double>> t;
-  t.reserve(crs.values.size());
-  for (int r = 0; r < crs.num_rows; ++r)
-    for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k)
-      t.emplace_back(r, crs.cols[k], crs.values[k]);
-  Eigen::SparseMatrix<double> J(crs.num_rows, crs.num_cols);
-  J.setFromTriplets(t.begin(), t.end());
-  return J;
+  // Ceres' compressed rows are a row-major sparse matrix: read in place and transposed into
+  // column-major storage in one pass (no triplet list: on a long run that was 16 bytes per
+  // non-zero more, and a second copy inside setFromTriplets).
+  if (crs.values.empty()) return Eigen::SparseMatrix<double>(crs.num_rows, crs.num_cols);
+  const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>> rows(
+      crs.num_rows,
+      crs.num_cols,
+      static_cast<Eigen::Index>(crs.values.size()),
+      crs.rows.data(),
+      crs.cols.data(),
+      crs.values.data());
+  return Eigen::SparseMatrix<double>(rows);
 }
 
 Eigen::MatrixXd information_from_jacobian(const ceres::CRSMatrix& crs) {

@@ -316,6 +316,7 @@ void check_frame_index(int frame, std::size_t images, const std::string& path, i
 
 GroundTruth load_ground_truth(const std::string& dir,
                               const std::vector<ImageRecord>& images,
+                              bool with_lines,
                               std::vector<std::string>* notes) {
   GroundTruth gt;
   std::error_code ec;
@@ -346,7 +347,7 @@ GroundTruth load_ground_truth(const std::string& dir,
     }
   }
   const std::string lines = rel(dir, "lines.csv");
-  if (fs::exists(lines, ec)) {
+  if (with_lines && fs::exists(lines, ec)) {
     gt.has_lines = true;
     for_each_csv_row(
         lines,
@@ -470,7 +471,7 @@ Dataset Dataset::load(const std::string& dir, const LoadOptions& options) {
   const std::string gt_dir = rel(dir, "ground_truth");
   if (fs::is_directory(gt_dir, ec)) {
     try {
-      d.ground_truth_ = load_ground_truth(gt_dir, d.images_, &d.notes_);
+      d.ground_truth_ = load_ground_truth(gt_dir, d.images_, options.ground_truth_lines, &d.notes_);
     } catch (const InputError& e) {
       d.ground_truth_error_ = e.what();
     }

@@ -211,6 +211,7 @@ std::vector<TrackRow> read_tracks_csv(const fs::path& path) {
     rows.push_back(r);
   }
   if (!have_header) throw InputError(file, 0, "empty file: no header line");
+  rows.shrink_to_fit();  // a long run's rows are held through the calibration
   return rows;
 }
 

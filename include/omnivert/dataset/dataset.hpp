@@ -123,6 +123,10 @@ struct LoadOptions {
   // A wheel moving faster than this between two samples is an error (a wrapped counter
   // without counter_bits, a glitch) [m/s].
   double max_wheel_speed = 5.0;
+  // Read ground_truth/lines.csv (GroundTruth::lines). It is the largest file of a simulated
+  // run (a million rows on a 2,367-frame tour) and only the evaluations and the map check use
+  // it; without it has_lines is false.
+  bool ground_truth_lines = true;
 };
 
 class Dataset {
