@@ -394,6 +394,28 @@ TEST_F(DatasetTest, GroundTruthIsReadAndChecked) {
   ASSERT_EQ(d.notes().size(), 1u);
 }
 
+// LoadOptions::ground_truth_lines = false (calibrate without the map check): lines.csv is not
+// read, not even checked; the rest of the ground truth is.
+TEST_F(DatasetTest, GroundTruthLinesAreLeftUnreadWhenNotWanted) {
+  fs::create_directories(root / "ground_truth");
+  write("ground_truth/extrinsics.yaml", "phi: -0.34\nrho: 0.23\npsi: 0.33\n");
+  write("ground_truth/lines.csv",
+        "#timestamp [ns],frame,line_id,bearing [rad],r_inner [px],r_outer [px]\n"
+        "1000000000,0,4,0.5,6,19\n2000000000,7,4,0.6,6,19\n");
+  LoadOptions without;
+  without.ground_truth_lines = false;
+  const Dataset d = Dataset::load(root.string(), without);
+  ASSERT_TRUE(d.ground_truth().has_value()) << d.ground_truth_error();
+  EXPECT_DOUBLE_EQ(d.ground_truth()->extrinsics->rho, 0.23);
+  EXPECT_FALSE(d.ground_truth()->has_lines);
+  EXPECT_TRUE(d.ground_truth()->lines.empty());
+  // Read (the default), the same file's frame 7 is refused.
+  const Dataset with = Dataset::load(root.string());
+  EXPECT_FALSE(with.ground_truth().has_value());
+  EXPECT_EQ(with.ground_truth_error(),
+            p("ground_truth/lines.csv") + ":3: frame 7 is not an image index (0..2)");
+}
+
 TEST_F(DatasetTest, OccluderEdgesAreReadAndChecked) {
   fs::create_directories(root / "ground_truth");
   write("ground_truth/occluders.csv",
