@@ -223,8 +223,8 @@ dataset::Dataset load_checked(const std::string& dataset_dir,
   lo.require_wheel = true;
   lo.allow_missing_images = true;
   // The ground truth's lines only for the check against the simulator's map.
-  lo.ground_truth_lines = o.check_reference && !o.check_off &&
-                          o.reprojection.reference.source == ReferenceSource::kMap;
+  lo.ground_truth_lines =
+      o.check_reference && !o.check_off && o.reprojection.reference.source == ReferenceSource::kMap;
   auto data = dataset::Dataset::load(dataset_dir, lo);
   for (const std::string& n : data.notes()) spdlog::debug("{}", n);
   // Ground truth is optional here (the report's truth rows): one that cannot be read is a
