@@ -30,21 +30,15 @@ double one_line_statistic(Built* b, int a, int c, FeatureCovariance* cache) {
   constexpr double kNone = std::numeric_limits<double>::infinity();
   if (!cache->ready) {
     cache->ready = true;
-    ceres::Problem::EvaluateOptions eo;
-    eo.parameter_blocks = variable_blocks(*b);
-    eo.apply_loss_function = false;
     Eigen::SparseMatrix<double> F;
     {
-      // The Jacobian in both forms is gone before the factorisation (on a long run each is
-      // tens of MB, and the filter's noise check may be doing the same beside).
-      ceres::CRSMatrix crs;
-      if (!b->problem->Evaluate(eo, nullptr, nullptr, nullptr, &crs)) return kNone;
-      Eigen::SparseMatrix<double> J = sparse_jacobian(crs);
-      crs = ceres::CRSMatrix();
+      // J is gone before the factorisation (on a long run it is tens of MB, and the filter's
+      // noise check may be doing the same beside).
+      Eigen::SparseMatrix<double> J;
+      if (!whole_jacobian(*b, &J)) return kNone;
       F = information_with_ridge(J);
     }
     cache->ldlt.compute(F);
-    F = Eigen::SparseMatrix<double>();
     cache->ok = cache->ldlt.info() == Eigen::Success && (cache->ldlt.vectorD().array() > 0).all();
     int col = 3 * (static_cast<int>(b->poses.size()) - 1);
     for (const auto& [id, f] : b->features) {

@@ -94,6 +94,16 @@ Eigen::SparseMatrix<double> sparse_jacobian(const ceres::CRSMatrix& crs) {
   return Eigen::SparseMatrix<double>(rows);
 }
 
+bool whole_jacobian(Built& b, Eigen::SparseMatrix<double>* J) {
+  ceres::Problem::EvaluateOptions eo;
+  eo.parameter_blocks = variable_blocks(b);
+  eo.apply_loss_function = false;
+  ceres::CRSMatrix crs;
+  if (!b.problem->Evaluate(eo, nullptr, nullptr, nullptr, &crs)) return false;
+  *J = sparse_jacobian(crs);
+  return true;
+}
+
 Eigen::MatrixXd information_from_jacobian(const ceres::CRSMatrix& crs) {
   const Eigen::SparseMatrix<double> J = sparse_jacobian(crs);
   const Eigen::SparseMatrix<double> F = J.transpose() * J;

@@ -103,6 +103,11 @@ Eigen::SparseMatrix<double> information_with_ridge(const Eigen::SparseMatrix<dou
 // A Jacobian in Ceres' compressed-row form as an Eigen sparse matrix (rows x cols).
 Eigen::SparseMatrix<double> sparse_jacobian(const ceres::CRSMatrix& crs);
 
+// The Jacobian of b's residuals (without the loss function) in the columns of
+// variable_blocks(b). Ceres' compressed rows are freed before it returns: on a long run each
+// form is tens of MB. false when Ceres cannot evaluate the problem.
+bool whole_jacobian(Built& b, Eigen::SparseMatrix<double>* J);
+
 // J^T J of a Jacobian in Ceres' compressed-row form, as a dense matrix. Each row of J has a
 // handful of entries (a bearing touches one pose, one feature and the extrinsics), so the
 // product is formed sparse: O(rows x 8^2) instead of the dense O(rows x cols^2) (318 tracks:

@@ -299,12 +299,8 @@ VariableLayout layout_of(const Built& b) {
 }
 
 Eigen::SparseMatrix<double> fisher_information(Built& b) {
-  ceres::Problem::EvaluateOptions eo;
-  eo.parameter_blocks = variable_blocks(b);
-  eo.apply_loss_function = false;
-  ceres::CRSMatrix crs;
-  b.problem->Evaluate(eo, nullptr, nullptr, nullptr, &crs);
-  const Eigen::SparseMatrix<double> J = sparse_jacobian(crs);
+  Eigen::SparseMatrix<double> J;
+  if (!whole_jacobian(b, &J)) return {};
   return Eigen::SparseMatrix<double>(J.transpose() * J);
 }
 

@@ -31,7 +31,8 @@ struct VariableLayout {
 
 VariableLayout layout_of(const Built& b);
 
-// F = J^T J of the batch problem at its point (unwhitened loss: the Gaussian model), sparse.
+// F = J^T J of the batch problem at its point (unwhitened loss: the Gaussian model), sparse;
+// empty when Ceres cannot evaluate the problem.
 Eigen::SparseMatrix<double> fisher_information(Built& b);
 
 // The plain reference: pseudo-inverse of the whole (scaled) nuisance block by its
