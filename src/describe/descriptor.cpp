@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include <opencv2/imgproc.hpp>
 
@@ -130,28 +131,60 @@ void DescriptorExtractor::prepare(const cv::Mat& gray, const MirrorCircle& circl
     }
   }
   if (usable_.empty()) sample_usable_.release();
-  if (!options_.reference) polar_table();
+  if (!options_.reference) polar_table(circle);
 }
 
-void DescriptorExtractor::polar_table() {
+void DescriptorExtractor::polar_table(const MirrorCircle& circle) {
   // The part of each sample's vote that does not depend on the line: |g| (times the usable
   // fraction) and atan2(gy, gx), once per frame rather than once per area that covers the
   // sample. The same float operations as describe_one_reference, so the same bits.
+  // Only the annulus is computed: every area lies within r_min .. r_max of the centre (Sec. 3.1)
+  // and a sample beyond half a cell of it does not vote. Samples further than `pad` outside
+  // are set to zero (no vote), which is what describe_one reads there.
   mag_.create(gx_.size(), CV_32F);
   angle_.create(gx_.size(), CV_32F);
+  const double st = step_, off = 0.5 * st - 0.5, pad = 2 * st + 2;
+  const double cx = circle.center.x() - roi_.x - off, cy = circle.center.y() - roi_.y - off;
+  const double r_out = circle.r_max + pad, r_in = circle.r_min - pad;
+  const int cols = gx_.cols;
+  // Sample columns whose offset from the centre's column is within +-h: [lo, hi] (clamped).
+  auto span_of = [&](double h, bool outer) {
+    int lo = outer ? static_cast<int>(std::floor((cx - h) / st))
+                   : static_cast<int>(std::ceil((cx - h) / st));
+    int hi = outer ? static_cast<int>(std::ceil((cx + h) / st))
+                   : static_cast<int>(std::floor((cx + h) / st));
+    return std::pair<int, int>(std::max(0, lo), std::min(cols - 1, hi));
+  };
   for (int v = 0; v < gx_.rows; ++v) {
     const float* px = gx_.ptr<float>(v);
     const float* py = gy_.ptr<float>(v);
     float* m = mag_.ptr<float>(v);
     float* a = angle_.ptr<float>(v);
-    for (int u = 0; u < gx_.cols; ++u) {
-      m[u] = std::sqrt(px[u] * px[u] + py[u] * py[u]);
-      a[u] = fast_atan2_any(py[u], px[u]);
+    std::fill(m, m + cols, 0.0f);
+    std::fill(a, a + cols, 0.0f);
+    const double y = v * st - cy;
+    if (y * y > r_out * r_out) continue;
+    const auto [lo, hi] = span_of(std::sqrt(r_out * r_out - y * y), true);
+    // The hole inside r_in: [hole_lo, hole_hi] is left at zero.
+    int hole_lo = hi + 1, hole_hi = hi;
+    if (r_in > 0 && y * y < r_in * r_in) {
+      const auto h = span_of(std::sqrt(r_in * r_in - y * y), false);
+      if (h.first <= h.second) {
+        hole_lo = h.first;
+        hole_hi = h.second;
+      }
     }
-    if (!sample_usable_.empty()) {
-      const float* pu = sample_usable_.ptr<float>(v);
-      for (int u = 0; u < gx_.cols; ++u) m[u] *= pu[u];
-    }
+    const float* pu = sample_usable_.empty() ? nullptr : sample_usable_.ptr<float>(v);
+    auto compute = [&](int u0, int u1) {
+      for (int u = u0; u <= u1; ++u) {
+        m[u] = std::sqrt(px[u] * px[u] + py[u] * py[u]);
+        a[u] = fast_atan2_any(py[u], px[u]);
+      }
+      if (pu)
+        for (int u = u0; u <= u1; ++u) m[u] *= pu[u];
+    };
+    compute(lo, std::min(hi, hole_lo - 1));
+    compute(std::max(lo, hole_hi + 1), hi);
   }
 }
 

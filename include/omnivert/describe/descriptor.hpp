@@ -104,7 +104,7 @@ class DescriptorExtractor {
   void prepare(const cv::Mat& gray, const MirrorCircle& circle);
   void describe_one(const MirrorCircle& circle, double image_angle, float* row) const;
   void describe_one_reference(const MirrorCircle& circle, double image_angle, float* row) const;
-  void polar_table();
+  void polar_table(const MirrorCircle& circle);
   void normalize(float* row) const;
 
   DescriptorOptions options_;
