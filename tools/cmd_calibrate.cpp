@@ -236,6 +236,13 @@ void add_model_options(CLI::App* cmd, CalibrateArgs& a) {
                   "right and helps when the wheels are off: docs/theory/filter.md#odometry-noise)")
       ->check(kPositive)
       ->group(gm);
+  cmd->add_option("--update-iterations",
+                  a.options.calibration.filter.update_iterations,
+                  "Gauss-Newton iterations of the filter's update per frame (1: the plain EKF; "
+                  "more: the iterated EKF, docs/theory/filter.md#updates)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str()
+      ->group(gm);
   cmd->add_option("--track-bias-sigma",
                   a.track_bias_sigma_deg,
                   "A constant bearing error per track [degrees], in the filter, the refinement "

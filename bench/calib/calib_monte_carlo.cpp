@@ -9,6 +9,7 @@
 //                     [--bootstrap RAD] [--refine] [--seed 1] [--correlation A]
 //                     [--lateral M] [--break P] [--no-merge] [--model-sigma-deg S]
 //                     [--bias-deg B] [--model-bias-deg B] [--lower-level L]
+//                     [--legs N] [--length M] [--features N] [--visible M] [--max-distance M]
 // --init anchored (default): anchored inverse depth + camera-pose extrinsics, with the batch
 //   window up to the first turn (--bootstrap, rad of rotation; 0: no window);
 // --init inverse: the paper's state eq. (28) with undelayed inverse-distance features;
@@ -24,6 +25,9 @@
 //   track_bias_sigma; default: the simulated one).
 // --lower-level L: the noise check's "less noise" level (CalibrationOptions::noise_check.
 //   lower_level; default: the tool's).
+// --legs, --length, --features, --visible, --max-distance: a long run whose features enter and
+//   leave the view (SyntheticRunOptions zigzag_legs, straight_length, num_features,
+//   visible_range, max_distance), e.g. a 90 m zigzag of 40 legs among 400 lines seen within 6 m.
 // --no-merge: the pieces of one line are not joined, in the filter nor in the refinement
 //   (CalibrationOptions::association.join_pieces).
 // Diagnostics (environment): PRIOR_AT_TRUTH=s (prior centred on truth, sigma s), PRIOR_SIGMA=s,
@@ -138,6 +142,9 @@ struct Args {
   double lower_level = NoiseCheckOptions{}.lower_level;
   std::string init = "anchored", trajectory = "paper";
   std::uint64_t seed = 1;
+  // A long run (SyntheticRunOptions): 0 keeps the trajectory's default.
+  int legs = 0, features = 0;
+  double length = 0.0, visible = 0.0, max_distance = 0.0;
 };
 
 // The command line; exits with 2 on a bad argument.
@@ -186,6 +193,16 @@ Args parse_args(int argc, char** argv) {
       a.merge = false;
     else if (!std::strcmp(argv[i], "--seed"))
       a.seed = std::strtoull(next(), nullptr, 10);
+    else if (!std::strcmp(argv[i], "--legs"))
+      a.legs = std::atoi(next());
+    else if (!std::strcmp(argv[i], "--features"))
+      a.features = std::atoi(next());
+    else if (!std::strcmp(argv[i], "--length"))
+      a.length = std::atof(next());
+    else if (!std::strcmp(argv[i], "--visible"))
+      a.visible = std::atof(next());
+    else if (!std::strcmp(argv[i], "--max-distance"))
+      a.max_distance = std::atof(next());
     else {
       std::fprintf(stderr, "unknown argument %s\n", argv[i]);
       std::exit(2);
@@ -202,6 +219,11 @@ SyntheticRunOptions synthetic_options(const Args& a) {
   so.track_bias_sigma = deg2rad(a.bias_deg);
   so.break_probability = a.break_probability;
   so.trajectory = a.trajectory == "zigzag" ? Trajectory::kZigzag : Trajectory::kPaper;
+  if (a.legs > 0) so.zigzag_legs = a.legs;
+  if (a.features > 0) so.num_features = a.features;
+  if (a.length > 0) so.straight_length = a.length;
+  if (a.visible > 0) so.visible_range = a.visible;
+  if (a.max_distance > 0) so.max_distance = a.max_distance;
   return so;
 }
 

@@ -33,7 +33,7 @@ SyntheticRun make_synthetic_run(const SyntheticRunOptions& o) {
       !(o.wheel_base > 0.0) || o.num_features < 1 || !(o.min_distance > o.truth.rho) ||
       !(o.max_distance > o.min_distance) || !(o.bearing_sigma >= 0.0) ||
       !(o.track_bias_sigma >= 0.0) || !(o.odometry_K >= 0.0) || o.zigzag_legs < 1 ||
-      !(o.bearing_correlation >= 0.0 && o.bearing_correlation < 1.0))
+      !(o.visible_range >= 0.0) || !(o.bearing_correlation >= 0.0 && o.bearing_correlation < 1.0))
     throw InputError("synthetic run: invalid options");
   std::mt19937_64 rng(o.seed);
   std::normal_distribution<double> normal(0.0, 1.0);
@@ -94,6 +94,7 @@ SyntheticRun make_synthetic_run(const SyntheticRunOptions& o) {
     std::mt19937_64 bias_rng(o.seed ^ 0x9e3779b97f4a7c15ULL);
     for (double& b : bias) b = o.track_bias_sigma * normal(bias_rng);
   }
+  std::vector<bool> was_visible(out.features.size(), true);
   for (std::size_t k = 0; k < out.true_poses.size(); ++k) {
     FrameInput f;
     if (k > 0) {
@@ -101,12 +102,25 @@ SyntheticRun make_synthetic_run(const SyntheticRunOptions& o) {
       f.d_right = s.d_right + std::sqrt(o.odometry_K * std::abs(s.d_right)) * normal(rng);
       f.d_left = s.d_left + std::sqrt(o.odometry_K * std::abs(s.d_left)) * normal(rng);
     }
+    const Eigen::Vector3d& pose = out.true_poses[k];
+    const Eigen::Vector2d camera =
+        pose.head<2>() + o.truth.rho * Eigen::Vector2d(std::cos(pose(2) + o.truth.phi),
+                                                       std::sin(pose(2) + o.truth.phi));
     for (std::size_t j = 0; j < out.features.size(); ++j) {
       if (k > 0 && o.break_probability > 0.0 && uniform(rng) < o.break_probability) {
         track_of[j] = next_id++;
         out.track_feature[track_of[j]] = static_cast<int>(j);
       }
       const double n = normal(rng);
+      if (o.visible_range > 0.0) {
+        const bool visible = (out.features[j] - camera).norm() <= o.visible_range;
+        if (visible && !was_visible[j]) {  // back in view: a new track
+          track_of[j] = next_id++;
+          out.track_feature[track_of[j]] = static_cast<int>(j);
+        }
+        was_visible[j] = visible;
+        if (!visible) continue;
+      }
       error[j] = k == 0 ? o.bearing_sigma * n : a * error[j] + innovation * o.bearing_sigma * n;
       const double beta =
           bearing_from_geometry(out.true_poses[k], out.features[j], o.truth) + error[j] + bias[j];

@@ -45,6 +45,11 @@ struct SyntheticRunOptions {
   // Each track is cut into pieces (new track ids) with this probability per frame; 0: every
   // feature is one track over the whole run (the camera sees all around).
   double break_probability = 0.0;
+  // [m] A feature is seen only from camera positions within this distance (0: from
+  // everywhere); a feature seen again after it was out of range is a new track, as a tracker
+  // that lost it would report. With a long zigzag, a run whose features enter and leave the
+  // view as on a tour of a building (the filter marginalises the tracks that ended).
+  double visible_range = 0.0;
   std::uint64_t seed = 1;
 };
 
