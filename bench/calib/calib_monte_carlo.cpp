@@ -131,7 +131,7 @@ void print(const char* name, const Stats& s, const Eigen::Vector3d& crlb, double
 }
 
 struct Args {
-  int runs = 50, iterations = 3;
+  int runs = 50, iterations = FilterOptions{}.update_iterations;
   bool refine = false;
   double bootstrap = FilterOptions{}.bootstrap_rotation;
   bool merge = true;
