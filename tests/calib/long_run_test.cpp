@@ -22,10 +22,10 @@ double nees(const Extrinsics& est, const Eigen::Matrix3d& cov, const Extrinsics&
 }
 
 // A long run whose lines enter and leave the view (a 90 m zigzag of 40 legs, 2,900 frames, 200
-// lines each seen within 5 m; the filter marginalises the tracks that end): with the update
-// linearised once (update_iterations 1) the filter's mean NEES over 8 runs is inside the 95 %
-// interval. The iterated update (the default, 3) fails here: NEES 9.0, rho 1.85x its bound
-// (bench/calib/calib_monte_carlo, docs/theory/filter.md#updates).
+// lines each seen within 5 m; the filter marginalises the tracks that end): the filter's mean
+// NEES over 8 runs inside the 95 % interval. The iterated update (update_iterations 3) fails
+// here: NEES 9.0, rho 1.85x its bound (bench/calib/calib_monte_carlo,
+// docs/theory/filter.md#updates).
 TEST(CalibrationFilter, LongRunWithLinesEnteringAndLeavingIsConsistent) {
   const int N = 8;
   SyntheticRunOptions so;
@@ -43,7 +43,6 @@ TEST(CalibrationFilter, LongRunWithLinesEnteringAndLeavingIsConsistent) {
     const SyntheticRun run = make_synthetic_run(so);
     CalibrationOptions o = test_support::filter_case_options(so);
     o.noise.bearing_sigma = so.bearing_sigma;
-    o.filter.update_iterations = 1;
     const FilterResult fr = run_filter(run.run, o);
     filt += nees(fr.extrinsics, fr.covariance, run.truth);
     // Tracks ended and came back under new ids: many more tracks than lines.

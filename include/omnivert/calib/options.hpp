@@ -112,7 +112,9 @@ struct FilterOptions {
   int bootstrap_starts = 5;
   // Updates.
   bool second_order_noise = true;  // add 1/2 tr(Hxx P Hxx P) to each bearing's variance
-  int update_iterations = 3;       // 1: plain EKF; >1: iterated EKF (Gauss-Newton)
+  // 1: the plain EKF (linearised at the prediction); >1: the iterated EKF (Gauss-Newton), which
+  // ends biased and overconfident on long runs (docs/theory/filter.md#updates).
+  int update_iterations = 1;
 };
 
 // Which bearings belong together, in the filter, its window and the refinement alike.
