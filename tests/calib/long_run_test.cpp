@@ -2,7 +2,6 @@
 // the run's visibility, and the filter's consistency over such runs.
 #include <gtest/gtest.h>
 
-#include <Eigen/Cholesky>
 #include <cmath>
 #include <map>
 #include <set>
@@ -16,9 +15,19 @@
 namespace omnivert::calib {
 namespace {
 
-double nees(const Extrinsics& est, const Eigen::Matrix3d& cov, const Extrinsics& truth) {
-  const Eigen::Vector3d e = test_support::error(est, truth);
-  return e.dot(cov.ldlt().solve(e));
+using test_support::nees;
+
+// A zigzag of `legs` legs over `length` m among `lines` lines within `range` - 1 m of the path,
+// each seen from within `range` m.
+SyntheticRunOptions long_zigzag(int legs, double length, int lines, double range) {
+  SyntheticRunOptions so;
+  so.trajectory = Trajectory::kZigzag;
+  so.zigzag_legs = legs;
+  so.straight_length = length;
+  so.num_features = lines;
+  so.visible_range = range;
+  so.max_distance = range - 1.0;
+  return so;
 }
 
 // A long run whose lines enter and leave the view (a 90 m zigzag of 40 legs, 2,900 frames, 200
@@ -28,13 +37,7 @@ double nees(const Extrinsics& est, const Eigen::Matrix3d& cov, const Extrinsics&
 // docs/theory/filter.md#updates).
 TEST(CalibrationFilter, LongRunWithLinesEnteringAndLeavingIsConsistent) {
   const int N = 8;
-  SyntheticRunOptions so;
-  so.trajectory = Trajectory::kZigzag;
-  so.zigzag_legs = 40;
-  so.straight_length = 90.0;
-  so.num_features = 200;
-  so.visible_range = 5.0;
-  so.max_distance = 4.0;
+  SyntheticRunOptions so = long_zigzag(40, 90.0, 200, 5.0);
   so.bearing_sigma = deg2rad(0.025);
   double filt = 0;
   int ended = 0;
@@ -57,13 +60,7 @@ TEST(CalibrationFilter, LongRunWithLinesEnteringAndLeavingIsConsistent) {
 // A line seen only within SyntheticRunOptions::visible_range of the camera, a new track each
 // time it comes back into range.
 TEST(SyntheticRun, LinesAreSeenOnlyWithinTheVisibleRange) {
-  SyntheticRunOptions so;
-  so.trajectory = Trajectory::kZigzag;
-  so.zigzag_legs = 6;
-  so.straight_length = 12.0;
-  so.num_features = 40;
-  so.visible_range = 3.0;
-  so.max_distance = 2.5;
+  const SyntheticRunOptions so = long_zigzag(6, 12.0, 40, 3.0);
   const SyntheticRun run = make_synthetic_run(so);
   std::map<int, std::set<int>> lines_of_track;
   std::size_t seen = 0, unseen = 0;
