@@ -16,6 +16,7 @@
 #include "calib/association.hpp"
 #include "calib/batch_problem.hpp"
 #include "calib/noise_check.hpp"
+#include "calib/refine_steps.hpp"
 #include "calib/serial_sparse_algebra.hpp"
 #include "calib/warm_start.hpp"
 #include "omnivert/core/angles.hpp"
@@ -219,6 +220,13 @@ bool extrinsics_covariance(Built* b, Eigen::Matrix3d* covariance, double* time_o
 RefinementResult refine_batch(const CalibrationRun& run,
                               const CalibrationOptions& options,
                               const BatchPoint& start) {
+  return internal::refine_batch(run, options, start, RefineSteps{});
+}
+
+RefinementResult internal::refine_batch(const CalibrationRun& run,
+                                        const CalibrationOptions& options,
+                                        const BatchPoint& start,
+                                        const RefineSteps& steps) {
   std::string why;
   if (!options.IsValid(&why)) throw InputError("calibration options: " + why);
   const SerialSparseAlgebra serial;  // this call's solves: one OpenMP thread in CHOLMOD
@@ -236,6 +244,7 @@ RefinementResult refine_batch(const CalibrationRun& run,
   ceres::Solver::Summary summary;
   if (options.progress) options.progress("refinement: first solve", 0, 0);
   solve_logged(loose, &b, &summary, "first solve");
+  if (steps.after_first_solve) steps.after_first_solve();
   // Lines that cross, outliers (false matches, at the filter's gate), pieces of one line,
   // slipped tracks; the problem solved again after each decision.
   Association association;
@@ -267,6 +276,7 @@ RefinementResult refine_batch(const CalibrationRun& run,
   res.solution = point_of(b);
   res.extrinsics = res.solution.extrinsics;
   double time_offset_variance = std::numeric_limits<double>::quiet_NaN();
+  if (!steps.covariance) return res;
   if (options.progress) options.progress("refinement: covariance", 0, 0);
   const auto t_covariance = std::chrono::steady_clock::now();
   const bool covariance = extrinsics_covariance(&b, &res.covariance, &time_offset_variance);
