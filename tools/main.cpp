@@ -5,10 +5,6 @@
 #include <exception>
 #include <string>
 
-#ifdef __GLIBC__
-#include <malloc.h>
-#endif
-
 #include <glog/logging.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
@@ -34,15 +30,6 @@ const std::string& command_line() { return g_command_line; }
 }  // namespace omnivert::cli
 
 int main(int argc, char** argv) {
-#ifdef __GLIBC__
-  // Blocks of 1 MB and more (the solvers' Jacobians and factors, images) are mapped for
-  // themselves and go back to the system when freed. glibc's default raises that threshold
-  // as such blocks are freed, after which they come from the heaps and stay resident: with
-  // the refinement and the filter's noise check on two threads, each thread's heap kept the
-  // other's peak (the hall tour's calibration: 566-597 MB resident at the peak, 478 MB with
-  // this).
-  mallopt(M_MMAP_THRESHOLD, 1 << 20);
-#endif
   // Warnings and log lines go to stderr: stdout carries results (tables, summaries).
   spdlog::set_default_logger(spdlog::stderr_color_mt("omnivert"));
   // Ceres logs through glog: to stderr, never to files, and only its errors (its warnings,
