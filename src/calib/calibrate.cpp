@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <functional>
 #include <future>
 #include <iomanip>
 #include <limits>
@@ -108,8 +107,7 @@ void refine_and_analyse(const CalibrationRun& run,
                         const CalibrationOptions& options,
                         const BatchPoint& filter_point,
                         StageTimer* timer,
-                        CalibrationResult* r,
-                        const std::function<void()>& after_first_solve = {}) {
+                        CalibrationResult* r) {
   BatchPoint at = filter_point;
   // Sec. 8.1 on the bearings the estimate used: those left out where lines cross
   // (CalibrationOptions::association.crossing_guard) do not follow eq. (30)'s model, and those the
@@ -119,7 +117,7 @@ void refine_and_analyse(const CalibrationRun& run,
   CalibrationRun analysed =
       join_tracks(without_bearings(run, r->filter.guarded, r->filter.rejected), r->filter.joins);
   if (options.refinement.enabled) {
-    r->refinement = internal::refine_batch(run, options, at, {after_first_solve, true});
+    r->refinement = refine_batch(run, options, at);
     r->refined = true;
     r->covariance_from_information = r->refinement.covariance_from_information;
     at = r->refinement.solution;
@@ -175,7 +173,7 @@ BatchNoiseCheck filter_noise_check(const CalibrationRun& run,
   for (const auto& [id, tracker] : origin)
     if (const auto it = filter_point.features.find(tracker); it != filter_point.features.end())
       start.features[id] = it->second;
-  return internal::refine_batch(filter_run, unsplit, start, {{}, /*covariance=*/false}).noise;
+  return internal::refine_batch(filter_run, unsplit, start, {/*covariance=*/false}).noise;
 }
 
 // The filter's noise check applied to its covariance: scaled by the ratio when the check
@@ -247,28 +245,17 @@ CalibrationResult calibrate_once(const CalibrationRun& run, const CalibrationOpt
   const BatchPoint filter_point = batch_point_from_filter(run, options, r.filter);
   // The filter's noise check on its own tracks does not wait for the refinement: with a
   // second thread it runs beside it (the same numbers; spent for nothing when the trajectory
-  // leaves the extrinsics undetermined), from the end of the refinement's first solve, so
-  // that the two largest problems are not held at once (the hall tour: 566 MB at the peak
-  // when both started together).
+  // leaves the extrinsics undetermined).
   // The check reports no progress: it runs on another thread, or after the refinement.
   CalibrationOptions quiet = options;
   quiet.progress = nullptr;
   std::future<BatchNoiseCheck> beside;
-  std::function<void()> start_beside;
   if (nc.enabled && !filter_check_may_be_the_refinements(options, r.filter) &&
       resolve_threads(options.threads) > 1)
-    start_beside = [&beside, &run, &quiet, &filter_point, &r] {
-      beside = std::async(std::launch::async, [&run, &quiet, &filter_point, &r] {
-        return filter_noise_check(run, quiet, filter_point, r.filter);
-      });
-    };
-  if (start_beside && !options.refinement.enabled) start_beside();
-  refine_and_analyse(run,
-                     options,
-                     filter_point,
-                     &timer,
-                     &r,
-                     options.refinement.enabled ? start_beside : std::function<void()>{});
+    beside = std::async(std::launch::async, [&run, &quiet, &filter_point, &r] {
+      return filter_noise_check(run, quiet, filter_point, r.filter);
+    });
+  refine_and_analyse(run, options, filter_point, &timer, &r);
   r.noise_check.filter_model_covariance = r.filter.covariance;
   r.noise_check.refinement_model_covariance = r.refinement.covariance;
   if (nc.enabled && r.observability.all_determined()) {

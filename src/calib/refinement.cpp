@@ -244,7 +244,6 @@ RefinementResult internal::refine_batch(const CalibrationRun& run,
   ceres::Solver::Summary summary;
   if (options.progress) options.progress("refinement: first solve", 0, 0);
   solve_logged(loose, &b, &summary, "first solve");
-  if (steps.after_first_solve) steps.after_first_solve();
   // Lines that cross, outliers (false matches, at the filter's gate), pieces of one line,
   // slipped tracks; the problem solved again after each decision.
   Association association;
