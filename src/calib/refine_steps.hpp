@@ -7,7 +7,8 @@ namespace omnivert::calib::internal {
 
 struct RefineSteps {
   // The covariance of (phi, rho, psi) at the solution; the filter's noise check, which keeps
-  // only RefinementResult::noise, goes without it (then covariance_ok is false).
+  // only RefinementResult::noise, goes without it (then covariance_ok is false and the time
+  // offset's sigma NaN).
   bool covariance = true;
 };
 

@@ -275,16 +275,17 @@ RefinementResult internal::refine_batch(const CalibrationRun& run,
   res.solution = point_of(b);
   res.extrinsics = res.solution.extrinsics;
   double time_offset_variance = std::numeric_limits<double>::quiet_NaN();
-  if (!steps.covariance) return res;
-  if (options.progress) options.progress("refinement: covariance", 0, 0);
-  const auto t_covariance = std::chrono::steady_clock::now();
-  const bool covariance = extrinsics_covariance(&b, &res.covariance, &time_offset_variance);
-  spdlog::debug("refinement covariance: {:.2f} s", seconds_since(t_covariance));
-  if (covariance) res.covariance_ok = res.covariance.allFinite();
-  if (!res.covariance_ok && !b.time_offset.empty() &&
-      marginal_with_time_offset(&b, &res.covariance, &time_offset_variance)) {
-    res.covariance_ok = true;
-    res.covariance_from_information = true;
+  if (steps.covariance) {
+    if (options.progress) options.progress("refinement: covariance", 0, 0);
+    const auto t_covariance = std::chrono::steady_clock::now();
+    const bool covariance = extrinsics_covariance(&b, &res.covariance, &time_offset_variance);
+    spdlog::debug("refinement covariance: {:.2f} s", seconds_since(t_covariance));
+    if (covariance) res.covariance_ok = res.covariance.allFinite();
+    if (!res.covariance_ok && !b.time_offset.empty() &&
+        marginal_with_time_offset(&b, &res.covariance, &time_offset_variance)) {
+      res.covariance_ok = true;
+      res.covariance_from_information = true;
+    }
   }
   if (!b.time_offset.empty()) {
     res.time_offset_estimated = true;
