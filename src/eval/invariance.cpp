@@ -21,6 +21,15 @@ cv::Mat rotate_about(const cv::Mat& image, const Eigen::Vector2d& center, double
   return out;
 }
 
+cv::Mat rotated_usable(const cv::Mat& usable,
+                       cv::Size size,
+                       const Eigen::Vector2d& center,
+                       double angle_rad) {
+  cv::Mat ones = usable.empty() ? cv::Mat(size, CV_8U, cv::Scalar(255)) : (usable != 0);
+  cv::Mat out = rotate_about(ones, center, angle_rad);
+  return out == 255;  // every bilinear neighbour usable
+}
+
 cv::Mat relight(const cv::Mat& image, double gain, double gamma) {
   cv::Mat lut(1, 256, CV_8U);
   for (int i = 0; i < 256; ++i) {

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <numeric>
+#include <optional>
+#include <utility>
 #include <sstream>
 
 #include "omnivert/core/angles.hpp"
@@ -38,8 +40,13 @@ bool features_of(const cv::Mat& image,
                  const CameraGeometry& geometry,
                  const FeaturePipelineOptions& options,
                  FrameFeatures* f,
-                 std::string* why) {
+                 std::string* why,
+                 const std::optional<std::pair<Eigen::Vector2d, double>>& rotation = {}) {
   FeaturePipeline pipe(geometry, options);
+  // A rotated copy (centre, angle): its mask is the camera's, rotated, less the corners the
+  // rotation filled with zeros.
+  if (rotation)
+    pipe.set_mask(rotated_usable(pipe.mask(), image.size(), rotation->first, rotation->second));
   return pipe.process(image, *f, why);
 }
 
@@ -112,7 +119,7 @@ RealImageResult study_real_image(const std::string& label,
       FrameFeatures f1;
       std::string why;
       const cv::Mat rotated = rotate_about(image, f0.circle.center, t);
-      if (!features_of(rotated, g, o.pipeline, &f1, &why)) {
+      if (!features_of(rotated, g, o.pipeline, &f1, &why, std::pair(f0.circle.center, t))) {
         r.rotation[mode].looked_for += static_cast<int>(top.size());
         continue;
       }

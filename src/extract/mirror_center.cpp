@@ -146,7 +146,7 @@ std::optional<rim::RimFit> find_rim(const cv::Mat& gray,
         cands.begin(), cands.end(), [](const auto& x, const auto& y) { return x.score > y.score; });
     if (cands.size() > 8) cands.resize(8);
   } else {
-    cands = rim::hough_circles(small, r_lo, r_hi, options_.edge_threshold, 10, 6.0, small_usable);
+    cands = rim::hough_circles(small, r_lo, r_hi, options_.edge_threshold, 30, 6.0, small_usable);
   }
   // Each candidate is refined on rays at full resolution; the rim is the candidate found
   // within 1 px on the most rays, on at least 30% of its visible circumference, with enough

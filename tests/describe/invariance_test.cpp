@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <vector>
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
@@ -68,6 +69,40 @@ TEST(Invariance, RotatedSceneGivesTheSameLinesShiftedAndTheSameDescriptors) {
       worst_dist);
   EXPECT_LE(worst_shift, 0.1);
   EXPECT_LE(worst_dist, 0.25);
+}
+
+// rotated_usable: a copy's pixel is usable when its bilinear sample reads only usable pixels
+// of the original (inside its frame and its mask), and not when it reads beyond either.
+TEST(Invariance, RotatedUsableMarksWhatTheCopyReallySaw) {
+  const cv::Size size(120, 90);
+  const Eigen::Vector2d c(61.3, 44.8);
+  cv::Mat usable(size, CV_8U, cv::Scalar(255));
+  usable.colRange(0, 30).setTo(0);  // the left quarter masked
+  for (const double deg : {7.0, 41.0, 137.0}) {
+    const double t = deg2rad(deg);
+    const cv::Mat frame = eval::rotated_usable(cv::Mat(), size, c, t);
+    const cv::Mat masked = eval::rotated_usable(usable, size, c, t);
+    ASSERT_EQ(frame.size(), size);
+    ASSERT_EQ(frame.type(), CV_8UC1);
+    int checked = 0;
+    for (int v = 0; v < size.height; ++v)
+      for (int u = 0; u < size.width; ++u) {
+        // The copy's pixel at image angle a + t comes from the original's at angle a.
+        const Eigen::Vector2d d = Eigen::Vector2d(u, v) - c;
+        const Eigen::Vector2d q = c + Eigen::Rotation2Dd(-t).toRotationMatrix() * d;
+        const bool inside = q.x() >= 1 && q.y() >= 1 && q.x() <= size.width - 2 &&
+                            q.y() <= size.height - 2;
+        const bool outside = q.x() < -1 || q.y() < -1 || q.x() > size.width ||
+                             q.y() > size.height;
+        if (inside) EXPECT_EQ(frame.at<uchar>(v, u), 255) << u << "," << v << " at " << deg;
+        if (outside) EXPECT_EQ(frame.at<uchar>(v, u), 0) << u << "," << v << " at " << deg;
+        if (inside && q.x() >= 31) EXPECT_EQ(masked.at<uchar>(v, u), 255) << u << "," << v;
+        if (q.x() < 29) EXPECT_EQ(masked.at<uchar>(v, u), 0) << u << "," << v;
+        checked += inside || outside;
+      }
+    EXPECT_GT(checked, size.area() * 9 / 10);
+    EXPECT_GT(cv::countNonZero(frame == 0), size.area() / 20);  // the corners
+  }
 }
 
 TEST(Invariance, GainAndGammaChangeDescriptorsLittle) {

@@ -15,6 +15,15 @@ namespace omnivert::eval {
 // Rotates `image` about `center` so that image angles change by +angle_rad (bilinear).
 cv::Mat rotate_about(const cv::Mat& image, const Eigen::Vector2d& center, double angle_rad);
 
+// The pixels of rotate_about's copy that come wholly from inside `usable` (CV_8U, non-zero =
+// usable; empty: every pixel of an image of `size`): 255 there, 0 where the copy's bilinear
+// sample reads the zero fill beyond the original's frame or a masked pixel. The copy's corners
+// are not image content: given as the copy's mask, they neither hide nor fake the rim.
+cv::Mat rotated_usable(const cv::Mat& usable,
+                       cv::Size size,
+                       const Eigen::Vector2d& center,
+                       double angle_rad);
+
 // out = 255 * (gain * in / 255)^gamma, saturated.
 cv::Mat relight(const cv::Mat& image, double gain, double gamma);
 

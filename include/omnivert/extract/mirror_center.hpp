@@ -12,7 +12,7 @@
 // Without a known rim radius, `estimate` finds the rim as a circle Hough transform (every
 // edge pixel votes along its gradient line, for every radius from 30% of the image's
 // smaller side up, so a rim darker or brighter outward counts alike) on a copy at most 320
-// pixels across; each of the best ten circles is refined on rays at full resolution (the
+// pixels across; each of the best thirty circles is refined on rays at full resolution (the
 // strongest radial step of either sign near the circle, a robust circle fit) and the rim is
 // the circle found within one pixel on the most rays (at least 30% of its circumference
 // inside the image). Rays that leave the image are skipped, so a rim cut off by the frame is fitted
