@@ -120,6 +120,19 @@ inline void add_pipeline_options(CLI::App* cmd, FeaturePipelineOptions& o) {
       ->check(CLI::Range(-10.0, 1000.0))
       ->capture_default_str()
       ->group(g);
+  cmd->add_option("--faint-min-significance",
+                  o.lines.faint_min_significance,
+                  "Significance lines below --min-significance need to be kept when they cover "
+                  "--faint-min-fraction of the annulus (at --min-significance or above: none)")
+      ->check(CLI::Range(-10.0, 1000.0))
+      ->capture_default_str()
+      ->group(g);
+  cmd->add_option("--faint-min-fraction",
+                  o.lines.faint_min_fraction,
+                  "Fraction of the annulus a faint line (--faint-min-significance) must cover")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str()
+      ->group(g);
   cmd->add_option("--top-k", o.lines.top_k, "Lines kept per frame with --line-threshold topk")
       ->check(kPositive)
       ->capture_default_str()

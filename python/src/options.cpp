@@ -102,6 +102,14 @@ const OptionTable<FP>& extraction_table() {
           "min_significance", "-log10 NFA of a line kept (significance)", [](FP & o) -> auto& {
             return o.lines.min_significance;
           }),
+      field<double, FP>(
+          "faint_min_significance",
+          "-log10 NFA of a faint line kept when it covers faint_min_fraction",
+          [](FP & o) -> auto& { return o.lines.faint_min_significance; }),
+      field<double, FP>(
+          "faint_min_fraction",
+          "fraction of the annulus a faint line must cover",
+          [](FP & o) -> auto& { return o.lines.faint_min_fraction; }),
       field<int, FP>(
           "top_k", "lines kept per frame (topk)", [](FP & o) -> auto& { return o.lines.top_k; }),
       field<double, FP>(

@@ -5,8 +5,8 @@
 #include <cstdio>
 #include <numeric>
 #include <optional>
-#include <utility>
 #include <sstream>
+#include <utility>
 
 #include "omnivert/core/angles.hpp"
 #include "omnivert/eval/invariance.hpp"

@@ -30,6 +30,10 @@ bool LineExtractorOptions::IsValid(std::string* why) const {
   if (!(adaptive_k >= 0)) return fail("adaptive_k must not be negative");
   if (top_k < 1) return fail("top_k must be at least 1");
   if (!(min_fraction >= 0 && min_fraction <= 1)) return fail("min_fraction must be in [0, 1]");
+  if (!(faint_min_fraction >= 0 && faint_min_fraction <= 1))
+    return fail("faint_min_fraction must be in [0, 1]");
+  if (!(faint_min_significance >= -10 && faint_min_significance <= 1000))
+    return fail("faint_min_significance must be in [-10, 1000]");
   if (!(min_significance >= -10 && min_significance <= 1000))
     return fail("min_significance must be in [-10, 1000]");
   return true;
@@ -427,9 +431,12 @@ bool LineExtractor::fit_peak(
   lc->line.significance =
       line_significance(radii, local_hit_probability(k, pol, a, cx, cy), log10_tests_);
   if (!uses_significance()) return true;  // threshold_lines decides
-  return lc->line.significance >= options_.min_significance ||
+  const double L = lut_r_max_ - lut_r_min_;
+  const double s = lc->line.significance;
+  return s >= options_.min_significance ||
+         (s >= options_.faint_min_significance && covered >= options_.faint_min_fraction * L) ||
          (options_.threshold == LineThreshold::kSignificantOrLong &&
-          covered >= options_.length_fraction * (lut_r_max_ - lut_r_min_));
+          covered >= options_.length_fraction * L);
 }
 
 void LineExtractor::refit_crowded_lines(const MirrorCircle& circle) {

@@ -6,8 +6,8 @@
 #include <filesystem>
 #include <vector>
 
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 #include <opencv2/imgcodecs.hpp>
 
 #include "omnivert/core/angles.hpp"
@@ -90,10 +90,9 @@ TEST(Invariance, RotatedUsableMarksWhatTheCopyReallySaw) {
         // The copy's pixel at image angle a + t comes from the original's at angle a.
         const Eigen::Vector2d d = Eigen::Vector2d(u, v) - c;
         const Eigen::Vector2d q = c + Eigen::Rotation2Dd(-t).toRotationMatrix() * d;
-        const bool inside = q.x() >= 1 && q.y() >= 1 && q.x() <= size.width - 2 &&
-                            q.y() <= size.height - 2;
-        const bool outside = q.x() < -1 || q.y() < -1 || q.x() > size.width ||
-                             q.y() > size.height;
+        const bool inside =
+            q.x() >= 1 && q.y() >= 1 && q.x() <= size.width - 2 && q.y() <= size.height - 2;
+        const bool outside = q.x() < -1 || q.y() < -1 || q.x() > size.width || q.y() > size.height;
         if (inside) EXPECT_EQ(frame.at<uchar>(v, u), 255) << u << "," << v << " at " << deg;
         if (outside) EXPECT_EQ(frame.at<uchar>(v, u), 0) << u << "," << v << " at " << deg;
         if (inside && q.x() >= 31) EXPECT_EQ(masked.at<uchar>(v, u), 255) << u << "," << v;

@@ -183,5 +183,66 @@ TEST(LineExtractor, SignificanceKeepsPartialEdges) {
   EXPECT_EQ(s_def.long_found, s_def.long_edges);
 }
 
+// Faint long edges (contrast 6-12 grey levels at noise 3): the faint tier keeps lines of
+// significance down to faint_min_significance that cover faint_min_fraction of the annulus,
+// no shorter ones; at faint_min_significance >= min_significance the lines are the default's.
+TEST(LineExtractor, FaintTierKeepsFaintLongEdgesOnly) {
+  Score s_def, s_faint;
+  int kept_faint = 0, equal_when_off = 0, frames = 0;
+  for (int seed = 1; seed <= 10; ++seed) {
+    sim::RadialPatternOptions o;
+    o.seed = seed;
+    o.min_contrast = 6.0;
+    o.max_contrast = 12.0;
+    o.noise_sigma = 3.0;
+    const auto p = sim::draw_radial_pattern(o);
+    const double L = p.circle.r_max - p.circle.r_min;
+    auto run = [&](const LineExtractorOptions& lo) {
+      LineExtractor ex(lo);
+      std::vector<VerticalLine> lines;
+      ex.extract(p.image, p.circle, lines);
+      return lines;
+    };
+    LineExtractorOptions def, faint, off;
+    faint.faint_min_significance = 10.0;
+    faint.faint_min_fraction = 0.2;
+    off.faint_min_significance = 40.0;  // above min_significance: no faint lines
+    off.faint_min_fraction = 0.0;
+    const auto ld = run(def), lf = run(faint), lo = run(off);
+    ++frames;
+    bool same = ld.size() == lo.size();
+    for (std::size_t i = 0; same && i < ld.size(); ++i)
+      same = ld[i].image_angle == lo[i].image_angle && ld[i].edge_pixels == lo[i].edge_pixels;
+    equal_when_off += same;
+    for (const auto& l : lf) {
+      const bool long_enough = l.edge_pixels >= 0.2 * L - 1;
+      EXPECT_TRUE(l.significance >= def.min_significance ||
+                  (l.significance >= 10.0 && long_enough) || l.edge_pixels >= 0.5 * L - 1)
+          << "seed " << seed << ": significance " << l.significance << ", " << l.edge_pixels
+          << " px";
+      kept_faint += l.significance < def.min_significance && l.edge_pixels < 0.5 * L - 1;
+    }
+    FrameFeatures f;
+    f.circle = p.circle;
+    f.lines = ld;
+    score_frame(p, f, s_def);
+    f.lines = lf;
+    score_frame(p, f, s_faint);
+  }
+  std::printf(
+      "faint edges, long ones found: %d of %d (default), %d (faint tier, %d faint lines); "
+      "invented %d, %d\n",
+      s_def.long_found,
+      s_def.long_edges,
+      s_faint.long_found,
+      kept_faint,
+      s_def.invented,
+      s_faint.invented);
+  EXPECT_EQ(equal_when_off, frames);
+  EXPECT_GT(kept_faint, 0);
+  EXPECT_GE(s_faint.long_found, s_def.long_found + s_def.long_edges / 8);  // 139 vs 102 of 176
+  EXPECT_EQ(s_faint.invented, 0);
+}
+
 }  // namespace
 }  // namespace omnivert

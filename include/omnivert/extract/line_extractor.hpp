@@ -90,6 +90,13 @@ struct LineExtractorOptions {
   double adaptive_k = 3.0;         // kAdaptive
   int top_k = 20;                  // kTopK
   double min_fraction = 0.2;       // floor for kAdaptive and kTopK
+  // kSignificance(OrLong): a line less significant than min_significance is still kept when
+  // it is at least faint_min_significance and covers faint_min_fraction of the annulus: the
+  // faint long edges of a room (a wall corner between like walls), whose short fragments
+  // would be clutter (docs/validation.md#faint-lines). faint_min_significance >=
+  // min_significance: no faint lines.
+  double faint_min_significance = 35.0;
+  double faint_min_fraction = 0.2;
 
   // Step 2 pixel by pixel through the lookup table instead of the fast path, which runs along
   // each row of the annulus in a loop the compiler vectorises. Both give the same edges and
