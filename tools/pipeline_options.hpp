@@ -127,6 +127,13 @@ inline void add_pipeline_options(CLI::App* cmd, FeaturePipelineOptions& o) {
       ->check(CLI::Range(-10.0, 1000.0))
       ->capture_default_str()
       ->group(g);
+  cmd->add_option(
+         "--faint-max-fit",
+         o.lines.faint_max_fit_px,
+         "RMS distance (px) of a faint line's support pixels from its radial line, at most")
+      ->check(kPositive)
+      ->capture_default_str()
+      ->group(g);
   cmd->add_option("--faint-min-fraction",
                   o.lines.faint_min_fraction,
                   "Fraction of the annulus a faint line (--faint-min-significance) must cover")

@@ -110,6 +110,10 @@ const OptionTable<FP>& extraction_table() {
           "faint_min_fraction",
           "fraction of the annulus a faint line must cover",
           [](FP & o) -> auto& { return o.lines.faint_min_fraction; }),
+      field<double, FP>(
+          "faint_max_fit_px",
+          "RMS distance of a faint line's support pixels from its line, px",
+          [](FP & o) -> auto& { return o.lines.faint_max_fit_px; }),
       field<int, FP>(
           "top_k", "lines kept per frame (topk)", [](FP & o) -> auto& { return o.lines.top_k; }),
       field<double, FP>(

@@ -32,6 +32,7 @@ bool LineExtractorOptions::IsValid(std::string* why) const {
   if (!(min_fraction >= 0 && min_fraction <= 1)) return fail("min_fraction must be in [0, 1]");
   if (!(faint_min_fraction >= 0 && faint_min_fraction <= 1))
     return fail("faint_min_fraction must be in [0, 1]");
+  if (!(faint_max_fit_px > 0)) return fail("faint_max_fit_px must be positive");
   if (!(faint_min_significance >= -10 && faint_min_significance <= 1000))
     return fail("faint_min_significance must be in [-10, 1000]");
   if (!(min_significance >= -10 && min_significance <= 1000))
@@ -434,7 +435,8 @@ bool LineExtractor::fit_peak(
   const double L = lut_r_max_ - lut_r_min_;
   const double s = lc->line.significance;
   return s >= options_.min_significance ||
-         (s >= options_.faint_min_significance && covered >= options_.faint_min_fraction * L) ||
+         (s >= options_.faint_min_significance && covered >= options_.faint_min_fraction * L &&
+          fit_rms <= options_.faint_max_fit_px) ||
          (options_.threshold == LineThreshold::kSignificantOrLong &&
           covered >= options_.length_fraction * L);
 }

@@ -217,7 +217,8 @@ TEST(LineExtractor, FaintTierKeepsFaintLongEdgesOnly) {
     for (const auto& l : lf) {
       const bool long_enough = l.edge_pixels >= 0.2 * L - 1;
       EXPECT_TRUE(l.significance >= def.min_significance ||
-                  (l.significance >= 10.0 && long_enough) || l.edge_pixels >= 0.5 * L - 1)
+                  (l.significance >= 10.0 && long_enough && l.fit_rms_px <= 0.45) ||
+                  l.edge_pixels >= 0.5 * L - 1)
           << "seed " << seed << ": significance " << l.significance << ", " << l.edge_pixels
           << " px";
       kept_faint += l.significance < def.min_significance && l.edge_pixels < 0.5 * L - 1;

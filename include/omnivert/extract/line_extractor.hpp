@@ -97,6 +97,9 @@ struct LineExtractorOptions {
   // min_significance: no faint lines.
   double faint_min_significance = 35.0;
   double faint_min_fraction = 0.2;
+  // ... and whose support pixels lie within this RMS of its radial line (px): oblique texture
+  // edges that pass the orientation test over part of the annulus fit a radial line worse.
+  double faint_max_fit_px = 0.45;
 
   // Step 2 pixel by pixel through the lookup table instead of the fast path, which runs along
   // each row of the annulus in a loop the compiler vectorises. Both give the same edges and
