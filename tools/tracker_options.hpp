@@ -20,7 +20,7 @@ struct TrackerFlags {
   bool no_gate = false;
   int look_back = 20;
   // Each flag not given keeps the value of the rule set (--rules) or of TrackerOptions.
-  std::optional<double> f1, f2, f3, partial_area_scale;
+  std::optional<double> f1, f2, f3, partial_area_scale, partial_side_scale;
   std::string gate_candidates = "default";  // on|off|default (the rule set's)
   std::optional<double> gate_min_distance, gate_tolerance_deg;
   std::string same_polarity = "default";  // on|off|default (the rule set's)
@@ -44,6 +44,7 @@ struct TrackerFlags {
     if (f2) o.match.f2 = *f2;
     if (f3) o.match.f3 = *f3;
     if (partial_area_scale) o.match.partial_area_scale = *partial_area_scale;
+    if (partial_side_scale) o.match.partial_side_scale = *partial_side_scale;
     if (gate_candidates != "default") o.gate_candidates = gate_candidates == "on";
     if (continuity_deg) o.continuity_tolerance = deg2rad(*continuity_deg);
     if (continuity_model != "default") {
@@ -209,6 +210,13 @@ inline void add_tracker_options(CLI::App* cmd, TrackerFlags& t) {
                   "Occluder-tolerant descriptor distance: where one of the three areas holds more "
                   "than (s-1)/s of the squared distance, the other two decide, scaled by s "
                   "(e.g. 2 in scenes with people; default 0: off, eq. 6)")
+      ->check(CLI::Number)
+      ->group(g);
+  cmd->add_option("--partial-side-scale",
+                  t.partial_side_scale,
+                  "Occluder-tolerant descriptor distance by the line's sides: the distance may "
+                  "also be s times the closer side's (a person beside the line changes one "
+                  "side; e.g. 2 with people; default 0: off)")
       ->check(CLI::Number)
       ->group(g);
 }

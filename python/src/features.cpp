@@ -174,7 +174,8 @@ void bind_features(py::module_& m) {
          double f1,
          double f2,
          double f3,
-         double partial_area_scale) {
+         double partial_area_scale,
+         double partial_side_scale) {
         if (query.ndim() != 2 || candidates.ndim() != 2 || query.shape(1) != candidates.shape(1))
           throw InputError("match: expected two (N, D) descriptor arrays of one width D");
         MatchOptions o;
@@ -182,6 +183,7 @@ void bind_features(py::module_& m) {
         o.f2 = f2;
         o.f3 = f3;
         o.partial_area_scale = partial_area_scale;
+        o.partial_side_scale = partial_side_scale;
         check_valid(o);
         using Map = Eigen::Map<const DescriptorMatrix>;
         const Map q(query.data(), query.shape(0), query.shape(1));
@@ -217,6 +219,7 @@ void bind_features(py::module_& m) {
       py::arg("f2") = MatchOptions{}.f2,
       py::arg("f3") = MatchOptions{}.f3,
       py::arg("partial_area_scale") = MatchOptions{}.partial_area_scale,
+      py::arg("partial_side_scale") = MatchOptions{}.partial_side_scale,
       "Each query descriptor's nearest candidate (eq. 6, or the occluder-tolerant distance with "
       "partial_area_scale) and the verdict of tests 1-3 (eq. 8-10; "
       "defaults: the paper's Table 2): a dict of arrays best, distance, second_distance, "

@@ -185,6 +185,11 @@ const OptionTable<TO>& tracker_table() {
           "occluder-tolerant descriptor distance: the two areas that agree decide "
           "where one holds more than (s-1)/s of the squared distance; 0: off",
           [](TO & o) -> auto& { return o.match.partial_area_scale; }),
+      field<double, TO>(
+          "partial_side_scale",
+          "occluder-tolerant descriptor distance by sides: also s times the closer "
+          "side's squared distance; 0: off",
+          [](TO & o) -> auto& { return o.match.partial_side_scale; }),
       field<bool, TO>(
           "gate_candidates",
           "tests 1, 3 and mutual among the lines the gate admits",

@@ -20,6 +20,9 @@ bool MatchOptions::IsValid(std::string* error) const {
   if (!(partial_area_scale == 0.0 ||
         (partial_area_scale >= 1.0 && std::isfinite(partial_area_scale))))
     return fail("the partial-area scale must be 0 (off) or a finite number >= 1");
+  if (!(partial_side_scale == 0.0 ||
+        (partial_side_scale >= 1.0 && std::isfinite(partial_side_scale))))
+    return fail("the partial-side scale must be 0 (off) or a finite number >= 1");
   return true;
 }
 
@@ -78,6 +81,8 @@ Matcher::DistanceView Matcher::compute_distances(const ConstDescriptors& query,
   if (candidate_norms_.size() < cols_) candidate_norms_.resize(distances_.cols());
   if (rows_ == 0 || cols_ == 0) return last_distances();
 
+  if (options_.partial_side_scale > 0.0 && query.cols() % 6 == 0)
+    return partial_side_distances(query, candidates);
   if (options_.partial_area_scale > 0.0 && query.cols() % 3 == 0)
     return partial_distances(query, candidates);
   // Eq. (6) as |a - b|^2 = |a|^2 + |b|^2 - 2 a.b: one matrix product for all pairs.
@@ -102,6 +107,14 @@ namespace {
 // times the sum without the largest where that is less.
 float occluder_tolerant_sq(float sum, float worst, float s) {
   return std::min(sum, s * (sum - worst));
+}
+
+// With MatchOptions::partial_side_scale too: also s_side times the lesser side's d^2.
+template <typename T>
+T side_tolerant_sq(T sum, T worst, T left, T right, T area_scale, T side_scale) {
+  T d = sum;
+  if (area_scale > 0) d = std::min(d, area_scale * (sum - worst));
+  return std::min(d, side_scale * std::min(left, right));
 }
 
 }  // namespace
@@ -139,10 +152,74 @@ Matcher::DistanceView Matcher::partial_distances(const ConstDescriptors& query,
   return last_distances();
 }
 
+// MatchOptions::partial_side_scale: the six halves' d^2 by one matrix product each (columns
+// in sixths: H_1L, H_1R, H_2L, ...), summed per area (sum, largest) and per side.
+Matcher::DistanceView Matcher::partial_side_distances(const ConstDescriptors& query,
+                                                      const ConstDescriptors& candidates) {
+  for (DistanceMatrix* m : {&area_, &worst_, &half_, &left_, &right_})
+    if (m->rows() < distances_.rows() || m->cols() < distances_.cols())
+      m->resize(distances_.rows(), distances_.cols());
+  auto d = distances_.topLeftCorner(rows_, cols_);
+  auto a = area_.topLeftCorner(rows_, cols_);
+  auto m = worst_.topLeftCorner(rows_, cols_);
+  auto h = half_.topLeftCorner(rows_, cols_);
+  auto l = left_.topLeftCorner(rows_, cols_);
+  auto r = right_.topLeftCorner(rows_, cols_);
+  const Eigen::Index w = query.cols() / 6;
+  for (Eigen::Index k = 0; k < 6; ++k) {
+    const auto q = query.middleCols(k * w, w);
+    const auto c = candidates.middleCols(k * w, w);
+    h.noalias() = q * c.transpose();
+    query_norms_.head(rows_) = q.rowwise().squaredNorm();
+    candidate_norms_.head(cols_) = c.rowwise().squaredNorm();
+    const bool right = k % 2 == 1;
+    for (Eigen::Index i = 0; i < rows_; ++i)
+      for (Eigen::Index j = 0; j < cols_; ++j) {
+        const float sq = std::max(query_norms_(i) + candidate_norms_(j) - 2.0f * h(i, j), 0.0f);
+        if (!right) {
+          a(i, j) = sq;
+          l(i, j) = k == 0 ? sq : l(i, j) + sq;
+          continue;
+        }
+        a(i, j) += sq;
+        r(i, j) = k == 1 ? sq : r(i, j) + sq;
+        d(i, j) = k == 1 ? a(i, j) : d(i, j) + a(i, j);
+        m(i, j) = k == 1 ? a(i, j) : std::max(m(i, j), a(i, j));
+      }
+  }
+  const auto sa = static_cast<float>(options_.partial_area_scale);
+  const auto ss = static_cast<float>(options_.partial_side_scale);
+  for (Eigen::Index i = 0; i < rows_; ++i)
+    for (Eigen::Index j = 0; j < cols_; ++j)
+      d(i, j) = std::sqrt(side_tolerant_sq(d(i, j), m(i, j), l(i, j), r(i, j), sa, ss));
+  return last_distances();
+}
+
 float descriptor_distance_sq(const MatchOptions& o,
                              const Eigen::Ref<const Eigen::RowVectorXf>& a,
                              const Eigen::Ref<const Eigen::RowVectorXf>& b) {
   const Eigen::Index n = a.size();
+  if (o.partial_side_scale > 0.0 && n % 6 == 0) {
+    const Eigen::Index w = n / 6;
+    float sum = 0.0f, worst = 0.0f, side[2] = {0.0f, 0.0f};
+    for (Eigen::Index k = 0; k < 3; ++k) {
+      float area = 0.0f;
+      for (Eigen::Index s = 0; s < 2; ++s) {
+        const Eigen::Index at = (2 * k + s) * w;
+        const float sq = (a.segment(at, w) - b.segment(at, w)).squaredNorm();
+        area += sq;
+        side[s] += sq;
+      }
+      sum += area;
+      worst = std::max(worst, area);
+    }
+    return side_tolerant_sq(sum,
+                            worst,
+                            side[0],
+                            side[1],
+                            static_cast<float>(o.partial_area_scale),
+                            static_cast<float>(o.partial_side_scale));
+  }
   if (!(o.partial_area_scale > 0.0) || n % 3 != 0) return (a - b).squaredNorm();
   const Eigen::Index w = n / 3;
   float sum = 0.0f, worst = 0.0f;
@@ -205,15 +282,24 @@ std::vector<MatchResult> match_brute_force(const MatchOptions& options,
       // Eq. (6) term by term, per area when the occluder-tolerant distance is on.
       const Eigen::Index cols = query.cols();
       const bool partial = options.partial_area_scale > 0.0 && cols % 3 == 0;
-      double area[3] = {0.0, 0.0, 0.0};
+      const bool sides = options.partial_side_scale > 0.0 && cols % 6 == 0;
+      double area[3] = {0.0, 0.0, 0.0}, side[2] = {0.0, 0.0};
       for (Eigen::Index k = 0; k < cols; ++k) {
         const double diff = static_cast<double>(query(i, k)) - candidates(j, k);
-        area[partial ? 3 * k / cols : 0] += diff * diff;
+        area[partial || sides ? 3 * k / cols : 0] += diff * diff;
+        if (sides) side[(6 * k / cols) % 2] += diff * diff;
       }
       const double s = area[0] + area[1] + area[2];
       const double worst = std::max({area[0], area[1], area[2]});
       const double dist =
-          std::sqrt(partial ? std::min(s, options.partial_area_scale * (s - worst)) : s);
+          std::sqrt(sides     ? side_tolerant_sq(s,
+                                             worst,
+                                             side[0],
+                                             side[1],
+                                             options.partial_area_scale,
+                                             options.partial_side_scale)
+                    : partial ? std::min(s, options.partial_area_scale * (s - worst))
+                              : s);
       sum += dist;
       row.emplace_back(dist, static_cast<int>(j));
     }

@@ -303,5 +303,86 @@ TEST(Matcher, TheOccluderTolerantDistanceAgreesWithBruteForce) {
   EXPECT_GT(partial, 100);  // the one-area copies do take the tolerant branch
 }
 
+// MatchOptions::partial_side_scale on known geometry: a candidate equal to the query but on
+// one side of the line (a person there: that side's three halves replaced) is at 0, alone or
+// with the area rule; one changed in one area only is left out by the area rule as before.
+TEST(Matcher, OneChangedSideIsLeftOut) {
+  std::mt19937 rng(5);
+  const DescriptorMatrix a = random_descriptors(1, rng);
+  const Eigen::Index w = a.cols() / 6;  // one half: H_kL or H_kR
+  DescriptorMatrix b = a;
+  for (Eigen::Index k = 0; k < 3; ++k) {  // the right halves replaced
+    const Eigen::Index at = (2 * k + 1) * w;
+    b.row(0).segment(at, w) =
+        random_descriptors(1, rng, static_cast<int>(w)).row(0) * a.row(0).segment(at, w).norm();
+  }
+  ASSERT_GT((a.row(0) - b.row(0)).norm(), 0.5);
+  MatchOptions sides, both, area;
+  sides.partial_side_scale = 2.0;
+  both.partial_side_scale = 2.0;
+  both.partial_area_scale = 2.0;
+  area.partial_area_scale = 2.0;
+  for (const MatchOptions& o : {sides, both}) {
+    Matcher m(o);
+    EXPECT_NEAR(m.compute_distances(a, b)(0, 0), 0.0, 1e-3);
+    EXPECT_NEAR(std::sqrt(descriptor_distance_sq(o, a.row(0), b.row(0))), 0.0, 1e-3);
+  }
+  // Every area changed: the area rule alone keeps most of the distance.
+  EXPECT_GT(Matcher(area).compute_distances(a, b)(0, 0), 0.5 * (a.row(0) - b.row(0)).norm());
+  // A change on both sides evenly: sqrt(2 min(L, R)) equals the full distance, not less.
+  DescriptorMatrix c = a;
+  c(0, 0) += 0.2f;
+  c(0, w) += 0.2f;
+  EXPECT_NEAR(Matcher(sides).compute_distances(a, c)(0, 0), (a.row(0) - c.row(0)).norm(), 1e-4);
+}
+
+// The side-tolerant fast path (six matrix products) against the reference term by term.
+TEST(Matcher, TheSideTolerantDistanceAgreesWithBruteForce) {
+  std::mt19937 rng(13);
+  for (const double area_scale : {0.0, 2.0}) {
+    MatchOptions o;
+    o.partial_area_scale = area_scale;
+    o.partial_side_scale = 2.0;
+    Matcher m(o);
+    std::vector<MatchResult> fast;
+    int partial = 0;
+    for (int trial = 0; trial < 30; ++trial) {
+      const int na = std::uniform_int_distribution<int>(1, 30)(rng);
+      const int nb = std::uniform_int_distribution<int>(2, 30)(rng);
+      DescriptorMatrix a = random_descriptors(na, rng);
+      const DescriptorMatrix b = random_descriptors(nb, rng);
+      for (int i = 0; i < na; i += 2) {  // copies of a candidate with one side replaced
+        const int j = std::uniform_int_distribution<int>(0, nb - 1)(rng);
+        a.row(i) = b.row(j);
+        const int side = std::uniform_int_distribution<int>(0, 1)(rng);
+        for (Eigen::Index k = 0; k < 3; ++k)
+          a.row(i).segment((2 * k + side) * 32, 32) =
+              random_descriptors(1, rng, 32).row(0) *
+              b.row(j).segment((2 * k + side) * 32, 32).norm();
+      }
+      m.match(a, b, &fast);
+      const auto ref = match_brute_force(o, a, b);
+      const auto dist = m.last_distances();
+      for (int i = 0; i < na; ++i) {
+        for (int j = 0; j < nb; ++j) {
+          const double full = (a.row(i) - b.row(j)).norm();
+          const double exact = std::sqrt(descriptor_distance_sq(o, a.row(i), b.row(j)));
+          ASSERT_NEAR(dist(i, j) * dist(i, j), exact * exact, 1e-5) << i << "," << j;
+          partial += exact < full - 1e-3;
+        }
+        const MatchResult& f = fast[static_cast<std::size_t>(i)];
+        const MatchResult& r = ref[static_cast<std::size_t>(i)];
+        EXPECT_NEAR(f.min_distance, r.min_distance, 1e-3);
+        EXPECT_NEAR(f.second_distance, r.second_distance, 1e-3);
+        EXPECT_NEAR(f.mean_distance, r.mean_distance, 1e-3);
+        if (r.second_distance - r.min_distance > 1e-3f) {
+          EXPECT_EQ(f.best, r.best);
+        }
+      }
+    }
+    EXPECT_GT(partial, 100) << "area scale " << area_scale;
+  }
+}
+
 }  // namespace
 }  // namespace omnivert

@@ -55,6 +55,11 @@ struct MatchOptions {
   // histograms of the areas it enters (the inner circle spans +-17 degrees of bearing at the
   // annulus's inner radius), not the others (docs/theory/matching.md#occluders).
   double partial_area_scale = 0.0;
+  // The same for the line's two sides; 0: off. With L and R the squared distances over the
+  // halves on each side of the line (all three areas' H_kL, and H_kR), the distance may also
+  // be sqrt(s_side min(L, R)): a person walking beside a line changes the histograms on its
+  // side only, whichever areas it enters. With both scales set, the least of the three forms.
+  double partial_side_scale = 0.0;
 
   // True when the options are usable; otherwise false with the reason in *error.
   bool IsValid(std::string* error) const;
@@ -127,11 +132,14 @@ class Matcher {
 
  private:
   DistanceView partial_distances(const ConstDescriptors& query, const ConstDescriptors& candidates);
+  DistanceView partial_side_distances(const ConstDescriptors& query,
+                                      const ConstDescriptors& candidates);
 
   MatchOptions options_;
   // Work space with capacity; the live part is the top-left rows_ x cols_ corner.
   DistanceMatrix distances_;
   DistanceMatrix area_, worst_;  // the occluder-tolerant distance's: one area's d^2, the largest
+  DistanceMatrix half_, left_, right_;  // with partial_side_scale: one half's d^2, each side's
   Eigen::VectorXf query_norms_;
   Eigen::VectorXf candidate_norms_;
   Eigen::Index rows_ = 0;
