@@ -95,6 +95,36 @@ inline void add_prediction_options(CLI::App* cmd, TrackerFlags& t, const std::st
       ->group(g);
 }
 
+// Tests 1-3 (eq. 8-10) and the occluder-tolerant distances.
+inline void add_descriptor_test_options(CLI::App* cmd, TrackerFlags& t, const std::string& g) {
+  cmd->add_option("--f1",
+                  t.f1,
+                  "Test 1, eq. (8): min distance <= F1 (default: the rule set's: paper 1.05, "
+                  "recommended 0.6)")
+      ->check(kPositive)
+      ->group(g);
+  cmd->add_option("--f2", t.f2, "Test 2, eq. (9): min <= F2 * mean (default 0.75)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->group(g);
+  cmd->add_option("--f3", t.f3, "Test 3, eq. (10): min <= F3 * second min (default 0.8)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->group(g);
+  cmd->add_option("--partial-area-scale",
+                  t.partial_area_scale,
+                  "Occluder-tolerant descriptor distance: where one of the three areas holds more "
+                  "than (s-1)/s of the squared distance, the other two decide, scaled by s "
+                  "(e.g. 2 in scenes with people; default 0: off, eq. 6)")
+      ->check(CLI::Number)
+      ->group(g);
+  cmd->add_option("--partial-side-scale",
+                  t.partial_side_scale,
+                  "Occluder-tolerant descriptor distance by the line's sides: the distance may "
+                  "also be s times the closer side's (a person beside the line changes one "
+                  "side; e.g. 2 with people; default 0: off)")
+      ->check(CLI::Number)
+      ->group(g);
+}
+
 inline void add_tracker_options(CLI::App* cmd, TrackerFlags& t) {
   const std::string g = kTrackingGroup;
   cmd->add_option(
@@ -193,32 +223,7 @@ inline void add_tracker_options(CLI::App* cmd, TrackerFlags& t) {
                   "Odometry gate: bearing detection tolerance [degrees] (default 2)")
       ->check(CLI::Range(0.0, 179.0))
       ->group(g);
-  cmd->add_option("--f1",
-                  t.f1,
-                  "Test 1, eq. (8): min distance <= F1 (default: the rule set's: paper 1.05, "
-                  "recommended 0.6)")
-      ->check(kPositive)
-      ->group(g);
-  cmd->add_option("--f2", t.f2, "Test 2, eq. (9): min <= F2 * mean (default 0.75)")
-      ->check(CLI::Range(0.0, 1.0))
-      ->group(g);
-  cmd->add_option("--f3", t.f3, "Test 3, eq. (10): min <= F3 * second min (default 0.8)")
-      ->check(CLI::Range(0.0, 1.0))
-      ->group(g);
-  cmd->add_option("--partial-area-scale",
-                  t.partial_area_scale,
-                  "Occluder-tolerant descriptor distance: where one of the three areas holds more "
-                  "than (s-1)/s of the squared distance, the other two decide, scaled by s "
-                  "(e.g. 2 in scenes with people; default 0: off, eq. 6)")
-      ->check(CLI::Number)
-      ->group(g);
-  cmd->add_option("--partial-side-scale",
-                  t.partial_side_scale,
-                  "Occluder-tolerant descriptor distance by the line's sides: the distance may "
-                  "also be s times the closer side's (a person beside the line changes one "
-                  "side; e.g. 2 with people; default 0: off)")
-      ->check(CLI::Number)
-      ->group(g);
+  add_descriptor_test_options(cmd, t, g);
 }
 
 }  // namespace omnivert::cli
