@@ -93,10 +93,18 @@ TEST(Invariance, RotatedUsableMarksWhatTheCopyReallySaw) {
         const bool inside =
             q.x() >= 1 && q.y() >= 1 && q.x() <= size.width - 2 && q.y() <= size.height - 2;
         const bool outside = q.x() < -1 || q.y() < -1 || q.x() > size.width || q.y() > size.height;
-        if (inside) EXPECT_EQ(frame.at<uchar>(v, u), 255) << u << "," << v << " at " << deg;
-        if (outside) EXPECT_EQ(frame.at<uchar>(v, u), 0) << u << "," << v << " at " << deg;
-        if (inside && q.x() >= 31) EXPECT_EQ(masked.at<uchar>(v, u), 255) << u << "," << v;
-        if (q.x() < 29) EXPECT_EQ(masked.at<uchar>(v, u), 0) << u << "," << v;
+        if (inside) {
+          EXPECT_EQ(frame.at<uchar>(v, u), 255) << u << "," << v << " at " << deg;
+        }
+        if (outside) {
+          EXPECT_EQ(frame.at<uchar>(v, u), 0) << u << "," << v << " at " << deg;
+        }
+        if (inside && q.x() >= 31) {
+          EXPECT_EQ(masked.at<uchar>(v, u), 255) << u << "," << v;
+        }
+        if (q.x() < 29) {
+          EXPECT_EQ(masked.at<uchar>(v, u), 0) << u << "," << v;
+        }
         checked += inside || outside;
       }
     EXPECT_GT(checked, size.area() * 9 / 10);

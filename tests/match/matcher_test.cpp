@@ -293,7 +293,9 @@ int expect_fast_path_agrees(const MatchOptions& o, std::mt19937& rng, int trials
       EXPECT_NEAR(f.min_distance, r.min_distance, 1e-3);
       EXPECT_NEAR(f.second_distance, r.second_distance, 1e-3);
       EXPECT_NEAR(f.mean_distance, r.mean_distance, 1e-3);
-      if (r.second_distance - r.min_distance > 1e-3f) EXPECT_EQ(f.best, r.best);
+      if (r.second_distance - r.min_distance > 1e-3f) {
+        EXPECT_EQ(f.best, r.best);
+      }
     }
   }
   return partial;
