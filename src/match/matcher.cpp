@@ -119,6 +119,23 @@ T side_tolerant_sq(T sum, T worst, T left, T right, T area_scale, T side_scale) 
 
 }  // namespace
 
+// out = the squared distances over the columns at..at+width of every query and candidate row,
+// |a|^2 + |b|^2 - 2 a.b by one matrix product (clamped at 0 against rounding).
+void Matcher::block_distances_sq(const ConstDescriptors& query,
+                                 const ConstDescriptors& candidates,
+                                 Eigen::Index at,
+                                 Eigen::Index width,
+                                 Eigen::Block<DistanceMatrix> out) {
+  const auto q = query.middleCols(at, width);
+  const auto c = candidates.middleCols(at, width);
+  out.noalias() = q * c.transpose();
+  query_norms_.head(rows_) = q.rowwise().squaredNorm();
+  candidate_norms_.head(cols_) = c.rowwise().squaredNorm();
+  for (Eigen::Index i = 0; i < rows_; ++i)
+    for (Eigen::Index j = 0; j < cols_; ++j)
+      out(i, j) = std::max(query_norms_(i) + candidate_norms_(j) - 2.0f * out(i, j), 0.0f);
+}
+
 // MatchOptions::partial_area_scale: per area k, d_k^2 = |a_k|^2 + |b_k|^2 - 2 a_k.b_k by one
 // matrix product over its third of the columns; their sum in distances_, their largest in
 // worst_.
@@ -133,14 +150,10 @@ Matcher::DistanceView Matcher::partial_distances(const ConstDescriptors& query,
   auto m = worst_.topLeftCorner(rows_, cols_);
   const Eigen::Index w = query.cols() / 3;
   for (Eigen::Index k = 0; k < 3; ++k) {
-    const auto q = query.middleCols(k * w, w);
-    const auto c = candidates.middleCols(k * w, w);
-    a.noalias() = q * c.transpose();
-    query_norms_.head(rows_) = q.rowwise().squaredNorm();
-    candidate_norms_.head(cols_) = c.rowwise().squaredNorm();
+    block_distances_sq(query, candidates, k * w, w, a);
     for (Eigen::Index i = 0; i < rows_; ++i)
       for (Eigen::Index j = 0; j < cols_; ++j) {
-        const float sq = std::max(query_norms_(i) + candidate_norms_(j) - 2.0f * a(i, j), 0.0f);
+        const float sq = a(i, j);
         d(i, j) = k == 0 ? sq : d(i, j) + sq;
         m(i, j) = k == 0 ? sq : std::max(m(i, j), sq);
       }
@@ -167,15 +180,11 @@ Matcher::DistanceView Matcher::partial_side_distances(const ConstDescriptors& qu
   auto r = right_.topLeftCorner(rows_, cols_);
   const Eigen::Index w = query.cols() / 6;
   for (Eigen::Index k = 0; k < 6; ++k) {
-    const auto q = query.middleCols(k * w, w);
-    const auto c = candidates.middleCols(k * w, w);
-    h.noalias() = q * c.transpose();
-    query_norms_.head(rows_) = q.rowwise().squaredNorm();
-    candidate_norms_.head(cols_) = c.rowwise().squaredNorm();
+    block_distances_sq(query, candidates, k * w, w, h);
     const bool right = k % 2 == 1;
     for (Eigen::Index i = 0; i < rows_; ++i)
       for (Eigen::Index j = 0; j < cols_; ++j) {
-        const float sq = std::max(query_norms_(i) + candidate_norms_(j) - 2.0f * h(i, j), 0.0f);
+        const float sq = h(i, j);
         if (!right) {
           a(i, j) = sq;
           l(i, j) = k == 0 ? sq : l(i, j) + sq;

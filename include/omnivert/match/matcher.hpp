@@ -134,6 +134,11 @@ class Matcher {
   DistanceView partial_distances(const ConstDescriptors& query, const ConstDescriptors& candidates);
   DistanceView partial_side_distances(const ConstDescriptors& query,
                                       const ConstDescriptors& candidates);
+  void block_distances_sq(const ConstDescriptors& query,
+                          const ConstDescriptors& candidates,
+                          Eigen::Index at,
+                          Eigen::Index width,
+                          Eigen::Block<DistanceMatrix> out);
 
   MatchOptions options_;
   // Work space with capacity; the live part is the top-left rows_ x cols_ corner.
